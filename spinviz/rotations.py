@@ -1,0 +1,223 @@
+"""Quaternion and SO(3) maths (wraps numpy-quaternion).
+
+Conventions (DESIGN.md, section 5):
+
+* quaternions are scalar-first float arrays, shape (..., 4), ordered (w, x, y, z);
+  numpy-quaternion's ``quaternion`` dtype is used inside for products and interpolation;
+* ``q`` represents O = R(q), the rotation that maps body-frame vectors to the world
+  frame (r = O rho, as in section 2 of the paper), so ``world_from_body(q, v)`` = O v;
+* q and -q are the same rotation: compare rotations with ``misorientation`` or
+  ``allclose_up_to_sign``, never element by element;
+* ZXZ Euler angles (phi, theta, psi) in radians with O = Rz(phi) Rx(theta) Rz(psi), the
+  convention of the Poisson equations (6.4) (checked in DESIGN.md, section 2).
+
+This module knows no physics and no rendering.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import quaternion as _nq
+
+__all__ = [
+    "as_quaternion_array",
+    "as_float_quat",
+    "normalize",
+    "multiply",
+    "conjugate",
+    "exp_rotvec",
+    "quat_from_axis_angle",
+    "quat_from_euler_zxz",
+    "euler_zxz_from_quat",
+    "unwrap_euler_zxz",
+    "matrix_from_quat",
+    "quat_from_matrix",
+    "world_from_body",
+    "body_from_world",
+    "misorientation",
+    "allclose_up_to_sign",
+    "unflip",
+    "slerp_series",
+]
+
+
+def as_quaternion_array(q):
+    """Float array (..., 4) (w, x, y, z) -> numpy-quaternion array (...)."""
+    q = np.asarray(q, dtype=float)
+    if q.shape[-1] != 4:
+        raise ValueError(f"quaternion array must have last axis of length 4 (w, x, y, z); got shape {q.shape}")
+    return _nq.as_quat_array(np.ascontiguousarray(q))
+
+
+def as_float_quat(qa) -> np.ndarray:
+    """numpy-quaternion array (...) -> float array (..., 4), (w, x, y, z)."""
+    return _nq.as_float_array(qa)
+
+
+def normalize(q) -> np.ndarray:
+    """Unit quaternion(s) q / |q|; q shape (..., 4), (w, x, y, z)."""
+    q = np.asarray(q, dtype=float)
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
+def multiply(a, b) -> np.ndarray:
+    """Hamilton product a (x) b of float quaternions, shapes (..., 4) broadcast, (w, x, y, z)."""
+    return as_float_quat(as_quaternion_array(a) * as_quaternion_array(b))
+
+
+def conjugate(q) -> np.ndarray:
+    """Conjugate (w, -x, -y, -z); the inverse rotation of a unit quaternion."""
+    q = np.array(q, dtype=float, copy=True)
+    q[..., 1:] *= -1.0
+    return q
+
+
+def exp_rotvec(rotvec) -> np.ndarray:
+    """Unit quaternion exp(rotvec / 2): rotation by |rotvec| rad about rotvec.
+
+    rotvec : array_like, shape (..., 3), rad.  Returns shape (..., 4), (w, x, y, z).
+    Exact for any angle, including 0 (numpy-quaternion handles the small-angle limit).
+    """
+    rotvec = np.asarray(rotvec, dtype=float)
+    return as_float_quat(_nq.from_rotation_vector(rotvec))
+
+
+def quat_from_axis_angle(axis, angle) -> np.ndarray:
+    """Rotation by ``angle`` (rad, shape (...)) about the fixed unit ``axis`` (shape (3,)).
+
+    Returns shape (..., 4), (w, x, y, z).
+    """
+    axis = np.asarray(axis, dtype=float)
+    axis = axis / np.linalg.norm(axis)
+    half = 0.5 * np.asarray(angle, dtype=float)
+    out = np.empty(half.shape + (4,))
+    out[..., 0] = np.cos(half)
+    out[..., 1:] = np.sin(half)[..., None] * axis
+    return out
+
+
+def quat_from_euler_zxz(angles) -> np.ndarray:
+    """Quaternion of O = Rz(phi) Rx(theta) Rz(psi), the ZXZ convention of (6.4).
+
+    angles : array_like, shape (..., 3) -- (phi, theta, psi) in rad.
+    Returns shape (..., 4), (w, x, y, z), with
+    q = (cos(theta/2) cos((phi+psi)/2), sin(theta/2) cos((phi-psi)/2),
+         sin(theta/2) sin((phi-psi)/2), cos(theta/2) sin((phi+psi)/2)).
+    """
+    a = np.asarray(angles, dtype=float)
+    if a.shape[-1] != 3:
+        raise ValueError(f"Euler angles must have last axis of length 3 (phi, theta, psi); got shape {a.shape}")
+    phi, theta, psi = a[..., 0], a[..., 1], a[..., 2]
+    qz_phi = as_quaternion_array(quat_from_axis_angle((0.0, 0.0, 1.0), phi))
+    qx_theta = as_quaternion_array(quat_from_axis_angle((1.0, 0.0, 0.0), theta))
+    qz_psi = as_quaternion_array(quat_from_axis_angle((0.0, 0.0, 1.0), psi))
+    return as_float_quat(qz_phi * qx_theta * qz_psi)
+
+
+def euler_zxz_from_quat(q) -> np.ndarray:
+    """ZXZ Euler angles (phi, theta, psi), rad, of O = R(q); inverse of ``quat_from_euler_zxz``.
+
+    q : array_like, shape (..., 4), (w, x, y, z); need not be normalized.
+    Returns shape (..., 3) with theta in [0, pi] and phi, psi in (-pi, pi].
+
+    Uses atan2 on the closed form of ``quat_from_euler_zxz`` (no arccos, so theta keeps
+    full precision near 0 and pi).  At theta = 0 only phi + psi is defined and at
+    theta = pi only phi - psi: there psi is set to 0 -- the singularity of the
+    angles themselves, the reason (6.4) breaks down there and quaternions do not.
+    """
+    q = np.asarray(q, dtype=float)
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    c = np.hypot(w, z)                    # |cos(theta/2)|
+    s = np.hypot(x, y)                    # |sin(theta/2)|
+    theta = 2.0 * np.arctan2(s, c)
+    sum_ = 2.0 * np.arctan2(z, w)         # phi + psi  (mod 2 pi, up to the q -> -q sign)
+    diff = 2.0 * np.arctan2(y, x)         # phi - psi
+    tiny = 1e-15 * np.hypot(c, s)
+    sum_ = np.where(c > tiny, sum_, diff)   # theta = pi: put everything in phi
+    diff = np.where(s > tiny, diff, sum_)   # theta = 0:  put everything in phi
+    phi = 0.5 * (sum_ + diff)
+    psi = 0.5 * (sum_ - diff)
+    out = np.stack([phi, theta, psi], axis=-1)
+    # wrap phi, psi into (-pi, pi]
+    out[..., 0] = _wrap(out[..., 0])
+    out[..., 2] = _wrap(out[..., 2])
+    return out
+
+
+def _wrap(a):
+    return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
+
+
+def unwrap_euler_zxz(angles) -> np.ndarray:
+    """Unwrap phi and psi of a time series of ZXZ angles, shape (N, 3), along axis 0."""
+    out = np.array(angles, dtype=float, copy=True)
+    out[:, 0] = np.unwrap(out[:, 0])
+    out[:, 2] = np.unwrap(out[:, 2])
+    return out
+
+
+def matrix_from_quat(q) -> np.ndarray:
+    """Rotation matrix O = R(q), shape (..., 3, 3); q shape (..., 4), (w, x, y, z)."""
+    return _nq.as_rotation_matrix(as_quaternion_array(q))
+
+
+def quat_from_matrix(m) -> np.ndarray:
+    """Unit quaternion (w, x, y, z) of a rotation matrix, shape (..., 3, 3) -> (..., 4)."""
+    return as_float_quat(_nq.from_rotation_matrix(np.asarray(m, dtype=float)))
+
+
+def world_from_body(q, v_body) -> np.ndarray:
+    """O v: body-frame vectors to the world frame.
+
+    q : shape (..., 4), (w, x, y, z); v_body : shape (..., 3); leading axes broadcast
+    pairwise (one quaternion per vector), unlike ``quaternion.rotate_vectors``.
+    """
+    m = matrix_from_quat(q)
+    return np.einsum("...ij,...j->...i", m, np.asarray(v_body, dtype=float))
+
+
+def body_from_world(q, v_world) -> np.ndarray:
+    """O^T v: world-frame vectors to the body frame (pairwise broadcasting as above)."""
+    m = matrix_from_quat(q)
+    return np.einsum("...ji,...j->...i", m, np.asarray(v_world, dtype=float))
+
+
+def misorientation(q1, q2) -> np.ndarray:
+    """Angle (rad, in [0, pi]) of the rotation taking R(q1) to R(q2); sign-blind.
+
+    q1, q2 : shape (..., 4), (w, x, y, z), unit.  Uses atan2 of the vector and scalar parts
+    of q1* (x) q2, accurate also for tiny angles (arccos of a dot product is not).
+    """
+    r = multiply(conjugate(q1), q2)
+    return 2.0 * np.arctan2(np.linalg.norm(r[..., 1:], axis=-1), np.abs(r[..., 0]))
+
+
+def allclose_up_to_sign(q1, q2, atol: float = 1e-12) -> bool:
+    """True when q1 and q2 (shape (..., 4), (w, x, y, z)) are the same rotations within atol rad."""
+    return bool(np.all(misorientation(q1, q2) <= atol))
+
+
+def unflip(q) -> np.ndarray:
+    """Choose signs along a time series q, shape (N, 4), so that neighbours are continuous."""
+    return as_float_quat(_nq.unflip_rotors(as_quaternion_array(q), axis=-1, inplace=False))
+
+
+def slerp_series(t_src, q_src, t_dst) -> np.ndarray:
+    """Orientation at times ``t_dst`` by slerp between stored orientations.
+
+    t_src : shape (N,), increasing; q_src : shape (N, 4), (w, x, y, z), unit;
+    t_dst : shape (M,) within [t_src[0], t_src[-1]].  Returns shape (M, 4).
+    Each interval is interpolated along its shortest geodesic (neighbours are unflipped
+    first), so the stored samples must be closer than half a turn apart.
+    """
+    t_src = np.asarray(t_src, dtype=float)
+    t_dst = np.atleast_1d(np.asarray(t_dst, dtype=float))
+    q_src = unflip(np.asarray(q_src, dtype=float))
+    if t_src.size == 1:
+        return np.repeat(q_src[:1], t_dst.size, axis=0)
+    i = np.clip(np.searchsorted(t_src, t_dst, side="right") - 1, 0, t_src.size - 2)
+    span = t_src[i + 1] - t_src[i]
+    tau = np.clip((t_dst - t_src[i]) / np.where(span > 0, span, 1.0), 0.0, 1.0)
+    qa = as_quaternion_array(q_src[i])
+    qb = as_quaternion_array(q_src[i + 1])
+    return as_float_quat(np.slerp_vectorized(qa, qb, tau))

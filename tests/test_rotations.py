@@ -1,0 +1,113 @@
+"""Quaternion and Euler-angle conventions (DESIGN.md, section 5)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from spinviz import rotations as R
+
+RNG = np.random.default_rng(7)
+
+
+def Rz(a):
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+
+
+def Rx(a):
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[1.0, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def test_zxz_quaternion_is_Rz_Rx_Rz():
+    """O = Rz(phi) Rx(theta) Rz(psi) is the matrix of quat_from_euler_zxz (the convention of (6.4))."""
+    for _ in range(20):
+        phi, theta, psi = RNG.uniform(-np.pi, np.pi), RNG.uniform(0, np.pi), RNG.uniform(-np.pi, np.pi)
+        m = R.matrix_from_quat(R.quat_from_euler_zxz([phi, theta, psi]))
+        np.testing.assert_allclose(m, Rz(phi) @ Rx(theta) @ Rz(psi), atol=1e-14)
+
+
+def test_quaternion_is_scalar_first():
+    q = R.quat_from_axis_angle((0.0, 0.0, 1.0), 0.5 * np.pi)
+    np.testing.assert_allclose(q, [math.cos(np.pi / 4), 0, 0, math.sin(np.pi / 4)], atol=1e-15)
+    # and maps body x to world y
+    np.testing.assert_allclose(R.world_from_body(q, [1.0, 0.0, 0.0]), [0.0, 1.0, 0.0], atol=1e-15)
+
+
+def test_euler_round_trip_generic():
+    a = np.stack([RNG.uniform(-np.pi, np.pi, 200), RNG.uniform(1e-3, np.pi - 1e-3, 200), RNG.uniform(-np.pi, np.pi, 200)], -1)
+    back = R.euler_zxz_from_quat(R.quat_from_euler_zxz(a))
+    np.testing.assert_allclose(back, a, atol=1e-12)
+
+
+@pytest.mark.parametrize("theta", [0.0, np.pi])
+def test_euler_round_trip_at_the_singularities(theta):
+    """At theta = 0 only phi + psi is defined, at theta = pi only phi - psi: the angles come
+    back with psi = 0, theta exact, and the *rotation* is the same."""
+    for phi, psi in [(0.3, 0.5), (-2.0, 1.0), (3.0, 3.0)]:
+        q = R.quat_from_euler_zxz([phi, theta, psi])
+        back = R.euler_zxz_from_quat(q)
+        assert back[1] == pytest.approx(theta, abs=1e-15)
+        assert back[2] == 0.0
+        assert R.misorientation(R.quat_from_euler_zxz(back), q) < 1e-14
+        want = phi + psi if theta == 0.0 else phi - psi
+        assert abs(np.angle(np.exp(1j * (back[0] - want)))) < 1e-14
+
+
+def test_theta_keeps_precision_near_zero():
+    """theta from atan2 (not arccos) is exact to round-off even at 1e-10 rad."""
+    for th in (1e-6, 1e-10, 1e-14):
+        back = R.euler_zxz_from_quat(R.quat_from_euler_zxz([0.4, th, -0.3]))
+        assert back[1] == pytest.approx(th, rel=1e-9)
+
+
+def test_round_trip_is_sign_blind():
+    q = R.quat_from_euler_zxz([0.4, 1.0, -2.0])
+    np.testing.assert_allclose(R.euler_zxz_from_quat(-q), R.euler_zxz_from_quat(q), atol=1e-14)
+
+
+def test_misorientation_tiny_and_large_angles_and_sign():
+    q = R.normalize(RNG.normal(size=4))
+    for ang in (1e-12, 1e-6, 0.5, 3.0):
+        r = R.multiply(q, R.quat_from_axis_angle((0.6, 0.0, 0.8), ang))
+        assert R.misorientation(q, r) == pytest.approx(ang, rel=1e-9)
+        assert R.misorientation(q, -r) == pytest.approx(ang, rel=1e-9)
+
+
+def test_exp_rotvec_and_matrix_round_trip():
+    v = np.array([0.3, -1.2, 2.0])
+    q = R.exp_rotvec(v)
+    np.testing.assert_allclose(R.world_from_body(q, v), v, atol=1e-14)   # the axis is fixed
+    assert R.misorientation(q, np.array([1.0, 0, 0, 0])) == pytest.approx(np.linalg.norm(v), rel=1e-14)
+    assert R.allclose_up_to_sign(R.quat_from_matrix(R.matrix_from_quat(q)), q)
+
+
+def test_world_and_body_are_inverse_pairwise():
+    q = R.normalize(RNG.normal(size=(5, 4)))
+    v = RNG.normal(size=(5, 3))
+    np.testing.assert_allclose(R.body_from_world(q, R.world_from_body(q, v)), v, atol=1e-14)
+
+
+def test_slerp_series_follows_uniform_rotation():
+    """Sampled from a uniform rotation (0.4 rad between samples), slerp reproduces it exactly in between."""
+    t = np.linspace(0.0, 10.0, 26)
+    axis = np.array([1.0, 2.0, 2.0]) / 3.0
+    q = R.quat_from_axis_angle(axis, 1.0 * t)
+    q[1::2] *= -1.0                                   # sign flips must not matter
+    t2 = np.linspace(0.0, 10.0, 97)
+    np.testing.assert_array_less(R.misorientation(R.slerp_series(t, q, t2), R.quat_from_axis_angle(axis, 1.0 * t2)), 1e-13)
+
+
+def test_unwrap_euler_removes_jumps():
+    phi = np.linspace(0.0, 20.0, 200)
+    a = np.stack([phi, np.full_like(phi, 1.0), -phi], -1)
+    wrapped = R.euler_zxz_from_quat(R.quat_from_euler_zxz(a))
+    np.testing.assert_allclose(R.unwrap_euler_zxz(wrapped), a, atol=1e-12)
+
+
+def test_bad_shapes_say_what_was_expected():
+    with pytest.raises(ValueError, match=r"last axis of length 3 \(phi, theta, psi\); got shape \(4,\)"):
+        R.quat_from_euler_zxz([1.0, 2.0, 3.0, 4.0])
+    with pytest.raises(ValueError, match=r"last axis of length 4 \(w, x, y, z\); got shape \(3,\)"):
+        R.as_quaternion_array([1.0, 0.0, 0.0])

@@ -1,0 +1,241 @@
+"""Equations of motion: reduced (2.2)+(2.3), truncated (2.5), free, and the kinematics.
+
+All three Euler equations are written for any diagonal inertia J = (J1, J2, J3) and any
+body-frame radiation coupling vector g = sqrt(2 / (3 c^3)) d, so the torque of the paper,
+(2/3c^3) d x {...}, reads g x {...}.  The same formulas serve both unit systems:
+
+* CGS: J = (I1, I2, I3) in g cm^2, g = sqrt(2/3c^3) d, Omega in rad/s, t in s;
+* dimensionless (4.1): J = (1, I2/I1, I3/I1), g = d/|d| (unit), so tau0 = |g|^2/J1 = 1.
+
+The rate functions take and return components ``(w1, w2, w3)``.  Written component-wise,
+one implementation works on Python floats (the fast path inside the ODE right-hand
+side, free of NumPy's per-call overhead on 3-vectors), on NumPy arrays of any shape
+(vectorized evaluation along a trajectory) and on complex numbers (exact Jacobians by
+complex-step differentiation, see ``jacobian``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..rotations import world_from_body
+
+MODELS = ("reduced", "truncated", "free")
+
+
+def free_rate(w1, w2, w3, J, g):
+    """Omega_dot of the torque-free top (2.3a): -J^-1 (Omega x J Omega).  ``g`` is ignored."""
+    J1, J2, J3 = J
+    L1, L2, L3 = J1 * w1, J2 * w2, J3 * w3
+    return -(w2 * L3 - w3 * L2) / J1, -(w3 * L1 - w1 * L3) / J2, -(w1 * L2 - w2 * L1) / J3
+
+
+def reduced_rate(w1, w2, w3, J, g):
+    """Omega_dot of the reduced Euler equation: (2.2) with (2.3a), (2.3b) on the right.
+
+    J Omega_dot + Omega x J Omega = g x { g x (Omega^2 Omega - Omega_ddot)
+                                        + (g . Omega_dot) Omega + 2 (g . Omega) Omega_dot },
+    with Omega_dot, Omega_ddot on the right replaced by their free-motion values.
+    """
+    J1, J2, J3 = J
+    g1, g2, g3 = g
+    # Cross products are written out (no helper calls) so that numba can compile this
+    # very function for the integrator kernels: one source for every caller.
+    L1, L2, L3 = J1 * w1, J2 * w2, J3 * w3
+    c1, c2, c3 = w2 * L3 - w3 * L2, w3 * L1 - w1 * L3, w1 * L2 - w2 * L1   # Omega x J Omega
+    a1, a2, a3 = -c1 / J1, -c2 / J2, -c3 / J3                               # (2.3a)
+    # (2.3b): Omega_ddot = -J^-1 (Omega_dot x J Omega + Omega x J Omega_dot)
+    K1, K2, K3 = J1 * a1, J2 * a2, J3 * a3
+    b1 = -((a2 * L3 - a3 * L2) + (w2 * K3 - w3 * K2)) / J1
+    b2 = -((a3 * L1 - a1 * L3) + (w3 * K1 - w1 * K3)) / J2
+    b3 = -((a1 * L2 - a2 * L1) + (w1 * K2 - w2 * K1)) / J3
+    w_sq = w1 * w1 + w2 * w2 + w3 * w3
+    ga = g1 * a1 + g2 * a2 + g3 * a3
+    gw2 = 2.0 * (g1 * w1 + g2 * w2 + g3 * w3)
+    p1, p2, p3 = w_sq * w1 - b1, w_sq * w2 - b2, w_sq * w3 - b3
+    h1 = g2 * p3 - g3 * p2 + ga * w1 + gw2 * a1
+    h2 = g3 * p1 - g1 * p3 + ga * w2 + gw2 * a2
+    h3 = g1 * p2 - g2 * p1 + ga * w3 + gw2 * a3
+    n1, n2, n3 = g2 * h3 - g3 * h2, g3 * h1 - g1 * h3, g1 * h2 - g2 * h1   # radiation torque
+    return (n1 - c1) / J1, (n2 - c2) / J2, (n3 - c3) / J3
+
+
+def truncated_rate(w1, w2, w3, J, g):
+    """Omega_dot of the truncated Euler equation (2.5), solved exactly for Omega_dot.
+
+    J Omega_dot + Omega x J Omega = -{ |g x Omega|^2 Omega + (g . (Omega x Omega_dot)) g }.
+    Since g . (Omega x Omega_dot) = (g x Omega) . Omega_dot, this is
+    (J + g v^T) Omega_dot = r with v = g x Omega, r = -Omega x J Omega - |v|^2 Omega,
+    a rank-one update of J, inverted by Sherman-Morrison:
+    Omega_dot = J^-1 r - J^-1 g (v . J^-1 r) / (1 + v . J^-1 g).
+    The denominator vanishes only when |tau0 Omega| is of order 1, far outside any
+    physical regime; ``truncated_singularity`` reports how close a state is.
+    """
+    J1, J2, J3 = J
+    g1, g2, g3 = g
+    L1, L2, L3 = J1 * w1, J2 * w2, J3 * w3
+    c1, c2, c3 = w2 * L3 - w3 * L2, w3 * L1 - w1 * L3, w1 * L2 - w2 * L1   # Omega x J Omega
+    v1, v2, v3 = g2 * w3 - g3 * w2, g3 * w1 - g1 * w3, g1 * w2 - g2 * w1   # g x Omega
+    v_sq = v1 * v1 + v2 * v2 + v3 * v3
+    r1, r2, r3 = (-c1 - v_sq * w1) / J1, (-c2 - v_sq * w2) / J2, (-c3 - v_sq * w3) / J3
+    u1, u2, u3 = g1 / J1, g2 / J2, g3 / J3
+    k = (v1 * r1 + v2 * r2 + v3 * r3) / (1.0 + v1 * u1 + v2 * u2 + v3 * u3)
+    return r1 - k * u1, r2 - k * u2, r3 - k * u3
+
+
+def truncated_singularity(w1, w2, w3, J, g):
+    """1 + (g x Omega) . J^-1 g, the Sherman-Morrison denominator of ``truncated_rate``.
+
+    It equals det(J + g (g x Omega)^T) / det J; (2.5) cannot be solved for Omega_dot where
+    it is 0.  Dimensionless it is 1 + O(|omega|), so it matters only for |omega| ~ 1.
+    """
+    J1, J2, J3 = J
+    g1, g2, g3 = g
+    v1, v2, v3 = g2 * w3 - g3 * w2, g3 * w1 - g1 * w3, g1 * w2 - g2 * w1
+    return 1.0 + v1 * g1 / J1 + v2 * g2 / J2 + v3 * g3 / J3
+
+
+_RATES = {"reduced": reduced_rate, "truncated": truncated_rate, "free": free_rate}
+
+
+def rate_function(model: str):
+    """The Omega_dot function of a model name ("reduced", "truncated" or "free")."""
+    try:
+        return _RATES[model]
+    except KeyError:
+        raise ValueError(f"unknown model {model!r}; valid: {', '.join(MODELS)}") from None
+
+
+def omega_dot(model: str, omega, J, g) -> np.ndarray:
+    """Vectorized Omega_dot for omega of shape (..., 3); returns the same shape."""
+    omega = np.asarray(omega, dtype=float)
+    out = rate_function(model)(omega[..., 0], omega[..., 1], omega[..., 2], tuple(J), tuple(g))
+    return np.stack(np.broadcast_arrays(*out), axis=-1)
+
+
+def jacobian(model: str, omega, J, g) -> np.ndarray:
+    """d Omega_dot / d Omega at one state, shape (3, 3), exact to round-off.
+
+    Complex-step differentiation of the model's own formula: for a real-analytic f,
+    f(x + i h e_k) = f(x) + i h df/dx_k + O(h^2), with no subtraction, so with h = 1e-30
+    |omega| the imaginary part is the derivative to the last bit.  Every model is a
+    polynomial or rational function of Omega, so this is the analytic Jacobian without
+    a hand-expanded (and error-prone) copy of (2.2).
+    """
+    f = rate_function(model)
+    w = np.asarray(omega, dtype=float)
+    h = 1e-30 * max(float(np.max(np.abs(w))), 1e-300)
+    Jt, gt = tuple(J), tuple(g)
+    out = np.empty((3, 3))
+    for k in range(3):
+        z = [complex(w[0]), complex(w[1]), complex(w[2])]
+        z[k] += 1j * h
+        col = f(z[0], z[1], z[2], Jt, gt)
+        out[:, k] = [c.imag / h for c in col]
+    return out
+
+
+def quat_rate(q0, q1, q2, q3, w1, w2, w3):
+    """q_dot = 1/2 q (x) (0, Omega_body), scalar-first q = (w, x, y, z); O = R(q) body->world."""
+    return (
+        -0.5 * (q1 * w1 + q2 * w2 + q3 * w3),
+        0.5 * (q0 * w1 + q2 * w3 - q3 * w2),
+        0.5 * (q0 * w2 + q3 * w1 - q1 * w3),
+        0.5 * (q0 * w3 + q1 * w2 - q2 * w1),
+    )
+
+
+def euler_zxz_rate(phi, theta, psi, w1, w2, w3):
+    """The Poisson equations (6.4): (phi_dot, theta_dot, psi_dot) from body Omega.
+
+    Singular at sin(theta) = 0 -- kept as the comparison the quaternion kinematics
+    replaces; integrating it near theta = 0 blows up (see ``spinviz stress``).
+    """
+    s, c = np.sin(psi), np.cos(psi)
+    a = w1 * s + w2 * c
+    st = np.sin(theta)
+    return a / st, w1 * c - w2 * s, w3 - a * np.cos(theta) / st
+
+
+@dataclass(frozen=True)
+class System:
+    """What the integrators see: a model and the dimensionless body (4.1).
+
+    inertia : (J1, J2, J3), principal moments scaled by I1 (J1 = 1 for a physical body).
+    coupling : (g1, g2, g3), body-frame radiation coupling, |g|^2 / J1 = tau0 = 1.
+    model : "reduced", "truncated" or "free".
+    """
+
+    model: str
+    inertia: tuple[float, float, float]
+    coupling: tuple[float, float, float]
+
+    def __post_init__(self):
+        rate_function(self.model)  # validates the name
+
+    @property
+    def is_symmetric(self) -> bool:
+        """I1 = I2 (the paper's symmetric top, e3 the symmetry axis)."""
+        J1, J2, _ = self.inertia
+        return abs(J1 - J2) <= 1e-14 * max(abs(J1), abs(J2))
+
+    def rate(self):
+        """Closure (w1, w2, w3) -> Omega_dot components, parameters bound."""
+        f = rate_function(self.model)
+        J, g = tuple(map(float, self.inertia)), tuple(map(float, self.coupling))
+        return lambda w1, w2, w3: f(w1, w2, w3, J, g)
+
+    def omega_dot(self, omega) -> np.ndarray:
+        """Vectorized Omega_dot, omega shape (..., 3)."""
+        return omega_dot(self.model, omega, self.inertia, self.coupling)
+
+    def jacobian(self, omega) -> np.ndarray:
+        """Exact d Omega_dot / d Omega, shape (3, 3)."""
+        return jacobian(self.model, omega, self.inertia, self.coupling)
+
+    def rhs(self):
+        """f(t, y) for y = (w1, w2, w3, q0, q1, q2, q3): Euler equation + quaternion kinematics."""
+        rate = self.rate()
+
+        def f(t, y):
+            w1, w2, w3, q0, q1, q2, q3 = y.tolist()
+            a1, a2, a3 = rate(w1, w2, w3)
+            d0, d1, d2, d3 = quat_rate(q0, q1, q2, q3, w1, w2, w3)
+            return np.array((a1, a2, a3, d0, d1, d2, d3))
+
+        return f
+
+    def rhs_jacobian(self):
+        """J(t, y), shape (7, 7), of ``rhs``: exact Euler block, exact kinematics blocks."""
+        model, inertia, coupling = self.model, self.inertia, self.coupling
+
+        def jac(t, y):
+            w = y[:3]
+            q0, q1, q2, q3 = y[3:].tolist()
+            w1, w2, w3 = w.tolist()
+            out = np.zeros((7, 7))
+            out[:3, :3] = jacobian(model, w, inertia, coupling)
+            # d q_dot / d omega = 1/2 [q]_L restricted to the vector part
+            out[3:, :3] = 0.5 * np.array(
+                [[-q1, -q2, -q3], [q0, -q3, q2], [q3, q0, -q1], [-q2, q1, q0]]
+            )
+            # d q_dot / d q = 1/2 [(0, omega)]_R
+            out[3:, 3:] = 0.5 * np.array(
+                [[0.0, -w1, -w2, -w3], [w1, 0.0, w3, -w2], [w2, -w3, 0.0, w1], [w3, w2, -w1, 0.0]]
+            )
+            return out
+
+        return jac
+
+
+def kinetic_energy(omega, J) -> np.ndarray:
+    """E = 1/2 Omega . J Omega for omega shape (..., 3)."""
+    omega = np.asarray(omega, dtype=float)
+    return 0.5 * np.sum(np.asarray(J) * omega * omega, axis=-1)
+
+
+def angular_momentum_world(q, omega, J) -> np.ndarray:
+    """L_world = O J Omega_body; q shape (..., 4) (w, x, y, z), omega shape (..., 3)."""
+    return world_from_body(q, np.asarray(J) * np.asarray(omega, dtype=float))

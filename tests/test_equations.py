@@ -1,0 +1,190 @@
+"""The general equations of motion against the paper's component forms.
+
+(2.2)+(2.3) written for any inertia and dipole must reproduce (3.3)-(3.5) -- with c^3,
+not the c^2 the paper prints there (a typo: (3.8) has c^3; DESIGN.md, section 2) -- and
+the dimensionless (4.2)-(4.4); (2.5) must reproduce (5.3) at chi = 0.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from spinviz import units as U
+from spinviz.physics import equations as E
+
+RNG = np.random.default_rng(20261121)
+
+
+def eq_3_3_to_3_5(w, I1, I3, d, chi, c_power=3):
+    """(3.3)-(3.5) transcribed from the paper, CGS, with c^c_power in the prefactor."""
+    w1, w2, w3 = w
+    delta = 1.0 - I3 / I1
+    d1, d3 = d * math.sin(chi), d * math.cos(chi)
+    W2 = w1 * w1 + w2 * w2 + w3 * w3
+    wa = W2 + delta * (delta - 2.0) * w3**2
+    wb = W2 + delta * (2.0 * w1**2 - w2**2)
+    wc = W2 + delta * (delta + 1.0) * w3**2
+    c = U.C_LIGHT**c_power
+    r1 = delta * w2 * w3 - 2.0 * d3 / (3.0 * I1 * c) * (d3 * wa * w1 - d1 * wb * w3)
+    r2 = -delta * w1 * w3 - 2.0 / (3.0 * I1 * c) * (d1**2 * wc + d3**2 * wa - 3.0 * d1 * d3 * delta * w1 * w3) * w2
+    r3 = -2.0 * d1 / (3.0 * I3 * c) * (d1 * wb * w3 - d3 * wa * w1)
+    return np.array([r1, r2, r3])
+
+
+def eq_4_2_to_4_4(w, delta, chi):
+    """(4.2)-(4.4), dimensionless, solved for omega_dot."""
+    w1, w2, w3 = w
+    n1, n3 = math.sin(chi), math.cos(chi)
+    W2 = w1 * w1 + w2 * w2 + w3 * w3
+    wa = W2 + delta * (delta - 2.0) * w3**2
+    wb = W2 + delta * (2.0 * w1**2 - w2**2)
+    wc = W2 + delta * (delta + 1.0) * w3**2
+    r1 = delta * w2 * w3 - n3**2 * wa * w1 + n1 * n3 * wb * w3
+    r2 = -delta * w1 * w3 - (n1**2 * wc + n3**2 * wa - 3.0 * n1 * n3 * delta * w1 * w3) * w2
+    r3 = (-(n1**2) * wb * w3 + n1 * n3 * wa * w1) / (1.0 - delta)
+    return np.array([r1, r2, r3])
+
+
+@pytest.mark.parametrize("trial", range(20))
+def test_reduced_equals_3_3_to_3_5_with_c_cubed(trial):
+    """(2.2)+(2.3) in CGS = (3.3)-(3.5) read with c^3, for random parameters.
+
+    Omega is chosen so that tau0 |Omega| ~ 0.1-1: for real particles (1e-16) the
+    radiation part would sit below the round-off of the free part and compare nothing.
+    """
+    I1 = 10 ** RNG.uniform(-27, -25)
+    I3 = I1 * RNG.uniform(0.05, 1.95)
+    d = 10 ** RNG.uniform(-11, -7)
+    chi = RNG.uniform(0.0, 0.5 * math.pi)
+    tau0 = U.tau0_cgs(d, I1)
+    w = RNG.normal(size=3) * RNG.uniform(0.1, 1.0) / tau0
+    g = U.radiation_coupling((d * math.sin(chi), 0.0, d * math.cos(chi)))
+    got = np.array(E.reduced_rate(*w, (I1, I1, I3), tuple(g)))
+    want = eq_3_3_to_3_5(w, I1, I3, d, chi, c_power=3)
+    np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12 * np.abs(want).max())
+
+
+def test_c_squared_as_printed_disagrees_with_2_2():
+    """Read with c^2 as printed, (3.3)-(3.5) are not (2.2): the torque comes out c times too large."""
+    I1, I3, d, chi = 2.16e-26, 1.2e-26, 5.7e-11, 0.9
+    tau0 = U.tau0_cgs(d, I1)
+    w = np.array([0.3, -0.5, 0.4]) / tau0          # tau0 |Omega| ~ 0.7: torque and free part comparable
+    g = U.radiation_coupling((d * math.sin(chi), 0.0, d * math.cos(chi)))
+    general = np.array(E.reduced_rate(*w, (I1, I1, I3), tuple(g)))
+    free = eq_3_3_to_3_5(w, I1, I3, 0.0, chi)
+    np.testing.assert_allclose(eq_3_3_to_3_5(w, I1, I3, d, chi, c_power=3), general, rtol=1e-10)
+    printed_torque = eq_3_3_to_3_5(w, I1, I3, d, chi, c_power=2) - free
+    np.testing.assert_allclose(printed_torque / (general - free), U.C_LIGHT, rtol=1e-8)
+
+
+@pytest.mark.parametrize("trial", range(20))
+def test_reduced_equals_4_2_to_4_4(trial):
+    """Dimensionless general reduced equation = (4.2)-(4.4) for random delta, chi, omega."""
+    delta = RNG.uniform(-1.0, 0.95)
+    chi = RNG.uniform(0.0, 0.5 * math.pi)
+    w = RNG.normal(size=3)
+    got = E.reduced_rate(*w, (1.0, 1.0, 1.0 - delta), (math.sin(chi), 0.0, math.cos(chi)))
+    np.testing.assert_allclose(got, eq_4_2_to_4_4(w, delta, chi), rtol=1e-12, atol=1e-13)
+
+
+@pytest.mark.parametrize("trial", range(10))
+def test_truncated_equals_5_3_at_chi_0(trial):
+    """(2.5) at chi = 0 = (5.3): omega_dot_perp = free - omega_perp^2 omega_perp, omega3_dot = -omega_perp^2 omega3."""
+    delta = RNG.uniform(-1.0, 0.95)
+    w1, w2, w3 = RNG.normal(size=3)
+    wp2 = w1 * w1 + w2 * w2
+    want = [delta * w2 * w3 - wp2 * w1, -delta * w1 * w3 - wp2 * w2, -wp2 * w3]
+    got = E.truncated_rate(w1, w2, w3, (1.0, 1.0, 1.0 - delta), (0.0, 0.0, 1.0))
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-13)
+
+
+@pytest.mark.parametrize("trial", range(10))
+def test_truncated_solves_2_5_exactly_for_asymmetric_bodies(trial):
+    """The Sherman-Morrison solution makes the residual of (2.5) vanish, any inertia and dipole."""
+    J = np.sort(RNG.uniform(0.3, 1.0, size=3))
+    J[2] = min(J[2], J[0] + J[1])
+    g = RNG.normal(size=3) * 0.4
+    w = RNG.normal(size=3) * 0.5
+    wd = np.array(E.truncated_rate(*w, tuple(J), tuple(g)))
+    lhs = J * wd + np.cross(w, J * w)
+    rhs = -(np.dot(np.cross(g, w), np.cross(g, w)) * w + np.dot(g, np.cross(w, wd)) * g)
+    np.testing.assert_allclose(lhs, rhs, atol=1e-14)
+
+
+def test_2_3b_both_printed_forms_are_the_free_flow_derivative():
+    """Both lines of (2.3b) equal d/dt of (2.3a) along the free flow (the reduction's input)."""
+    J = (1.0, 0.7, 0.4)
+    w = np.array([0.3, -0.5, 0.8])
+    h = 1e-6
+    a = lambda x: np.array(E.free_rate(*x, J, None))  # noqa: E731
+    ddot_fd = (a(w + h * a(w)) - a(w - h * a(w))) / (2 * h)
+    Jv = np.array(J)
+    ad = a(w)
+    ddot_23b = (np.cross(w, np.cross(w, Jv * w)) - np.cross(Jv * w, (np.cross(w, Jv * w)) / Jv)) / Jv
+    ddot_first = -(np.cross(ad, Jv * w) + np.cross(w, Jv * ad)) / Jv
+    np.testing.assert_allclose(ddot_23b, ddot_first, rtol=1e-12)
+    np.testing.assert_allclose(ddot_first, ddot_fd, rtol=1e-7)
+
+
+@pytest.mark.parametrize("model", ["reduced", "truncated", "free"])
+def test_jacobian_matches_finite_differences(model):
+    J, g = (1.0, 0.8, 0.45), (0.3, -0.2, 0.9)
+    w = np.array([0.4, -0.7, 0.5])
+    jac = E.jacobian(model, w, J, g)
+    h = 1e-6
+    fd = np.empty((3, 3))
+    for k in range(3):
+        e = np.zeros(3)
+        e[k] = h
+        fd[:, k] = (E.omega_dot(model, w + e, J, g) - E.omega_dot(model, w - e, J, g)) / (2 * h)
+    np.testing.assert_allclose(jac, fd, rtol=1e-7, atol=1e-9)
+
+
+def test_free_rate_conserves_energy_and_body_momentum_magnitude():
+    """d/dt (1/2 W.JW) = 0 and d/dt |JW|^2 = 0 along (2.3a), exactly (not just numerically)."""
+    J = np.array([1.0, 0.6, 0.5])
+    for _ in range(5):
+        w = RNG.normal(size=3)
+        wd = np.array(E.free_rate(*w, tuple(J), None))
+        assert abs(np.dot(J * w, wd)) < 1e-14
+        assert abs(np.dot(J * w, J * wd)) < 1e-14
+
+
+def test_radiation_torque_dissipates_energy():
+    """Both models lose kinetic energy: dE/dt = W . torque < 0 (the braking of the title)."""
+    J, g = (1.0, 1.0, 0.6), (math.sin(0.9), 0.0, math.cos(0.9))
+    for model in ("reduced", "truncated"):
+        for _ in range(10):
+            w = RNG.normal(size=3) * 0.1
+            wd = E.omega_dot(model, w, J, g)
+            assert np.dot(np.array(J) * w, wd) < 0
+
+
+def test_quat_rate_matches_quaternion_product():
+    from spinviz import rotations as R
+
+    q = R.normalize(RNG.normal(size=4))
+    w = RNG.normal(size=3)
+    want = 0.5 * R.multiply(q, np.concatenate([[0.0], w]))
+    np.testing.assert_allclose(E.quat_rate(*q, *w), want, atol=1e-15)
+
+
+def test_euler_rate_6_4_matches_quaternion_kinematics():
+    """(6.4) and q_dot = 1/2 q (x) (0, W) describe the same motion (away from theta = 0)."""
+    from spinviz import rotations as R
+
+    ang = np.array([0.4, 1.1, -0.7])
+    w = np.array([0.3, -0.2, 0.5])
+    rates = np.array(E.euler_zxz_rate(*ang, *w))
+    h = 1e-6
+    q_plus = R.quat_from_euler_zxz(ang + h * rates)
+    q_minus = R.quat_from_euler_zxz(ang - h * rates)
+    q_dot_fd = (q_plus - q_minus) / (2 * h)
+    q = R.quat_from_euler_zxz(ang)
+    np.testing.assert_allclose(q_dot_fd, E.quat_rate(*q, *w), atol=1e-9)
+
+
+def test_unknown_model_is_refused():
+    with pytest.raises(ValueError, match="unknown model 'schott'; valid: reduced, truncated, free"):
+        E.rate_function("schott")

@@ -1,0 +1,11 @@
+"""Integrators behind the one ``simulate`` driver, chosen by lower-case name.
+
+Importing this package registers the built-in methods; ``get(name)`` returns one and
+``names()`` lists them.  Never imports the scene layer or rendering.
+"""
+
+from . import geometric  # noqa: F401  (registers lie-dop853, lie-rk4, lie-rk8)
+from . import scipy_ivp  # noqa: F401  (registers rk45, dop853, radau, bdf, lsoda)
+from .base import KINEMATICS, Integrator, Problem, Solution, get, names, register
+
+__all__ = ["Integrator", "Problem", "Solution", "KINEMATICS", "get", "names", "register"]

@@ -1,0 +1,178 @@
+"""The frozen result of a simulation: what the renderer, ``compare`` and the checks consume.
+
+A ``Trajectory`` is in the units of its body ("cgs": t in s, Omega in rad/s;
+"dimensionless": tau and omega of (4.1)).  ``sample(times)`` gives the state at any
+times inside the run -- Omega by cubic Hermite interpolation with the model's own
+Omega_dot at the nodes, orientation by slerp between stored quaternions -- so frames
+never step the integrator.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from . import rotations as R
+from .physics.bodies import Body
+from .physics.equations import angular_momentum_world, kinetic_energy
+
+
+def _frozen(a):
+    if a is None:
+        return None
+    a = np.array(a, dtype=float, copy=True)
+    a.flags.writeable = False
+    return a
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """t (N,); omega (N, 3) body frame; q (N, 4) (w, x, y, z) or None when no orientation
+    was integrated; euler (N, 3) only when the Euler-angle kinematics (6.4) was integrated
+    instead of quaternions; all in ``units`` of ``body``.  stats: method, nfev, runtime_s, ...
+    """
+
+    t: np.ndarray
+    omega: np.ndarray
+    q: np.ndarray | None
+    body: Body
+    model: str
+    euler: np.ndarray | None = None
+    stats: dict = field(default_factory=dict, compare=False)
+
+    def __post_init__(self):
+        for name in ("t", "omega", "q", "euler"):
+            object.__setattr__(self, name, _frozen(getattr(self, name)))
+        n = self.t.shape[0]
+        if self.omega.shape != (n, 3):
+            raise ValueError(f"omega must have shape ({n}, 3), got {self.omega.shape}")
+        if self.q is not None and self.q.shape != (n, 4):
+            raise ValueError(f"q must have shape ({n}, 4), got {self.q.shape}")
+
+    # -- units ---------------------------------------------------------------------------
+    @property
+    def units(self) -> str:
+        return self.body.units
+
+    @property
+    def tau0(self) -> float:
+        """tau0 in s (CGS) or 1 (dimensionless)."""
+        return self.body.tau0
+
+    @property
+    def time_seconds(self) -> np.ndarray | None:
+        """Physical time in s, or None for a dimensionless run."""
+        return self.t if self.units == "cgs" else None
+
+    # -- derived series ------------------------------------------------------------------
+    @property
+    def euler_zxz(self) -> np.ndarray:
+        """ZXZ Euler angles (phi, theta, psi), rad, unwrapped along time, shape (N, 3)."""
+        if self.euler is not None:
+            return np.array(self.euler)
+        self._need_q("euler_zxz")
+        return R.unwrap_euler_zxz(R.euler_zxz_from_quat(self.q))
+
+    @property
+    def omega_magnitude(self) -> np.ndarray:
+        return np.linalg.norm(self.omega, axis=-1)
+
+    def dipole_world(self) -> np.ndarray:
+        """Unit dipole direction in the world frame, O d/|d|, shape (N, 3)."""
+        self._need_q("dipole_world")
+        return self.body.dipole_world(self.q)
+
+    def angular_momentum_world(self) -> np.ndarray:
+        """L_world = O I Omega, shape (N, 3) (g cm^2/s, or relative units)."""
+        self._need_q("angular_momentum_world")
+        return angular_momentum_world(self.q, self.omega, self.body.inertia)
+
+    def omega_world(self) -> np.ndarray:
+        """Angular velocity in the world frame, O Omega, shape (N, 3)."""
+        self._need_q("omega_world")
+        return R.world_from_body(self.q, self.omega)
+
+    def energy(self) -> np.ndarray:
+        """Kinetic energy 1/2 Omega . I Omega, shape (N,)."""
+        return kinetic_energy(self.omega, self.body.inertia)
+
+    def omega_dot(self) -> np.ndarray:
+        """Omega_dot of the model at the stored states, shape (N, 3), in the body's units."""
+        s = self.body.system(self.model)
+        tau0 = self.tau0
+        return s.omega_dot(self.omega * tau0) / tau0**2
+
+    def _need_q(self, what: str):
+        if self.q is None:
+            raise ValueError(f"{what} needs the orientation, which this run did not integrate")
+
+    # -- resampling ----------------------------------------------------------------------
+    def sample(self, times) -> "Trajectory":
+        """The trajectory at ``times`` (within [t0, t_end]): Omega by cubic Hermite with the
+        model's Omega_dot, q by slerp between stored orientations.  No integration."""
+        times = np.atleast_1d(np.asarray(times, dtype=float))
+        t = self.t
+        lo, hi = t[0], t[-1]
+        if np.any(times < lo - 1e-12 * abs(hi - lo)) or np.any(times > hi + 1e-12 * abs(hi - lo)):
+            raise ValueError(f"sample times must lie in [{lo:g}, {hi:g}]")
+        times = np.clip(times, lo, hi)
+        if t.size == 1:
+            omega = np.repeat(self.omega, times.size, axis=0)
+        else:
+            i = np.clip(np.searchsorted(t, times, side="right") - 1, 0, t.size - 2)
+            h = (t[i + 1] - t[i])[:, None]
+            s = (times - t[i])[:, None] / h
+            dw = self.omega_dot()
+            h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+            h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
+            omega = h00 * self.omega[i] + h10 * h * dw[i] + h01 * self.omega[i + 1] + h11 * h * dw[i + 1]
+        q = None if self.q is None else R.slerp_series(t, self.q, times)
+        euler = None
+        if self.euler is not None:
+            euler = np.stack([np.interp(times, t, self.euler[:, k]) for k in range(3)], axis=-1)
+        return replace(self, t=times, omega=omega, q=q, euler=euler)
+
+    # -- output --------------------------------------------------------------------------
+    def arrays(self) -> dict[str, np.ndarray]:
+        """The arrays ``save_npz`` writes (t, omega, and q, euler_zxz when orientation exists)."""
+        out = {"t": np.array(self.t), "omega": np.array(self.omega)}
+        if self.q is not None:
+            out["q"] = np.array(self.q)
+        if self.q is not None or self.euler is not None:
+            out["euler_zxz"] = self.euler_zxz
+        return out
+
+    def metadata(self) -> dict:
+        b = self.body
+        return {
+            "units": self.units,
+            "time_unit": "s" if self.units == "cgs" else "tau0",
+            "omega_unit": "rad/s" if self.units == "cgs" else "1/tau0",
+            "quaternion_order": "w, x, y, z (scalar first); O = R(q) maps body to world",
+            "euler_convention": "ZXZ, O = Rz(phi) Rx(theta) Rz(psi), rad, unwrapped",
+            "model": self.model,
+            "body": b.name,
+            "inertia": list(b.inertia),
+            "dipole": list(b.dipole),
+            "tau0_s": b.tau0 if self.units == "cgs" else None,
+            "stats": {k: v for k, v in self.stats.items() if isinstance(v, (int, float, str, bool, type(None)))},
+        }
+
+    def save_npz(self, path) -> None:
+        """Write the arrays and a JSON ``metadata`` entry atomically (temp file + rename)."""
+        path = os.fspath(path)
+        d = os.path.dirname(os.path.abspath(path))
+        os.makedirs(d, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=".spinviz-", suffix=".npz.tmp", dir=d)
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                np.savez(fh, metadata=np.array(json.dumps(self.metadata())), **self.arrays())
+            os.replace(tmp, path)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise

@@ -1,0 +1,181 @@
+"""Integrated motion: invariants, the checks of ``spinviz check``, orders, units, sampling."""
+
+import math
+
+import numpy as np
+import pytest
+
+from spinviz import checks
+from spinviz import rotations as R
+from spinviz.physics import bodies as B
+from spinviz.physics import closed_forms as CF
+from spinviz.simulate import SimulationError, simulate
+
+ASKEW = B.symmetric_top(-0.6, math.radians(55.0))          # DAST family-1 proportions
+
+
+# --- the validation suite, one test per equation --------------------------------------
+def test_check_6_5_reduced_rod_converges_as_eps_to_0():
+    r = checks.check_eps_limit("reduced")
+    assert r.passed, r.details
+    # theta and psi converge at first order, phi at second (measured, see `spinviz check`)
+    assert np.allclose(r.details["order_theta"], 1.0, atol=0.05)
+    assert np.allclose(r.details["order_psi"], 1.0, atol=0.05)
+    assert np.allclose(r.details["order_phi"], 2.0, atol=0.05)
+
+
+def test_check_6_6_truncated_rod_converges_as_eps_to_0():
+    r = checks.check_eps_limit("truncated")
+    assert r.passed, r.details
+    assert np.allclose(r.details["order_psi"], 1.0, atol=0.05)
+
+
+def test_check_6_8_decay_rate_and_precession_limit():
+    r = checks.check_6_8()
+    assert r.passed, r.details
+    assert r.details["rel_error_rate"] < 1e-3 and r.details["rel_error_phi_dot"] < 1e-3
+
+
+def test_check_6_10_exact_to_1e_9_rad_over_3T():
+    r = checks.check_6_10()
+    assert r.passed and r.max_error <= 1e-9, r.details
+
+
+@pytest.mark.parametrize("model", ["reduced", "truncated"])
+def test_check_3_9_askew_rotation_about_e2(model):
+    r = checks.check_3_9(model)
+    assert r.passed and r.max_error <= 1e-9, r.details
+
+
+@pytest.mark.parametrize("model", ["reduced", "truncated"])
+def test_check_5_2_and_5_4_longitudinal(model):
+    r = checks.check_longitudinal(model)
+    assert r.passed and r.max_error <= 1e-9, r.details
+
+
+# --- invariants ---------------------------------------------------------------------------
+@pytest.mark.parametrize("method,kw", [("lie-dop853", {}), ("lie-rk4", {"step": 0.05}), ("lie-rk8", {"step": 0.2})])
+def test_quaternion_norm_stays_within_1e_12(method, kw):
+    """|q| = 1 within 1e-12 over ~160 turns of an askew reduced top (exp-map updates)."""
+    tr = simulate(ASKEW, "reduced", (0.3, 0.4, 0.8), t_end=1000.0, samples=500, method=method, **kw)
+    assert np.max(np.abs(np.linalg.norm(tr.q, axis=1) - 1.0)) <= 1e-12
+
+
+def test_free_motion_keeps_energy_and_world_angular_momentum():
+    """Asymmetric free top (near the intermediate axis), 100 turns: E and L_world constant
+    to 1e-11 relative at rtol = 1e-12."""
+    body = B.custom((1.0, 0.75, 0.4), (0.0, 0.0, 1.0), units="dimensionless")
+    tr = simulate(body, "free", (0.05, 0.9, 0.05), t_end=700.0, samples=400, rtol=1e-12, atol=1e-14)
+    E = tr.energy()
+    L = tr.angular_momentum_world()
+    assert np.max(np.abs(E / E[0] - 1.0)) < 1e-11
+    assert np.max(np.linalg.norm(L - L[0], axis=1)) / np.linalg.norm(L[0]) < 1e-11
+    # and the intermediate axis really flips: omega2 changes sign
+    assert tr.omega[:, 1].min() < -0.5
+
+
+def test_askew_energy_is_not_monotonic_but_falls():
+    """Radiation brakes both models on average, but dE/dt = Omega . torque changes sign
+    within a precession period for an askew top (the Schott-like term in the reduced
+    model; the (g . (Omega x Omega_dot)) g term in the truncated one)."""
+    for model in ("reduced", "truncated"):
+        tr = simulate(ASKEW, model, (0.1, 0.1, 0.1), t_end=200.0, samples=50)
+        E = tr.energy()
+        assert E[-1] < 0.5 * E[0]
+        assert np.any(np.diff(E) > 0)
+
+
+# --- fixed-step methods earn their declared order ----------------------------------------
+@pytest.mark.parametrize("method,order,substeps", [("lie-rk4", 4, (10, 20, 40, 80)), ("lie-rk8", 8, (6, 8, 12, 16))])
+def test_fixed_step_order_against_6_10(method, order, substeps):
+    """Orientation error at 2 T against the exact (6.10); slope of log(error) vs log(h)
+    (h = 2T/m exactly, errors between 1e-3 and 1e-11, above round-off)."""
+    w20 = w30 = 0.3
+    T = 1.0 / w20**2
+    th = math.atan(w20 / w30)
+    steps = [2.0 * T / m for m in substeps]
+    errs = []
+    for h in steps:
+        tr = simulate(B.symmetric_top(0.0, 0.0), "truncated", (0.0, w20, w30), t_end=2.0 * T, samples=2,
+                      euler_zxz0=(0.0, th, 0.0), method=method, step=h)
+        exact = R.quat_from_euler_zxz(CF.euler_eq6_10(tr.t, 1.0, w20, w30))
+        errs.append(R.misorientation(tr.q, exact).max())
+    slope = np.polyfit(np.log(steps), np.log(errs), 1)[0]
+    assert abs(slope - order) < 0.4, (errs, slope)
+
+
+# --- Euler angles (6.4) vs quaternions -----------------------------------------------------
+def test_euler_angle_formulation_agrees_away_from_theta_0():
+    q0 = R.quat_from_euler_zxz((0.2, 1.0, -0.4))
+    a = simulate(ASKEW, "reduced", (0.2, 0.1, 0.3), t_end=100.0, samples=50, q0=q0, rtol=1e-12, atol=1e-14)
+    b = simulate(ASKEW, "reduced", (0.2, 0.1, 0.3), t_end=100.0, samples=50, q0=q0, method="dop853",
+                 kinematics="euler_zxz", rtol=1e-12, atol=1e-14)
+    assert R.misorientation(a.q, R.quat_from_euler_zxz(b.euler)).max() < 1e-9
+
+
+def test_euler_angle_formulation_breaks_down_at_theta_0_quaternions_do_not():
+    """Starting with the dipole on the z axis (theta = 0), (6.4) divides by sin(theta) = 0 and
+    the integrator gives up (a clear error, not NaNs); the quaternion run is exact."""
+    body = B.symmetric_top(0.0, 0.0)
+    with pytest.raises(SimulationError, match="dop853"):
+        simulate(body, "reduced", (0.0, 0.05, 0.05), t_end=400.0, samples=5, euler_zxz0=(0.0, 0.0, 0.0),
+                 method="dop853", kinematics="euler_zxz")
+    tr = simulate(body, "reduced", (0.0, 0.05, 0.05), t_end=400.0, samples=5, euler_zxz0=(0.0, 0.0, 0.0))
+    assert np.all(np.isfinite(tr.q))
+
+
+# --- units and sampling ---------------------------------------------------------------------
+def test_cgs_and_dimensionless_runs_agree_through_4_1():
+    """A CGS body (tau0 = 1e-11 s, so tau0 Omega ~ 0.3) gives, through (4.1), the trajectory of
+    its dimensionless twin."""
+    I1 = 2.0e-26
+    d = math.sqrt(1.5 * I1 * 2.99792458e10**3 * 1e-11)         # tau0 = 2 d^2 / (3 I1 c^3) = 1e-11 s
+    cgs = B.custom((I1, I1, 0.7 * I1), (d * math.sin(0.6), 0.0, d * math.cos(0.6)), units="cgs")
+    assert cgs.tau0 == pytest.approx(1e-11, rel=1e-12)
+    dim = B.symmetric_top(0.3, 0.6)
+    W0 = np.array([0.1, 0.2, 0.25]) / 1e-11
+    a = simulate(cgs, "reduced", W0, t_end=50e-11, samples=20, rtol=1e-12, atol=1e-14)
+    b = simulate(dim, "reduced", W0 * 1e-11, t_end=50.0, samples=20, rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(a.omega * 1e-11, b.omega, rtol=1e-10, atol=1e-13)
+    assert R.misorientation(a.q, b.q).max() < 1e-10
+
+
+def test_real_cellulose_rod_parameters_do_not_underflow():
+    """tau0 = 1.4e-35 s and Omega = pi 1e10 /s: spin units keep the numbers O(1); over 100
+    turns the spin-down is invisible (tau0 Omega^2 t ~ 1e-15) and the rotation is free."""
+    rod = B.cellulose_rod()
+    W = np.array([0.0, math.pi * 1e10, 0.0])
+    t_end = 100 * 2 * math.pi / W[1]
+    tr = simulate(rod, "reduced", W, t_end=t_end, samples=11, rtol=1e-12, atol=1e-14)
+    assert np.all(np.isfinite(tr.omega))
+    np.testing.assert_allclose(tr.omega[:, 1], W[1], rtol=1e-12)
+    assert tr.stats["eps_rad"] == pytest.approx(rod.tau0 * W[1], rel=1e-12)
+
+
+def test_sample_interpolates_between_stored_states():
+    """Sampling a coarse trajectory at midpoints matches a run that stores those instants."""
+    kw = dict(t_end=60.0, rtol=1e-12, atol=1e-14)
+    coarse = simulate(ASKEW, "reduced", (0.2, 0.3, 0.5), samples=121, **kw)
+    t_mid = 0.5 * (coarse.t[:-1] + coarse.t[1:])
+    fine = simulate(ASKEW, "reduced", (0.2, 0.3, 0.5), t_eval=np.concatenate([[0.0], t_mid]), **kw)
+    s = coarse.sample(t_mid)
+    # cubic Hermite: error ~ h^4 |omega''''| / 384 with h = 0.5, |omega| ~ 0.6
+    assert np.max(np.abs(s.omega - fine.omega[1:])) < 1e-4
+    # slerp assumes constant angular velocity over a sample interval: error ~ h^2 |omega_dot| / 8
+    assert R.misorientation(s.q, fine.q[1:]).max() < 1e-2
+    with pytest.raises(ValueError, match="sample times must lie in"):
+        coarse.sample([61.0])
+
+
+def test_no_orientation_when_not_asked():
+    tr = simulate(ASKEW, "truncated", (0.2, 0.3, 0.5), t_end=10.0, samples=5, kinematics="none")
+    assert tr.q is None
+    full = simulate(ASKEW, "truncated", (0.2, 0.3, 0.5), t_end=10.0, samples=5)
+    np.testing.assert_allclose(tr.omega, full.omega, rtol=1e-9)
+    with pytest.raises(ValueError, match="needs the orientation"):
+        tr.dipole_world()
+
+
+def test_unknown_method_lists_the_valid_ones():
+    with pytest.raises(KeyError, match="unknown method 'rk99'; valid: .*lie-dop853"):
+        simulate(ASKEW, "reduced", (0.1, 0.1, 0.1), t_end=1.0, samples=2, method="rk99")

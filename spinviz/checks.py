@@ -1,0 +1,292 @@
+"""``spinviz check``: the integrated, quaternion-coupled equations against the paper.
+
+Each check integrates the full system (Euler equation + q_dot = 1/2 q (x) (0, Omega))
+and compares with a closed form.  What "agreement" means depends on the formula
+(DESIGN.md, section 2):
+
+* exact solutions -- (3.9), (5.2), (5.4), (6.10): the error must be at the integrator's
+  tolerance;
+* limits -- (6.5), (6.6) hold only as eps = I3/I1 -> 0: the error must fall with eps
+  at a steady order;
+* asymptotics -- (6.8) holds for t >> Theta: the measured decay rate of theta and the
+  limit of phi_dot must match tau0 Omega3^2 and Omega3.
+
+All runs are dimensionless (tau0 = 1); the closed forms are evaluated with tau0 = 1.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from . import rotations as R
+from .physics import bodies as B
+from .physics import closed_forms as CF
+from .simulate import simulate
+
+RTOL, ATOL = 1e-12, 1e-14      # tight: exact checks must sit at the integrator's tolerance
+
+
+@dataclass
+class CheckResult:
+    """One line of the report.  max_error is in the unit the criterion names."""
+
+    equation: str
+    description: str
+    passed: bool
+    max_error: float
+    criterion: str
+    runtime_s: float
+    details: dict = field(default_factory=dict)
+
+    def record(self) -> dict:
+        """Plain-JSON record: equation, description, passed, max_error, criterion, runtime_s, details."""
+        return _plain(asdict(self))
+
+
+def _plain(x):
+    """NumPy scalars and arrays to built-in types, recursively (for json.dumps)."""
+    if isinstance(x, dict):
+        return {k: _plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_plain(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    return x
+
+
+def _dimless(inertia, dipole) -> B.Body:
+    return B.custom(inertia, dipole, units="dimensionless")
+
+
+def _angle_error(a, b):
+    """|a - b| wrapped to [0, pi], elementwise (angles in rad)."""
+    return np.abs(np.angle(np.exp(1j * (np.asarray(a) - np.asarray(b)))))
+
+
+# --- (6.5), (6.6): limits eps -> 0 ---------------------------------------------------------
+EPSILONS = (1e-2, 1e-3, 1e-4)
+
+
+def check_eps_limit(model: str, omega20=0.2, omega30=1.0, epsilons=EPSILONS) -> CheckResult:
+    """(6.5) (reduced) or (6.6) (truncated): the rod of section 6.1 as eps = I3/I1 -> 0.
+
+    Start phi = psi = 0, theta = pi/2, Omega(0) = (0, Omega20, Omega30), d along e3, over 3T.
+    At finite eps the motion departs from the formula by an amount that vanishes with eps;
+    the check measures the error of each Euler angle at each eps and the observed order
+    log(e_i / e_i+1) / log(eps_i / eps_i+1); it passes when every angle's error falls at
+    a steady order (all local orders >= 0.8 and within 0.2 of each other).
+    """
+    eq = "6.5" if model == "reduced" else "6.6"
+    form = CF.euler_eq6_5 if model == "reduced" else CF.euler_eq6_6
+    T = 1.0 / omega20**2
+    start = time.perf_counter()
+    errors = []
+    for eps in epsilons:
+        tr = simulate(_dimless((1.0, 1.0, eps), (0.0, 0.0, 1.0)), model, (0.0, omega20, omega30),
+                      t_end=3.0 * T, samples=601, euler_zxz0=(0.0, 0.5 * math.pi, 0.0), rtol=RTOL, atol=ATOL)
+        errors.append(np.max(np.abs(tr.euler_zxz - form(tr.t, 1.0, omega20, omega30)), axis=0))
+    runtime = time.perf_counter() - start
+    errors = np.array(errors)                                   # (n_eps, 3): phi, theta, psi
+    logs = np.log(np.array(epsilons))
+    orders = np.diff(np.log(errors), axis=0) / np.diff(logs)[:, None]   # (n_eps - 1, 3)
+    steady = bool(np.all(orders >= 0.8) and np.all(np.ptp(orders, axis=0) <= 0.2))
+    details = {
+        "epsilon": list(epsilons),
+        "error_phi": errors[:, 0].tolist(), "error_theta": errors[:, 1].tolist(), "error_psi": errors[:, 2].tolist(),
+        "order_phi": orders[:, 0].tolist(), "order_theta": orders[:, 1].tolist(), "order_psi": orders[:, 2].tolist(),
+        "omega20": omega20, "omega30": omega30, "t_end": 3.0 * T,
+    }
+    return CheckResult(
+        equation=eq,
+        description=f"{model}, rod limit eps=I3/I1->0: Euler-angle error vs eps",
+        passed=steady,
+        max_error=float(errors[-1].max()),
+        criterion="error falls with eps at a steady order (orders >= 0.8, spread <= 0.2); max_error = rad at smallest eps",
+        runtime_s=runtime,
+        details=details,
+    )
+
+
+# --- (6.8): asymptotics t >> Theta ---------------------------------------------------------
+def check_6_8(omega20=0.05, omega30=0.05, tol=1e-3) -> CheckResult:
+    """(6.8): DAST cube (delta = 0, d along e3), reduced equation.
+
+    theta is measured from the final rotation axis (L_world at 16 Theta, which differs
+    from the initial L by O(tau0 Omega)), in a world frame with z along that axis.  Over
+    the window [3 Theta, 8 Theta] we fit log theta and phi, psi linearly in t.  The
+    asymptotic corrections decay as exp(-2 t/Theta) (<= 2.5e-3 at 3 Theta, smaller on
+    average over the window), so the rates must match to ``tol`` = 1e-3.
+    """
+    Th = 1.0 / omega30**2
+    start = time.perf_counter()
+    body = B.symmetric_top(0.0, 0.0)
+    tr = simulate(body, "reduced", (0.0, omega20, omega30), t_end=16.0 * Th, samples=4001,
+                  euler_zxz0=(0.0, 0.5 * math.pi, 0.0), rtol=RTOL, atol=ATOL)
+    runtime = time.perf_counter() - start
+    L = tr.angular_momentum_world()
+    axis = L[-1] / np.linalg.norm(L[-1])
+    q_frame = _quat_z_to(axis)
+    eu = R.unwrap_euler_zxz(R.euler_zxz_from_quat(R.multiply(R.conjugate(q_frame)[None, :], tr.q)))
+    m = (tr.t >= 3.0 * Th) & (tr.t <= 8.0 * Th)
+    rate = -np.polyfit(tr.t[m], np.log(eu[m, 1]), 1)[0]
+    phi_dot = np.polyfit(tr.t[m], eu[m, 0], 1)[0]
+    psi_dot = np.polyfit(tr.t[m], eu[m, 2], 1)[0]
+    expect = CF.asymptotics_eq6_8(1.0, omega30)
+    e_rate = abs(rate / expect["theta_decay_rate"] - 1.0)
+    e_phi = abs(phi_dot / expect["phi_rate"] - 1.0)
+    e_psi = abs(psi_dot) / abs(omega30)
+    L0 = L[0] / np.linalg.norm(L[0])
+    details = {
+        "theta_decay_rate": rate, "tau0_Omega3^2": expect["theta_decay_rate"], "rel_error_rate": e_rate,
+        "phi_dot_limit": phi_dot, "Omega3": omega30, "rel_error_phi_dot": e_phi,
+        "psi_dot_over_Omega3": psi_dot / omega30,
+        "axis_shift_rad": float(math.acos(min(1.0, float(L0 @ axis)))),
+        "window": [3.0 * Th, 8.0 * Th],
+    }
+    return CheckResult(
+        equation="6.8",
+        description="reduced, DAST cube: theta decay rate vs tau0 Omega3^2, phi_dot vs Omega3, psi_dot -> 0",
+        passed=max(e_rate, e_phi, e_psi) <= tol,
+        max_error=float(max(e_rate, e_phi, e_psi)),
+        criterion=f"relative error of rates <= {tol:g}",
+        runtime_s=runtime,
+        details=details,
+    )
+
+
+def _quat_z_to(axis) -> np.ndarray:
+    """Unit quaternion rotating the world z axis onto ``axis`` (shape (3,), unit)."""
+    z = np.array([0.0, 0.0, 1.0])
+    v = np.cross(z, axis)
+    s = float(np.linalg.norm(v))
+    if s < 1e-15:
+        return np.array([1.0, 0.0, 0.0, 0.0]) if axis[2] > 0 else np.array([0.0, 1.0, 0.0, 0.0])
+    return R.exp_rotvec(v / s * math.atan2(s, float(z @ axis)))
+
+
+# --- (6.10): exact ------------------------------------------------------------------------
+def check_6_10(omega20=0.1, omega30=0.1, periods_T=3.0, tol=1e-9) -> CheckResult:
+    """(6.10): truncated, DAST cube (delta = 0, d along e3), exact; error <= 1e-9 rad over 3 T.
+
+    Start phi = psi = 0, theta = arctan|Omega20/Omega30|, Omega(0) = (0, Omega20, Omega30).
+    Errors: each Euler angle, and the misorientation angle of the whole rotation.
+    """
+    T = 1.0 / omega20**2
+    theta0 = math.atan(abs(omega20 / omega30))
+    start = time.perf_counter()
+    tr = simulate(B.symmetric_top(0.0, 0.0), "truncated", (0.0, omega20, omega30), t_end=periods_T * T,
+                  samples=601, euler_zxz0=(0.0, theta0, 0.0), rtol=RTOL, atol=ATOL)
+    runtime = time.perf_counter() - start
+    exact = CF.euler_eq6_10(tr.t, 1.0, omega20, omega30)
+    err = np.max(_angle_error(tr.euler_zxz, exact), axis=0)
+    mis = float(R.misorientation(tr.q, R.quat_from_euler_zxz(exact)).max())
+    w_err = float(np.max(np.abs(tr.omega - CF.omega_eq6_9(tr.t, 1.0, omega20, omega30))) / math.hypot(omega20, omega30))
+    worst = float(max(err.max(), mis))
+    return CheckResult(
+        equation="6.10",
+        description=f"truncated, DAST cube: Euler angles exact over {periods_T:g} T",
+        passed=worst <= tol,
+        max_error=worst,
+        criterion=f"<= {tol:g} rad",
+        runtime_s=runtime,
+        details={"error_phi": err[0], "error_theta": err[1], "error_psi": err[2], "misorientation": mis,
+                 "rel_error_omega_6_9": w_err, "turns": float(exact[-1, 0] / (2 * math.pi)), "t_end": periods_T * T},
+    )
+
+
+# --- (3.9), (5.2), (5.4): exact angular velocities -----------------------------------------
+def check_3_9(model: str, delta=-0.6, chi=math.radians(55.0), omega20=0.1, periods_T=3.0, tol=1e-9) -> CheckResult:
+    """(3.9): rotation about e2 (Omega1 = Omega3 = 0) of the askew top (delta = -0.6,
+    chi = 55 deg, the DAST family-1 box); exact for both models.  Error: relative error of
+    Omega2 and the misorientation from the rotation about e2 by Omega20 vartheta(t)."""
+    T = 1.0 / omega20**2
+    start = time.perf_counter()
+    tr = simulate(B.symmetric_top(delta, chi), model, (0.0, omega20, 0.0), t_end=periods_T * T, samples=401,
+                  rtol=RTOL, atol=ATOL)
+    runtime = time.perf_counter() - start
+    w_exact = CF.omega_eq3_9(tr.t, 1.0, omega20)
+    w_err = float(np.max(np.abs(tr.omega - w_exact)) / abs(omega20))
+    q_exact = R.quat_from_axis_angle((0.0, 1.0, 0.0), CF.rotation_angle_eq3_9(tr.t, 1.0, omega20))
+    mis = float(R.misorientation(tr.q, q_exact).max())
+    worst = max(w_err, mis)
+    return CheckResult(
+        equation="3.9",
+        description=f"{model}, askew top delta={delta:g} chi={math.degrees(chi):.0f}deg: rotation about e2",
+        passed=worst <= tol,
+        max_error=worst,
+        criterion=f"<= {tol:g} (|dOmega|/Omega20 and rad)",
+        runtime_s=runtime,
+        details={"rel_error_omega": w_err, "misorientation": mis, "t_end": periods_T * T},
+    )
+
+
+def check_longitudinal(model: str, delta=0.3, omega20=0.1, omega30=0.3, tol=1e-9) -> CheckResult:
+    """(5.2) (reduced) or (5.4) (truncated): longitudinal dipole (chi = 0), omega10 = 0,
+    exact angular velocity; error relative to |omega0|.  (5.2) is followed over 5 Theta,
+    (5.4) over 5 T, long enough to see the residual rotation / the power-law spin-down."""
+    eq = "5.2" if model == "reduced" else "5.4"
+    eps = 1.0 - delta
+    t_end = 5.0 / (eps * omega30) ** 2 if model == "reduced" else 5.0 / omega20**2
+    form = CF.omega_eq5_2 if model == "reduced" else CF.omega_eq5_4
+    start = time.perf_counter()
+    tr = simulate(B.symmetric_top(delta, 0.0), model, (0.0, omega20, omega30), t_end=t_end, samples=801,
+                  rtol=RTOL, atol=ATOL)
+    runtime = time.perf_counter() - start
+    exact = form(tr.t, delta, omega20, omega30)
+    err = float(np.max(np.abs(tr.omega - exact)) / math.hypot(omega20, omega30))
+    final = "residual rotation about d" if model == "reduced" else "power-law spin-down to rest"
+    return CheckResult(
+        equation=eq,
+        description=f"{model}, chi=0, delta={delta:g}: Omega(t) exact ({final})",
+        passed=err <= tol,
+        max_error=err,
+        criterion=f"<= {tol:g} (|dOmega|/|Omega0|)",
+        runtime_s=runtime,
+        details={"t_end": t_end, "omega_final": tr.omega[-1].tolist()},
+    )
+
+
+ALL_CHECKS = (
+    ("6.5", lambda: check_eps_limit("reduced")),
+    ("6.6", lambda: check_eps_limit("truncated")),
+    ("6.8", check_6_8),
+    ("6.10", check_6_10),
+    ("3.9 reduced", lambda: check_3_9("reduced")),
+    ("3.9 truncated", lambda: check_3_9("truncated")),
+    ("5.2", lambda: check_longitudinal("reduced")),
+    ("5.4", lambda: check_longitudinal("truncated")),
+)
+
+
+def run_all() -> list[CheckResult]:
+    """Every check, in the order of ``ALL_CHECKS``."""
+    return [fn() for _, fn in ALL_CHECKS]
+
+
+def format_table(results: list[CheckResult]) -> str:
+    """A table for people, with the eps-convergence detail of (6.5) and (6.6)."""
+    lines = [f"{'eq.':<6} {'result':<6} {'max error':>11}  {'runtime':>9}  check", "-" * 100]
+    for r in results:
+        lines.append(f"({r.equation})".ljust(6) + f" {'PASS' if r.passed else 'FAIL':<6} {r.max_error:>11.3e}  "
+                     f"{r.runtime_s:>8.3f}s  {r.description}")
+        lines.append(" " * 38 + f"criterion: {r.criterion}")
+        d = r.details
+        if "epsilon" in d:
+            lines.append(" " * 38 + f"{'eps':>8} {'err phi':>10} {'err theta':>10} {'err psi':>10}")
+            for i, e in enumerate(d["epsilon"]):
+                lines.append(" " * 38 + f"{e:>8.0e} {d['error_phi'][i]:>10.2e} {d['error_theta'][i]:>10.2e} {d['error_psi'][i]:>10.2e}")
+            for i in range(len(d["order_phi"])):
+                lines.append(" " * 38 + f"{'order':>8} {d['order_phi'][i]:>10.2f} {d['order_theta'][i]:>10.2f} {d['order_psi'][i]:>10.2f}")
+        if r.equation == "6.8":
+            lines.append(" " * 38 + f"theta rate {d['theta_decay_rate']:.6g} vs tau0 Omega3^2 = {d['tau0_Omega3^2']:.6g}; "
+                         f"phi_dot {d['phi_dot_limit']:.6g} vs Omega3 = {d['Omega3']:.6g}; psi_dot/Omega3 = {d['psi_dot_over_Omega3']:.1e}")
+    n_fail = sum(not r.passed for r in results)
+    lines.append("-" * 100)
+    lines.append(f"{len(results) - n_fail}/{len(results)} checks passed")
+    return "\n".join(lines)

@@ -1,0 +1,345 @@
+"""Scenes: the TOML schema, its validation, and units at the boundary.
+
+A scene file describes one run (or two models side by side).  The smallest scene is
+dimensionless::
+
+    [body]
+    delta = 0.3          # 1 - I3/I1 of a symmetric top; or inertia = [I1, I2, I3] (relative)
+    chi = 0.7            # dipole angle from e3 in the e1-e3 plane, rad; or dipole = [d1, d2, d3]
+    [initial]
+    omega = [0.0, 0.05, 0.3]                      # body frame, 1/tau0
+    euler_zxz = [0.0, 1.5707963267948966, 0.0]    # phi, theta, psi in rad
+    [simulation]
+    model = "reduced"    # or "truncated", "free"; or models = ["reduced", "truncated"]
+    t_end = 1200.0       # in tau0
+    samples = 400
+
+Physical bodies are given in CGS with named units (``preset = "dast_cube"``,
+``shape = "rod"`` with ``length_nm`` ...), and then omega is in rad/s and t_end in s; see
+the README for every key.  Angles are radians unless the key ends in ``_deg``.
+
+Every problem is reported as ``SceneError(path, key, reason)``: one line naming the file,
+the key and the reason.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tomllib
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import rotations as R
+from . import units as U
+from .physics import bodies as B
+from .physics.equations import MODELS
+
+
+class SceneError(ValueError):
+    """A scene that cannot be used; str() is the one-line message for the user."""
+
+    def __init__(self, path: str, key: str, reason: str):
+        self.path, self.key, self.reason = str(path), key, reason
+        super().__init__(f"{self.path}: {key}: {reason}")
+
+
+class _Table:
+    """A TOML table being read: typed getters, and a check that no key is left unknown."""
+
+    def __init__(self, path: str, name: str, data):
+        if not isinstance(data, dict):
+            raise SceneError(path, name, f"must be a table, got {type(data).__name__}")
+        self.path, self.name, self.data, self.used = path, name, data, set()
+
+    def key(self, k: str) -> str:
+        return f"[{self.name}].{k}" if self.name else k
+
+    def has(self, k: str) -> bool:
+        return k in self.data
+
+    def error(self, k: str, reason: str) -> SceneError:
+        return SceneError(self.path, self.key(k), reason)
+
+    def raw(self, k: str, default=None, required=False):
+        if k not in self.data:
+            if required:
+                raise self.error(k, "missing value")
+            return default
+        self.used.add(k)
+        return self.data[k]
+
+    def number(self, k: str, default=None, required=False, positive=False, nonneg=False) -> float | None:
+        v = self.raw(k, default, required)
+        if v is None:
+            return None
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise self.error(k, f"must be a number, got {v!r}")
+        v = float(v)
+        if not math.isfinite(v):
+            raise self.error(k, f"must be finite, got {v}")
+        if positive and v <= 0.0:
+            raise self.error(k, f"must be positive, got {v:g}")
+        if nonneg and v < 0.0:
+            raise self.error(k, f"must not be negative, got {v:g}")
+        return v
+
+    def integer(self, k: str, default=None, required=False, minimum=None) -> int | None:
+        v = self.raw(k, default, required)
+        if v is None:
+            return None
+        if isinstance(v, bool) or not isinstance(v, int):
+            raise self.error(k, f"must be an integer, got {v!r}")
+        if minimum is not None and v < minimum:
+            raise self.error(k, f"must be at least {minimum}, got {v}")
+        return v
+
+    def vector(self, k: str, n: int = 3, default=None, required=False) -> np.ndarray | None:
+        v = self.raw(k, default, required)
+        if v is None:
+            return None
+        if not isinstance(v, (list, tuple)) or len(v) != n:
+            raise self.error(k, f"must be a list of {n} numbers, got {v!r}")
+        out = []
+        for x in v:
+            if isinstance(x, bool) or not isinstance(x, (int, float)):
+                raise self.error(k, f"must be a list of {n} numbers, got {v!r}")
+            if not math.isfinite(float(x)):
+                raise self.error(k, f"must be finite, got {v!r}")
+            out.append(float(x))
+        return np.array(out)
+
+    def string(self, k: str, default=None, required=False, choices=None) -> str | None:
+        v = self.raw(k, default, required)
+        if v is None:
+            return None
+        if not isinstance(v, str):
+            raise self.error(k, f"must be a string, got {v!r}")
+        if choices is not None and v not in choices:
+            raise self.error(k, f"unknown value {v!r}; valid: {', '.join(choices)}")
+        return v
+
+    def angle(self, k: str, default=None, required=False) -> float | None:
+        """An angle given as ``k`` (rad) or ``k_deg`` (degrees), returned in radians."""
+        if self.has(k) and self.has(k + "_deg"):
+            raise self.error(k, f"give {k} (rad) or {k}_deg, not both")
+        if self.has(k + "_deg"):
+            return math.radians(self.number(k + "_deg"))
+        return self.number(k, default, required)
+
+    def one_of(self, *keys: str) -> str | None:
+        present = [k for k in keys if self.has(k)]
+        if len(present) > 1:
+            raise self.error(present[1], f"give only one of {', '.join(keys)}")
+        return present[0] if present else None
+
+    def sub(self, k: str, required=False) -> "_Table | None":
+        if required and k not in self.data:
+            raise SceneError(self.path, f"[{self.name}.{k}]" if self.name else f"[{k}]", "missing table")
+        v = self.raw(k, None)
+        if v is None:
+            return None
+        return _Table(self.path, f"{self.name}.{k}" if self.name else k, v)
+
+    def finish(self):
+        unknown = sorted(set(self.data) - self.used)
+        if unknown:
+            k = unknown[0]
+            raise self.error(k, "unknown key" + (f" (also unknown: {', '.join(unknown[1:])})" if len(unknown) > 1 else ""))
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene, in the body's units (CGS: s, rad/s; dimensionless: tau0, 1/tau0)."""
+
+    path: str
+    title: str
+    body: B.Body
+    models: tuple[str, ...]
+    omega0: np.ndarray
+    q0: np.ndarray
+    t_end: float
+    samples: int
+    method: str = "auto"
+    rtol: float = 1e-10
+    atol: float = 1e-12
+    step: float | None = None
+    render: dict = field(default_factory=dict)
+    raw: dict = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def units(self) -> str:
+        return self.body.units
+
+    @property
+    def model(self) -> str:
+        return self.models[0]
+
+    def simulation_kwargs(self, kinematics: str = "quaternion") -> dict:
+        """Keyword arguments for ``spinviz.simulate.simulate`` (without body and model)."""
+        return dict(
+            omega0=self.omega0, t_end=self.t_end, samples=self.samples, q0=self.q0,
+            method=self.method, rtol=self.rtol, atol=self.atol, step=self.step, kinematics=kinematics,
+        )
+
+
+# --- body ---------------------------------------------------------------------------------
+_BODY_FORMS = ("preset", "shape", "delta", "inertia")
+
+
+def _body(t: _Table, units_hint: str | None) -> B.Body:
+    form = t.one_of(*_BODY_FORMS)
+    if form is None:
+        raise t.error("preset", "missing value: give preset, shape, delta (with chi) or inertia (with dipole)")
+    try:
+        if form == "preset":
+            return _preset(t)
+        if form == "shape":
+            return _shape(t)
+        if form == "delta":
+            delta = t.number("delta", required=True)
+            chi = t.angle("chi", required=True)
+            return B.symmetric_top(delta, chi, name=t.string("name", "symmetric top"))
+        inertia = t.vector("inertia", required=True)
+        units = units_hint or "dimensionless"
+        if units == "cgs":
+            d = t.one_of("dipole_debye", "dipole")
+            if d is None:
+                raise t.error("dipole_debye", "missing value (statC cm as dipole, or Debye as dipole_debye)")
+            dipole = t.vector(d, required=True) * (U.DEBYE if d == "dipole_debye" else 1.0)
+        else:
+            dipole = t.vector("dipole", required=True)
+        return B.custom(inertia, dipole, units=units, name=t.string("name", "custom body"))
+    except B.BodyError as e:
+        raise t.error(e.key, e.reason) from None
+
+
+def _preset(t: _Table) -> B.Body:
+    name = t.string("preset", choices=tuple(B.PRESETS) + ("dast_box",))
+    density = t.number("density", positive=True)
+    if name == "cellulose_rod":
+        return B.cellulose_rod()
+    if name == "dast_cube":
+        return B.dast_cube(t.number("a_nm", 100.0, positive=True), density=density)
+    if name == "dast_family1":
+        return B.dast_family1(t.number("a_nm", 100.0, positive=True), t.number("c_nm", 50.0, positive=True), density=density)
+    a, b, c = (t.number(k, required=True, positive=True) for k in ("a_nm", "b_nm", "c_nm"))
+    return B.dast_box(a, b, c, density=density)
+
+
+def _shape(t: _Table) -> B.Body:
+    kind = t.string("shape", choices=("rod", "box"))
+    density = t.number("density", required=True, positive=True)
+    name = t.string("name", kind)
+    if kind == "rod":
+        length = t.number("length_nm", required=True, positive=True) * U.NM
+        if t.has("diameter_nm") == t.has("aspect"):
+            raise t.error("diameter_nm", "give diameter_nm or aspect (L/D), exactly one")
+        diameter = t.number("diameter_nm", positive=True) * U.NM if t.has("diameter_nm") else length / t.number("aspect", positive=True)
+        dipole = t.number("dipole_debye", required=True, positive=True) * U.DEBYE
+        return B.rod(length, diameter, density, dipole, t.angle("chi", 0.0), name=name)
+    a, b, c = (t.number(k, required=True, positive=True) * U.NM for k in ("a_nm", "b_nm", "c_nm"))
+    dipole = t.vector("dipole_debye", required=True) * U.DEBYE
+    return B.box(a, b, c, density, dipole, name=name)
+
+
+# --- the whole file -----------------------------------------------------------------------
+def parse_scene(data: dict, path: str = "<scene>") -> Scene:
+    """Validate a parsed TOML document; raise SceneError on the first problem."""
+    top = _Table(path, "", data)
+    title = top.string("title", os.path.splitext(os.path.basename(path))[0])
+    top.string("description")
+    bt = top.sub("body", required=True)
+    it = top.sub("initial", required=True)
+    st = top.sub("simulation", required=True)
+    units_hint = st.string("units", choices=U.UNIT_SYSTEMS)
+    body = _body(bt, units_hint)
+    bt.string("name")
+    bt.finish()
+    if units_hint is not None and units_hint != body.units:
+        raise st.error("units", f"{units_hint!r} does not match the body, which is given in {body.units!r} units")
+
+    # initial state
+    omega0 = it.vector("omega", required=True)
+    form = it.one_of("euler_zxz", "euler_zxz_deg", "quaternion")
+    if form == "euler_zxz":
+        q0 = R.quat_from_euler_zxz(it.vector("euler_zxz"))
+    elif form == "euler_zxz_deg":
+        q0 = R.quat_from_euler_zxz(np.radians(it.vector("euler_zxz_deg")))
+    elif form == "quaternion":
+        qv = it.vector("quaternion", 4)
+        if not np.linalg.norm(qv) > 0:
+            raise it.error("quaternion", "must not be zero")
+        q0 = R.normalize(qv)
+    else:
+        q0 = np.array([1.0, 0.0, 0.0, 0.0])
+    it.finish()
+
+    # simulation
+    mkey = st.one_of("model", "models")
+    if mkey is None:
+        raise st.error("model", f"missing value; valid: {', '.join(MODELS)}")
+    if mkey == "model":
+        models = (st.string("model", choices=MODELS),)
+    else:
+        ms = st.raw("models")
+        if not isinstance(ms, list) or not (1 <= len(ms) <= 2) or not all(isinstance(m, str) for m in ms):
+            raise st.error("models", f"must be a list of one or two model names, got {ms!r}")
+        for m in ms:
+            if m not in MODELS:
+                raise st.error("models", f"unknown model {m!r}; valid: {', '.join(MODELS)}")
+        models = tuple(ms)
+    tkey = st.one_of("t_end", "t_end_T", "t_end_Theta")
+    if tkey is None:
+        raise st.error("t_end", "missing value (or give t_end_T / t_end_Theta)")
+    t_end = st.number(tkey, positive=True)
+    if tkey != "t_end":
+        t_end *= _time_scale(body, omega0, tkey, st)
+    samples = st.integer("samples", required=True, minimum=2)
+    method = st.string("method", "auto")
+    from .integrators import names as method_names  # registry lookup only, no integration
+
+    if method != "auto" and method.lower() not in method_names():
+        raise st.error("method", f"unknown method {method!r}; valid: auto, {', '.join(method_names())}")
+    rtol = st.number("rtol", 1e-10, positive=True)
+    atol = st.number("atol", 1e-12, positive=True)
+    step = st.number("step", positive=True)
+    st.finish()
+    render = top.raw("render", {})
+    if not isinstance(render, dict):
+        raise top.error("render", "must be a table")
+    top.finish()
+    return Scene(path=str(path), title=title, body=body, models=models, omega0=omega0, q0=q0,
+                 t_end=t_end, samples=samples, method=method.lower(), rtol=rtol, atol=atol, step=step,
+                 render=render, raw=data)
+
+
+def _time_scale(body: B.Body, omega0, key: str, st: _Table) -> float:
+    """T = 1/(tau0 Omega0^2) or Theta = 1/(tau0 Omega3^2 eps^2) of the initial state."""
+    w0 = float(np.linalg.norm(omega0))
+    if key == "t_end_T":
+        if w0 == 0.0:
+            raise st.error(key, "T = 1/(tau0 Omega0^2) is infinite for Omega0 = 0")
+        return body.braking_time_T(w0)
+    w3 = abs(float(omega0[2]))
+    if w3 == 0.0:
+        raise st.error(key, "Theta = 1/(tau0 Omega3^2 (I3/I1)^2) is infinite for Omega3 = 0")
+    return body.residual_time_Theta(w3)
+
+
+def load_scene(path) -> Scene:
+    """Read and validate a scene file; SceneError (one line: file, key, reason) on any problem."""
+    path = os.fspath(path)
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except FileNotFoundError:
+        raise SceneError(path, "(file)", "no such file") from None
+    except IsADirectoryError:
+        raise SceneError(path, "(file)", "is a directory, not a scene file") from None
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(path, "(file)", f"invalid TOML: {e}") from None
+    except OSError as e:
+        raise SceneError(path, "(file)", e.strerror or str(e)) from None
+    return parse_scene(data, path)

@@ -1,0 +1,39 @@
+"""Import hygiene, each in a fresh interpreter: nothing loads what it does not need."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+RENDERING = ("pyvista", "vtk", "vtkmodules", "imageio", "imageio_ffmpeg", "matplotlib")
+
+
+def loaded(code: str) -> set[str]:
+    """Top-level modules from RENDERING + numba/scipy present after running ``code``."""
+    probe = (
+        code
+        + "\nimport sys, json\n"
+        + f"print(json.dumps(sorted({{m.split('.')[0] for m in sys.modules}} & set({list(RENDERING) + ['numba', 'scipy']!r}))))"
+    )
+    r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, cwd=ROOT)
+    assert r.returncode == 0, r.stderr
+    return set(json.loads(r.stdout.strip().splitlines()[-1]))
+
+
+def test_import_spinviz_is_light():
+    """``import spinviz`` loads no rendering stack, not even numba or scipy (PEP 562 lazy submodules)."""
+    assert loaded("import spinviz") == set()
+
+
+@pytest.mark.parametrize("argv", [
+    ["info", "dast_cube"],
+    ["simulate", "scenes/check_6_10_cube_truncated.toml", "--out", "{tmp}/t.npz"],
+    ["check"],
+])
+def test_cli_commands_never_import_rendering(argv, tmp_path):
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    mods = loaded(f"from spinviz.cli import main\nimport contextlib, io\nwith contextlib.redirect_stdout(io.StringIO()):\n    assert main({argv!r}) == 0")
+    assert not (mods & set(RENDERING)), mods

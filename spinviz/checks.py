@@ -131,7 +131,7 @@ def check_6_8(omega20=0.05, omega30=0.05, tol=1e-3) -> CheckResult:
     runtime = time.perf_counter() - start
     L = tr.angular_momentum_world()
     axis = L[-1] / np.linalg.norm(L[-1])
-    q_frame = _quat_z_to(axis)
+    q_frame = R.quat_between((0.0, 0.0, 1.0), axis)
     eu = R.unwrap_euler_zxz(R.euler_zxz_from_quat(R.multiply(R.conjugate(q_frame)[None, :], tr.q)))
     m = (tr.t >= 3.0 * Th) & (tr.t <= 8.0 * Th)
     rate = -np.polyfit(tr.t[m], np.log(eu[m, 1]), 1)[0]
@@ -158,16 +158,6 @@ def check_6_8(omega20=0.05, omega30=0.05, tol=1e-3) -> CheckResult:
         runtime_s=runtime,
         details=details,
     )
-
-
-def _quat_z_to(axis) -> np.ndarray:
-    """Unit quaternion rotating the world z axis onto ``axis`` (shape (3,), unit)."""
-    z = np.array([0.0, 0.0, 1.0])
-    v = np.cross(z, axis)
-    s = float(np.linalg.norm(v))
-    if s < 1e-15:
-        return np.array([1.0, 0.0, 0.0, 0.0]) if axis[2] > 0 else np.array([0.0, 1.0, 0.0, 0.0])
-    return R.exp_rotvec(v / s * math.atan2(s, float(z @ axis)))
 
 
 # --- (6.10): exact ------------------------------------------------------------------------

@@ -35,6 +35,7 @@ __all__ = [
     "world_from_body",
     "body_from_world",
     "misorientation",
+    "quat_between",
     "allclose_up_to_sign",
     "unflip",
     "slerp_series",
@@ -180,6 +181,24 @@ def body_from_world(q, v_world) -> np.ndarray:
     """O^T v: world-frame vectors to the body frame (pairwise broadcasting as above)."""
     m = matrix_from_quat(q)
     return np.einsum("...ji,...j->...i", m, np.asarray(v_world, dtype=float))
+
+
+def quat_between(a, b) -> np.ndarray:
+    """The smallest rotation (w, x, y, z) taking the direction of ``a`` to that of ``b`` (shape (3,)).
+
+    Antiparallel vectors: a half turn about an axis perpendicular to ``a``.
+    """
+    a = np.asarray(a, dtype=float) / np.linalg.norm(a)
+    b = np.asarray(b, dtype=float) / np.linalg.norm(b)
+    v = np.cross(a, b)
+    s = float(np.linalg.norm(v))
+    c = float(a @ b)
+    if s < 1e-15:
+        if c > 0:
+            return np.array([1.0, 0.0, 0.0, 0.0])
+        perp = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
+        return quat_from_axis_angle(perp, np.pi)
+    return exp_rotvec(v / s * np.arctan2(s, c))
 
 
 def misorientation(q1, q2) -> np.ndarray:

@@ -94,7 +94,11 @@ def simulate(
     eps = spin_scaling(body, omega0)
     time_scale = eps / tau0                     # spin-unit time per unit of t
     system = spin_system(body, model, eps)
-    integrator = get(choose_method(body, model, omega0) if method == "auto" else method)
+    if method == "auto":
+        method, reason = choose_method(body, model, omega0, float(t_eval[-1]), kinematics)
+    else:
+        reason = "chosen by the user"
+    integrator = get(method)
     if kinematics not in integrator.kinematics:
         raise ValueError(f"method {integrator.name!r} does not support kinematics {kinematics!r}")
     if integrator.symmetric_only and not body.is_symmetric:
@@ -110,13 +114,20 @@ def simulate(
     kw = {"rtol": rtol, "atol": atol}
     if step is not None:
         kw["step"] = step * time_scale
+    auto = reason != "chosen by the user"
     start = time.perf_counter()
-    sol = integrator.solve(problem, **kw)
+    sol = integrator.solve(problem, **kw, **({"stop_on_stiffness": True} if auto and integrator.detects_stiffness else {}))
+    if auto and not sol.success and not integrator.stiff and integrator.name != "secular":
+        # the explicit method met stiffness the estimate from the initial state missed
+        why = f"stiffness detected at t = {sol.stats['stiff_at'] / time_scale:.3g}" if "stiff_at" in sol.stats else sol.message
+        integrator = get("radau")
+        reason = f"{method} gave up ({why}); switched to radau (implicit, exact Jacobian)"
+        sol = integrator.solve(problem, **kw)
     runtime = time.perf_counter() - start
     if not sol.success:
         raise SimulationError(f"{integrator.name}: {sol.message}")
     stats = dict(sol.stats)
-    stats.update(method=integrator.name, runtime_s=runtime, eps_rad=eps, rtol=rtol, atol=atol)
+    stats.update(method=integrator.name, method_reason=reason, runtime_s=runtime, eps_rad=eps, rtol=rtol, atol=atol)
     if step is not None:
         stats["step"] = step
     return Trajectory(
@@ -127,9 +138,54 @@ def simulate(
         body=body,
         model=model,
         stats=stats,
+        slow=sol.slow,
     )
 
 
-def choose_method(body: Body, model: str, omega0) -> str:
-    """The method ``method = "auto"`` picks (the Lie-group DOP853 until the stiffness logic lands)."""
-    return "lie-dop853"
+MAX_RESOLVED_TURNS = 1e6     # beyond this, resolving every turn costs more than ~10 s
+STIFF_RATIO = 10.0           # radiation decay rate / spin rate above which explicit steps are stability-bound
+
+
+def stiffness_ratio(body: Body, model: str, omega0) -> float:
+    """Fastest decay rate of the linearized Euler equation at omega0, per radian of spin.
+
+    The free motion has purely imaginary eigenvalues (rotation); a large negative real part
+    comes from the radiation torque -- |omega| ~ 1 or more in units of 1/tau0, or a thin
+    body (eps = I3/I1 -> 0) with an askew dipole, where (4.4) divides by 1 - delta = eps.
+    """
+    eps = spin_scaling(body, omega0)
+    s = spin_system(body, model, eps)
+    w = np.asarray(omega0, dtype=float) * body.tau0 / eps
+    lam = np.linalg.eigvals(s.jacobian(w))
+    return float(max(0.0, -np.min(lam.real)))
+
+
+def choose_method(body: Body, model: str, omega0, t_end: float, kinematics: str = "quaternion") -> tuple[str, str]:
+    """The method ``method = "auto"`` picks, and why (stored as stats["method_reason"]).
+
+    * more than 1e6 turns of a symmetric top: ``secular`` (slow flow averaged over the
+      precession; resolving each turn is neither affordable nor, past 1e16 turns,
+      representable in float64);
+    * stiff (decay rate > 10 x spin rate): ``radau`` with the exact Jacobian;
+    * otherwise ``lie-dop853``; if it then detects stiffness, the driver switches to radau.
+    """
+    eps = spin_scaling(body, omega0)
+    turns = t_end * eps / body.tau0 / (2.0 * math.pi)
+    if kinematics == "euler_zxz":
+        return "dop853", "Euler-angle kinematics (6.4) is integrated by scipy methods only"
+    if turns > MAX_RESOLVED_TURNS and body.is_symmetric:
+        from .integrators.secular import NotApplicable, prepare
+
+        try:
+            prepare(Problem(system=spin_system(body, model, eps), omega0=np.asarray(omega0) * body.tau0 / eps,
+                            t_eval=np.array([0.0, 1.0]), q0=None))
+            ulp = float(np.spacing(2.0 * math.pi * turns))
+            phase = f"; the spin phase is beyond float64 (1 ulp = {ulp:.2g} rad)" if ulp > 1e-3 else ""
+            return "secular", (f"{turns:.3g} turns of a symmetric top: averaged slow flow "
+                               f"(relative error O(tau0 Omega) = {eps:.2g}){phase}")
+        except NotApplicable:
+            pass                                        # precession too slow to average (mu > MU_MAX)
+    ratio = stiffness_ratio(body, model, omega0)
+    if ratio > STIFF_RATIO:
+        return "radau", f"stiff: decay rate {ratio:.3g} x the spin rate; implicit Radau with the exact Jacobian"
+    return "lie-dop853", f"non-stiff (decay/spin = {ratio:.2g}), {turns:.3g} turns resolved; |q| = 1 by construction"

@@ -34,6 +34,11 @@ class Trajectory:
     """t (N,); omega (N, 3) body frame; q (N, 4) (w, x, y, z) or None when no orientation
     was integrated; euler (N, 3) only when the Euler-angle kinematics (6.4) was integrated
     instead of quaternions; all in ``units`` of ``body``.  stats: method, nfev, runtime_s, ...
+
+    slow: for ``secular`` runs, the slow geometry -- q_L (4,) taking world z to the fixed
+    L_world, and (N,) arrays theta_L (nutation of e3 from L), phi_L (precession phase) and
+    psi_L (spin phase).  When ``phase_resolved`` is False the phases (and so q) are beyond
+    float64 resolution: only theta_L, L and omega's magnitude are physical.
     """
 
     t: np.ndarray
@@ -43,6 +48,7 @@ class Trajectory:
     model: str
     euler: np.ndarray | None = None
     stats: dict = field(default_factory=dict, compare=False)
+    slow: dict | None = field(default=None, compare=False)
 
     def __post_init__(self):
         for name in ("t", "omega", "q", "euler"):
@@ -69,6 +75,12 @@ class Trajectory:
         return self.t if self.units == "cgs" else None
 
     # -- derived series ------------------------------------------------------------------
+    @property
+    def phase_resolved(self) -> bool:
+        """False when the spin phase is below float64 resolution (> 1e-3 rad per ulp), as after
+        1e16 turns of a real DAST cube: then q's spin phase is not physical."""
+        return float(self.stats.get("phase_resolution_rad", 0.0)) <= 1e-3
+
     @property
     def euler_zxz(self) -> np.ndarray:
         """ZXZ Euler angles (phi, theta, psi), rad, unwrapped along time, shape (N, 3)."""
@@ -134,7 +146,11 @@ class Trajectory:
         euler = None
         if self.euler is not None:
             euler = np.stack([np.interp(times, t, self.euler[:, k]) for k in range(3)], axis=-1)
-        return replace(self, t=times, omega=omega, q=q, euler=euler)
+        slow = None
+        if self.slow is not None:
+            slow = {k: (np.interp(times, t, v) if isinstance(v, np.ndarray) and v.shape == t.shape else v)
+                    for k, v in self.slow.items()}
+        return replace(self, t=times, omega=omega, q=q, euler=euler, slow=slow)
 
     # -- output --------------------------------------------------------------------------
     def arrays(self) -> dict[str, np.ndarray]:

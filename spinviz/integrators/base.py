@@ -46,7 +46,8 @@ class Solution:
 
     omega : (N, 3); q : (N, 4) or None; euler : (N, 3) or None; stats : method, nfev,
     nsteps, and anything the method wants to report; success False with ``message`` when
-    the method gave up (never a silently wrong array).
+    the method gave up (never a silently wrong array).  slow : for ``secular`` runs, the
+    slow geometry (q_L: world z -> L_world, phi_L, theta_L, psi_L (N,), q_frame).
     """
 
     t: np.ndarray
@@ -56,6 +57,7 @@ class Solution:
     success: bool = True
     message: str = ""
     stats: dict = field(default_factory=dict)
+    slow: dict | None = None
 
 
 @dataclass(frozen=True)
@@ -65,7 +67,8 @@ class Integrator:
     name : lower-case registry key; order : the declared order (None if adaptive-only);
     fixed_step : True when ``step`` (not rtol/atol) controls accuracy;
     solve(problem, rtol, atol, step) -> Solution;
-    kinematics : the kinematics it supports; symmetric_only : needs I1 = I2;
+    kinematics : the kinematics it supports; symmetric_only : needs I1 = I2; stiff : an
+    implicit method; detects_stiffness : accepts ``stop_on_stiffness=True``;
     description : one line for ``spinviz methods`` and the README.
     """
 
@@ -77,6 +80,7 @@ class Integrator:
     kinematics: tuple[str, ...] = ("quaternion", "none")
     symmetric_only: bool = False
     stiff: bool = False
+    detects_stiffness: bool = False
 
 
 _REGISTRY: dict[str, Integrator] = {}

@@ -19,6 +19,7 @@ _STATUS = {
     KN.TOO_MANY_STEPS: "exceeded the step limit",
     KN.STEP_UNDERFLOW: "step size fell below round-off (the problem is too stiff for an explicit method)",
     KN.NOT_FINITE: "the solution left the finite numbers (overflow)",
+    KN.STIFF: "stiffness detected (Hairer's test: 15 steps in a row limited by stability)",
 }
 
 MAX_STEPS = 200_000_000
@@ -48,12 +49,14 @@ def _solution(problem, w, q, status, stats):
 
 
 def solve_lie_dop853(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, step: float | None = None,
-                     max_steps: int = MAX_STEPS) -> Solution:
-    """Adaptive Lie-group DOP853; ``step`` caps the step size."""
+                     max_steps: int = MAX_STEPS, stop_on_stiffness: bool = False) -> Solution:
+    """Adaptive Lie-group DOP853; ``step`` caps the step size; with ``stop_on_stiffness``
+    it gives up as soon as it detects stiffness (the driver then switches to radau)."""
     model, J, g, w0, q0, t, with_q = _args(problem)
     h_max = float(step) if step else np.inf
     w, q, nfev, nsteps, nrej, status, stiff_at = KN.lie_dop853(
-        model, J, g, w0, q0, t, float(rtol), float(atol), h_max, with_q, int(max_steps), *KN.DOP853_ARRAYS
+        model, J, g, w0, q0, t, float(rtol), float(atol), h_max, with_q, int(max_steps), bool(stop_on_stiffness),
+        *KN.DOP853_ARRAYS
     )
     stats = {"nfev": int(nfev), "nsteps": int(nsteps), "nrejected": int(nrej)}
     if stiff_at >= 0.0:
@@ -76,7 +79,7 @@ def _fixed(tableau: T.Tableau):
 
 
 register(Integrator(
-    name="lie-dop853", order=8, fixed_step=False, solve=solve_lie_dop853,
+    name="lie-dop853", order=8, fixed_step=False, solve=solve_lie_dop853, detects_stiffness=True,
     description="Lie-group DOP853 (RKMK, exact SO(3) dexp^-1), adaptive with dense output; |q| = 1 by construction; compiled; the default",
 ))
 register(Integrator(

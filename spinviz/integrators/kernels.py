@@ -170,10 +170,11 @@ def lie_fixed(model, J, g, w0, q0, t_eval, h, A, b, c, with_q, max_steps):
 
 
 @_jit
-def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps,
+def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps, stop_on_stiff,
                A, B, C, E3, E5, D):
     """Adaptive Lie-group DOP853 (error control and 7th-order dense output as in
-    Hairer's DOP853 / SciPy), with Hairer's stiffness detection.
+    Hairer's DOP853 / SciPy), with Hairer's stiffness detection (15 stiff steps in a row:
+    record the time, and return with status STIFF when ``stop_on_stiff``).
 
     Returns (omega (N,3), q (N,4), nfev, nsteps, nrejected, status, stiff_at)."""
     N = t_eval.shape[0]
@@ -284,6 +285,8 @@ def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps
                     n_stiff += 1
                     if n_stiff == 15 and stiff_at < 0.0:
                         stiff_at = t
+                        if stop_on_stiff:
+                            return out_w, out_q, nfev, nsteps, nrej, STIFF, stiff_at
                 else:
                     n_nonstiff += 1
                     if n_nonstiff == 6:

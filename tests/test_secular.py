@@ -1,0 +1,123 @@
+"""The averaged slow flow for real horizons, and the driver's choice of method."""
+
+import math
+
+import numpy as np
+import pytest
+
+from spinviz import rotations as R
+from spinviz.integrators.secular import SlowFlow
+from spinviz.physics import bodies as B
+from spinviz.physics import closed_forms as CF
+from spinviz.physics.equations import System
+from spinviz.simulate import SimulationError, choose_method, simulate
+
+W = math.pi * 1e10                      # the spin of section 6, rad/s
+
+
+def test_slow_flow_is_4_12_for_the_reduced_model():
+    """The M-point phase average of the model's own rate equals the printed (4.12)."""
+    for delta, chi in [(0.3, 0.7), (-0.6, math.radians(55.0)), (0.5, 1.2)]:
+        s = System("reduced", (1.0, 1.0, 1.0 - delta), (math.sin(chi), 0.0, math.cos(chi)))
+        flow = SlowFlow(s, equivariant=False)
+        for wp, w3 in [(0.2, 0.5), (0.05, -0.3)]:
+            got = flow.rates(wp, w3)
+            dwp, dw3, dphi = CF.averaged_rate_eq4_12(wp, w3, delta, chi)
+            np.testing.assert_allclose(got, (dwp, dw3, dphi), rtol=1e-12, atol=1e-16)
+
+
+@pytest.mark.parametrize("model,form", [("reduced", CF.omega_eq6_7), ("truncated", CF.omega_eq6_9)])
+def test_real_dast_cube_over_10_Theta_matches_6_7_6_9_and_6_8(model, form):
+    """DAST cube with its real parameters (tau0 = 3.7e-27 s, Omega20 = Omega30 = pi 1e10 /s),
+    10 Theta ~ 1.4e16 turns: |Omega_perp|, Omega3 and theta (d from the rotation axis) match
+    (6.7)/(6.9) and (6.8)/(6.10) to 1e-6 relative (tolerance set by rtol = 1e-10 on a
+    quantity that falls by e^-10)."""
+    cube = B.dast_cube()
+    Th = 1.0 / (cube.tau0 * W**2)
+    tr = simulate(cube, model, (0.0, W, W), t_end=10.0 * Th, samples=201, euler_zxz0=(0.0, 0.5 * math.pi, 0.0))
+    assert tr.stats["method"] == "secular"
+    assert tr.stats["turns"] > 1e15 and not tr.phase_resolved
+    exact = form(tr.t, cube.tau0, W, W)
+    wp, wpe = np.hypot(tr.omega[:, 0], tr.omega[:, 1]), np.hypot(exact[:, 0], exact[:, 1])
+    np.testing.assert_allclose(wp, wpe, rtol=1e-6)
+    np.testing.assert_allclose(tr.omega[:, 2], exact[:, 2], rtol=1e-6)
+    # theta: angle between d (= e3) and the fixed rotation axis L_world
+    L = np.array(tr.stats["L_axis_world"])
+    theta = np.arccos(np.clip(tr.dipole_world() @ L, -1, 1))
+    np.testing.assert_allclose(theta, np.arctan2(wpe, exact[:, 2]), rtol=1e-6, atol=1e-12)
+    if model == "reduced":                                  # (6.8): theta ~ exp(-tau0 Omega3^2 t)
+        late = tr.t > 3.0 * Th
+        rate = -np.polyfit(tr.t[late], np.log(theta[late]), 1)[0]
+        assert rate == pytest.approx(cube.tau0 * W**2, rel=1e-4)
+    else:                                                   # (6.10): theta stays arctan|Omega20/Omega30|
+        np.testing.assert_allclose(theta, math.pi / 4, rtol=1e-9)
+
+
+def test_secular_is_exact_for_free_symmetric_motion():
+    """No torque: the secular reconstruction is the exact free symmetric top."""
+    body = B.symmetric_top(0.4, 0.3)
+    kw = dict(t_end=200.0, samples=50, q0=R.quat_from_euler_zxz((0.3, 1.1, -0.2)), rtol=1e-12, atol=1e-14)
+    a = simulate(body, "free", (0.2, -0.1, 0.5), method="secular", **kw)
+    b = simulate(body, "free", (0.2, -0.1, 0.5), method="lie-dop853", **kw)
+    np.testing.assert_allclose(a.omega, b.omega, atol=1e-11)
+    assert R.misorientation(a.q, b.q).max() < 1e-10
+
+
+def test_secular_is_exact_for_6_10():
+    """(6.10): the torque is along L, so L stays fixed exactly and secular is exact."""
+    w = 0.1
+    tr = simulate(B.symmetric_top(0.0, 0.0), "truncated", (0.0, w, w), t_end=300.0, samples=51,
+                  euler_zxz0=(0.0, math.pi / 4, 0.0), method="secular", rtol=1e-12, atol=1e-14)
+    exact = R.quat_from_euler_zxz(CF.euler_eq6_10(tr.t, 1.0, w, w))
+    assert R.misorientation(tr.q, exact).max() < 1e-9
+
+
+@pytest.mark.parametrize("eps_rad", [3e-4, 1e-4])
+def test_secular_error_is_of_order_tau0_omega_for_an_askew_top(eps_rad):
+    """Askew top (delta = -0.6, chi = 55 deg) over 2 T: the slow variables of the averaged
+    flow differ from a resolved run by O(tau0 Omega) (first-order averaging)."""
+    body = B.symmetric_top(-0.6, math.radians(55.0))
+    w0 = np.array([0.0, 0.6, 0.8]) * eps_rad
+    t_end = 2.0 / eps_rad**2
+    a = simulate(body, "reduced", w0, t_end=t_end, samples=41, method="secular")
+    b = simulate(body, "reduced", w0, t_end=t_end, samples=41, method="lie-dop853")
+    err = max(np.max(np.abs(np.hypot(a.omega[:, 0], a.omega[:, 1]) - np.hypot(b.omega[:, 0], b.omega[:, 1]))),
+              np.max(np.abs(a.omega[:, 2] - b.omega[:, 2]))) / eps_rad
+    assert 0.05 * eps_rad < err < 5.0 * eps_rad
+
+
+def test_secular_refuses_when_precession_is_too_slow():
+    """(3.9)-like rotation about e2 of an askew top has no precession to average over."""
+    with pytest.raises(SimulationError, match="precession, which is too slow"):
+        simulate(B.symmetric_top(-0.6, 1.0), "reduced", (0.0, 0.1, 0.0), t_end=10.0, samples=3, method="secular")
+
+
+def test_secular_needs_a_symmetric_top():
+    body = B.custom((1.0, 0.8, 0.5), (0.0, 0.0, 1.0), units="dimensionless")
+    with pytest.raises(ValueError, match="symmetric top"):
+        simulate(body, "reduced", (0.0, 0.1, 0.1), t_end=10.0, samples=3, method="secular")
+
+
+def test_auto_picks_secular_radau_or_lie_and_says_why():
+    cube = B.dast_cube()
+    m, why = choose_method(cube, "reduced", (0.0, W, W), 10.0 / (cube.tau0 * W**2))
+    assert m == "secular" and "turns of a symmetric top" in why and "beyond float64" in why
+    thin = B.custom((1.0, 1.0, 1e-6), (math.sin(0.5), 0.0, math.cos(0.5)), units="dimensionless")
+    m, why = choose_method(thin, "reduced", (0.0, 0.1, 0.1), 100.0)
+    assert m == "radau" and "stiff" in why
+    m, why = choose_method(B.symmetric_top(0.3, 0.7), "reduced", (0.0, 0.05, 0.3), 1200.0)
+    assert m == "lie-dop853" and "non-stiff" in why
+
+
+def test_driver_switches_to_radau_when_the_explicit_method_detects_stiffness(monkeypatch):
+    """If the up-front estimate misses stiffness, lie-dop853's stiffness test (Hairer's) fires
+    and the driver reruns with radau, saying so."""
+    import spinviz.simulate as S
+
+    monkeypatch.setattr(S, "choose_method", lambda *a, **k: ("lie-dop853", "forced for the test"))
+    thin = B.custom((1.0, 1.0, 1e-5), (math.sin(0.5), 0.0, math.cos(0.5)), units="dimensionless")
+    tr = simulate(thin, "reduced", (0.0, 0.3, 0.3), t_end=5.0, samples=11)
+    assert tr.stats["method"] == "radau"
+    assert tr.stats["method_reason"].startswith("lie-dop853 gave up (stiffness detected at t = ")
+    ref = simulate(thin, "reduced", (0.0, 0.3, 0.3), t_end=5.0, samples=11, method="radau")
+    np.testing.assert_allclose(tr.omega, ref.omega)

@@ -121,3 +121,30 @@ def test_driver_switches_to_radau_when_the_explicit_method_detects_stiffness(mon
     assert tr.stats["method_reason"].startswith("lie-dop853 gave up (stiffness detected at t = ")
     ref = simulate(thin, "reduced", (0.0, 0.3, 0.3), t_end=5.0, samples=11, method="radau")
     np.testing.assert_allclose(tr.omega, ref.omega)
+
+
+def test_slow_flow_keeps_a_1e_16_torque_above_round_off():
+    """At real scale (tau0 Omega ~ 1e-16) the averaged radiation rates are still (4.12),
+    to 1e-10 relative: they are computed without the O(1) free part, whose round-off would
+    otherwise be as large as the torque (this once hung the askew DAST scene)."""
+    eps = 1e-16
+    delta, chi = -0.6, math.radians(55.0)
+    s = System("reduced", (1.0, 1.0, 1.0 - delta), tuple(math.sqrt(eps) * np.array([math.sin(chi), 0.0, math.cos(chi)])))
+    flow = SlowFlow(s, equivariant=False)
+    dwp, dw3, dp = flow.rates(0.5, 0.8)
+    want = CF.averaged_rate_eq4_12(0.5, 0.8, delta, chi)
+    np.testing.assert_allclose([dwp, dw3], eps * np.array(want[:2]), rtol=1e-10)
+    assert dp == pytest.approx(-delta * 0.8, rel=1e-12)
+
+
+@pytest.mark.parametrize("model", ["reduced", "truncated", "free"])
+def test_radiation_part_plus_free_rate_is_the_rate(model):
+    from spinviz.physics import equations as E
+
+    rng = np.random.default_rng(3)
+    J, g = (1.0, 0.8, 0.5), (0.3, -0.2, 0.7)
+    for _ in range(5):
+        w = rng.normal(size=3)
+        total = np.array(E.rate_function(model)(*w, J, g))
+        parts = np.array(E.radiation_function(model)(*w, J, g)) + np.array(E.free_rate(*w, J, g))
+        np.testing.assert_allclose(parts, total, rtol=1e-13, atol=1e-14)

@@ -33,17 +33,17 @@ _jit = nb.njit(cache=True)
 MODEL_ID = {"free": 0, "reduced": 1, "truncated": 2}
 
 _free = _jit(E.free_rate)
-_reduced = _jit(E.reduced_rate)
-_truncated = _jit(E.truncated_rate)
+_reduced = _jit(E.reduced_terms)
+_truncated = _jit(E.truncated_terms)
 
 
 @_jit
 def rate(model, w1, w2, w3, J, g):
     """Omega_dot components of model 0 (free), 1 (reduced) or 2 (truncated)."""
     if model == 1:
-        return _reduced(w1, w2, w3, J, g)
+        return _reduced(w1, w2, w3, J, g, 1.0)
     if model == 2:
-        return _truncated(w1, w2, w3, J, g)
+        return _truncated(w1, w2, w3, J, g, 1.0)
     return _free(w1, w2, w3, J, g)
 
 

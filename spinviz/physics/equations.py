@@ -32,12 +32,15 @@ def free_rate(w1, w2, w3, J, g):
     return -(w2 * L3 - w3 * L2) / J1, -(w3 * L1 - w1 * L3) / J2, -(w1 * L2 - w2 * L1) / J3
 
 
-def reduced_rate(w1, w2, w3, J, g):
+def reduced_terms(w1, w2, w3, J, g, free):
     """Omega_dot of the reduced Euler equation: (2.2) with (2.3a), (2.3b) on the right.
 
     J Omega_dot + Omega x J Omega = g x { g x (Omega^2 Omega - Omega_ddot)
                                         + (g . Omega_dot) Omega + 2 (g . Omega) Omega_dot },
     with Omega_dot, Omega_ddot on the right replaced by their free-motion values.
+    ``free`` = 1 gives the whole rate; ``free`` = 0 only the radiation part J^-1 torque, which
+    for real particles is 1e-16 of the free part and would drown in its round-off if the two
+    were summed first (the averaged slow flow needs it alone).
     """
     J1, J2, J3 = J
     g1, g2, g3 = g
@@ -59,10 +62,10 @@ def reduced_rate(w1, w2, w3, J, g):
     h2 = g3 * p1 - g1 * p3 + ga * w2 + gw2 * a2
     h3 = g1 * p2 - g2 * p1 + ga * w3 + gw2 * a3
     n1, n2, n3 = g2 * h3 - g3 * h2, g3 * h1 - g1 * h3, g1 * h2 - g2 * h1   # radiation torque
-    return (n1 - c1) / J1, (n2 - c2) / J2, (n3 - c3) / J3
+    return (n1 - free * c1) / J1, (n2 - free * c2) / J2, (n3 - free * c3) / J3
 
 
-def truncated_rate(w1, w2, w3, J, g):
+def truncated_terms(w1, w2, w3, J, g, free):
     """Omega_dot of the truncated Euler equation (2.5), solved exactly for Omega_dot.
 
     J Omega_dot + Omega x J Omega = -{ |g x Omega|^2 Omega + (g . (Omega x Omega_dot)) g }.
@@ -72,17 +75,35 @@ def truncated_rate(w1, w2, w3, J, g):
     Omega_dot = J^-1 r - J^-1 g (v . J^-1 r) / (1 + v . J^-1 g).
     The denominator vanishes only when |tau0 Omega| is of order 1, far outside any
     physical regime; ``truncated_singularity`` reports how close a state is.
+    ``free`` = 0 drops the free part -J^-1 (Omega x J Omega) (it stays inside v . J^-1 r,
+    where it belongs to the torque's (g . (Omega x Omega_dot)) g term).
     """
     J1, J2, J3 = J
     g1, g2, g3 = g
     L1, L2, L3 = J1 * w1, J2 * w2, J3 * w3
-    c1, c2, c3 = w2 * L3 - w3 * L2, w3 * L1 - w1 * L3, w1 * L2 - w2 * L1   # Omega x J Omega
+    f1, f2, f3 = -(w2 * L3 - w3 * L2) / J1, -(w3 * L1 - w1 * L3) / J2, -(w1 * L2 - w2 * L1) / J3   # free rate
     v1, v2, v3 = g2 * w3 - g3 * w2, g3 * w1 - g1 * w3, g1 * w2 - g2 * w1   # g x Omega
     v_sq = v1 * v1 + v2 * v2 + v3 * v3
-    r1, r2, r3 = (-c1 - v_sq * w1) / J1, (-c2 - v_sq * w2) / J2, (-c3 - v_sq * w3) / J3
+    s1, s2, s3 = -v_sq * w1 / J1, -v_sq * w2 / J2, -v_sq * w3 / J3
     u1, u2, u3 = g1 / J1, g2 / J2, g3 / J3
-    k = (v1 * r1 + v2 * r2 + v3 * r3) / (1.0 + v1 * u1 + v2 * u2 + v3 * u3)
-    return r1 - k * u1, r2 - k * u2, r3 - k * u3
+    k = (v1 * (f1 + s1) + v2 * (f2 + s2) + v3 * (f3 + s3)) / (1.0 + v1 * u1 + v2 * u2 + v3 * u3)
+    return free * f1 + s1 - k * u1, free * f2 + s2 - k * u2, free * f3 + s3 - k * u3
+
+
+def free_terms(w1, w2, w3, J, g, free):
+    """The torque-free rate times ``free`` (its radiation part is zero)."""
+    a1, a2, a3 = free_rate(w1, w2, w3, J, g)
+    return free * a1, free * a2, free * a3
+
+
+def reduced_rate(w1, w2, w3, J, g):
+    """Omega_dot of the reduced Euler equation (2.2)+(2.3); see ``reduced_terms``."""
+    return reduced_terms(w1, w2, w3, J, g, 1.0)
+
+
+def truncated_rate(w1, w2, w3, J, g):
+    """Omega_dot of the truncated Euler equation (2.5); see ``truncated_terms``."""
+    return truncated_terms(w1, w2, w3, J, g, 1.0)
 
 
 def truncated_singularity(w1, w2, w3, J, g):
@@ -98,6 +119,7 @@ def truncated_singularity(w1, w2, w3, J, g):
 
 
 _RATES = {"reduced": reduced_rate, "truncated": truncated_rate, "free": free_rate}
+_TERMS = {"reduced": reduced_terms, "truncated": truncated_terms, "free": free_terms}
 
 
 def rate_function(model: str):
@@ -106,6 +128,14 @@ def rate_function(model: str):
         return _RATES[model]
     except KeyError:
         raise ValueError(f"unknown model {model!r}; valid: {', '.join(MODELS)}") from None
+
+
+def radiation_function(model: str):
+    """(w1, w2, w3, J, g) -> the radiation part of Omega_dot alone (rate minus free rate,
+    computed without the cancellation of subtracting them)."""
+    rate_function(model)
+    terms = _TERMS[model]
+    return lambda w1, w2, w3, J, g: terms(w1, w2, w3, J, g, 0.0)
 
 
 def omega_dot(model: str, omega, J, g) -> np.ndarray:
@@ -184,6 +214,12 @@ class System:
     def rate(self):
         """Closure (w1, w2, w3) -> Omega_dot components, parameters bound."""
         f = rate_function(self.model)
+        J, g = tuple(map(float, self.inertia)), tuple(map(float, self.coupling))
+        return lambda w1, w2, w3: f(w1, w2, w3, J, g)
+
+    def radiation(self):
+        """Closure (w1, w2, w3) -> the radiation part of Omega_dot alone."""
+        f = radiation_function(self.model)
         J, g = tuple(map(float, self.inertia)), tuple(map(float, self.coupling))
         return lambda w1, w2, w3: f(w1, w2, w3, J, g)
 

@@ -2,4 +2,5 @@
 
 from .cli import entry
 
-entry()
+if __name__ == "__main__":    # guarded: render workers are spawned and re-import __main__
+    entry()

@@ -10,13 +10,12 @@ never step the integrator.
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from . import rotations as R
+from .atomic import atomic_path
 from .physics.bodies import Body
 from .physics.equations import angular_momentum_world, kinetic_energy
 
@@ -180,15 +179,5 @@ class Trajectory:
 
     def save_npz(self, path) -> None:
         """Write the arrays and a JSON ``metadata`` entry atomically (temp file + rename)."""
-        path = os.fspath(path)
-        d = os.path.dirname(os.path.abspath(path))
-        os.makedirs(d, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=".spinviz-", suffix=".npz.tmp", dir=d)
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                np.savez(fh, metadata=np.array(json.dumps(self.metadata())), **self.arrays())
-            os.replace(tmp, path)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
+        with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+            np.savez(fh, metadata=np.array(json.dumps(self.metadata())), **self.arrays())

@@ -149,6 +149,98 @@ class _Table:
             raise self.error(k, "unknown key" + (f" (also unknown: {', '.join(unknown[1:])})" if len(unknown) > 1 else ""))
 
 
+SHOW_ITEMS = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud", "hodograph")
+DEFAULT_SHOW = ("body", "dipole", "axes", "trail", "sphere", "hud")
+ORIENTATION_ITEMS = ("body", "dipole", "omega", "L", "trail")
+
+
+@dataclass(frozen=True)
+class RenderSpec:
+    """What a video shows and how simulation time maps to video time (the [render] table).
+
+    duration : s of video; fps; size : (width, height) px.
+    time_map : "linear" or "log" -- video time s in [0, 1] maps to t = t_end s, or to
+        t = knee ((1 + t_end/knee)^s - 1) (logarithmic once t >> knee).
+    log_knee : knee of the log map, in the scene's time unit (default t_end / 1000).
+    spin : "auto", "true" (the simulated orientation at each frame) or "slowed" (symmetric
+        tops: slow geometry exact, spin and precession phases re-timed so that the shown
+        spin rate is ``spin_turns_per_second`` x |Omega_L(t)| / |Omega_L(0)|; labelled).
+    show : the actors to build (others are not built, and what they need is not computed).
+    trail_seconds : length of the dipole trail, video seconds.
+    camera : azimuth_deg, elevation_deg (view direction from the origin), zoom.
+    background : "white" or "black".  title : shown under the panels.
+    poster : where in the video (0..1) the PNG poster frame is taken.
+    """
+
+    duration: float = 12.0
+    fps: int = 30
+    size: tuple[int, int] = (1280, 720)
+    time_map: str = "linear"
+    log_knee: float | None = None
+    spin: str = "auto"
+    spin_turns_per_second: float = 0.75
+    show: tuple[str, ...] = DEFAULT_SHOW
+    trail_seconds: float = 2.0
+    azimuth_deg: float = -55.0
+    elevation_deg: float = 22.0
+    zoom: float = 1.0
+    background: str = "white"
+    title: str = ""
+    poster: float = 1.0
+
+    @property
+    def needs_orientation(self) -> bool:
+        """False when nothing shown depends on the orientation (e.g. a hodograph-only scene):
+        then no orientation is integrated at all."""
+        return any(item in self.show for item in ORIENTATION_ITEMS)
+
+    @property
+    def frames(self) -> int:
+        return max(2, int(round(self.duration * self.fps)))
+
+
+def parse_render(t: "_Table | None", title: str, t_end: float) -> RenderSpec:
+    """Validate a [render] table (None: all defaults)."""
+    if t is None:
+        return RenderSpec(title=title)
+    kw = {}
+    kw["duration"] = t.number("duration", 12.0, positive=True)
+    kw["fps"] = t.integer("fps", 30, minimum=1)
+    if kw["fps"] > 240:
+        raise t.error("fps", f"must be at most 240, got {kw['fps']}")
+    size = t.raw("size", [1280, 720])
+    if (not isinstance(size, list) or len(size) != 2 or not all(isinstance(x, int) and not isinstance(x, bool) for x in size)
+            or min(size) < 16 or max(size) > 7680):
+        raise t.error("size", f"must be [width, height] in pixels (16..7680), got {size!r}")
+    kw["size"] = (size[0], size[1])
+    kw["time_map"] = t.string("time_map", "linear", choices=("linear", "log"))
+    kw["log_knee"] = t.number("log_knee", positive=True)
+    if kw["log_knee"] is not None and kw["log_knee"] >= t_end:
+        raise t.error("log_knee", f"must be below t_end = {t_end:g}")
+    kw["spin"] = t.string("spin", "auto", choices=("auto", "true", "slowed"))
+    kw["spin_turns_per_second"] = t.number("spin_turns_per_second", 0.75, positive=True)
+    show = t.raw("show", list(DEFAULT_SHOW))
+    if not isinstance(show, list) or not show or not all(isinstance(x, str) for x in show):
+        raise t.error("show", f"must be a non-empty list of names from: {', '.join(SHOW_ITEMS)}")
+    for item in show:
+        if item not in SHOW_ITEMS:
+            raise t.error("show", f"unknown item {item!r}; valid: {', '.join(SHOW_ITEMS)}")
+    kw["show"] = tuple(dict.fromkeys(show))
+    kw["trail_seconds"] = t.number("trail_seconds", 2.0, nonneg=True)
+    kw["azimuth_deg"] = t.number("azimuth_deg", -55.0)
+    kw["elevation_deg"] = t.number("elevation_deg", 22.0)
+    if not -89.0 <= kw["elevation_deg"] <= 89.0:
+        raise t.error("elevation_deg", f"must lie in [-89, 89], got {kw['elevation_deg']:g}")
+    kw["zoom"] = t.number("zoom", 1.0, positive=True)
+    kw["background"] = t.string("background", "white", choices=("white", "black"))
+    kw["title"] = t.string("title", title)
+    kw["poster"] = t.number("poster", 1.0, nonneg=True)
+    if kw["poster"] > 1.0:
+        raise t.error("poster", f"must lie in [0, 1] (a fraction of the video), got {kw['poster']:g}")
+    t.finish()
+    return RenderSpec(**kw)
+
+
 @dataclass(frozen=True)
 class Scene:
     """A validated scene, in the body's units (CGS: s, rad/s; dimensionless: tau0, 1/tau0)."""
@@ -165,7 +257,7 @@ class Scene:
     rtol: float = 1e-10
     atol: float = 1e-12
     step: float | None = None
-    render: dict = field(default_factory=dict)
+    render: RenderSpec = field(default_factory=RenderSpec)
     raw: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
@@ -306,9 +398,7 @@ def parse_scene(data: dict, path: str = "<scene>") -> Scene:
     atol = st.number("atol", 1e-12, positive=True)
     step = st.number("step", positive=True)
     st.finish()
-    render = top.raw("render", {})
-    if not isinstance(render, dict):
-        raise top.error("render", "must be a table")
+    render = parse_render(top.sub("render"), title, t_end)
     top.finish()
     return Scene(path=str(path), title=title, body=body, models=models, omega0=omega0, q0=q0,
                  t_end=t_end, samples=samples, method=method.lower(), rtol=rtol, atol=atol, step=step,

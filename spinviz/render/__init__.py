@@ -1,0 +1,254 @@
+"""Off-screen rendering to video: the only part of spinviz that imports pyvista/imageio.
+
+``render_video(plan, out)`` draws every frame of a ``timeline.FramePlan`` and encodes it;
+``render_frames`` draws chosen frames in this process (tests, stills).  The renderer
+consumes frames planned from stored trajectories and never steps physics.
+
+Parallel MP4: the frames are split into contiguous segments, one per worker process (one
+per core); each worker renders its segment and encodes it with its own single-threaded
+x264 (H.264, yuv420p), and the segments are joined by ffmpeg's concat demuxer without
+re-encoding.  No frame crosses a process boundary, so the parent costs nothing per frame.
+GIFs (small by nature) are rendered in-process.
+"""
+
+from __future__ import annotations
+
+import os
+import queue as _queue
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import traceback
+from dataclasses import dataclass
+
+import numpy as np
+
+from .encode import AtomicPath, Mp4Writer, open_writer, write_png
+
+__all__ = ["render_video", "render_frames", "RenderResult", "RenderError"]
+
+
+class RenderError(RuntimeError):
+    """Rendering failed; the message says where (a worker's last traceback line included)."""
+
+
+@dataclass
+class RenderResult:
+    path: str
+    poster: str | None
+    frames: int
+    size: tuple[int, int]
+    seconds: float
+    startup_seconds: float
+    workers: int
+
+    @property
+    def fps(self) -> float:
+        return self.frames / self.seconds if self.seconds > 0 else float("inf")
+
+    @property
+    def steady_fps(self) -> float:
+        """Frames per second once the workers are up (encoding and joining included)."""
+        dt = self.seconds - self.startup_seconds
+        return self.frames / dt if dt > 0 else float("inf")
+
+
+def default_workers() -> int:
+    return max(1, min(4, os.cpu_count() or 1))
+
+
+def default_supersample(size) -> float:
+    """2 x 2 supersampling (4 samples per pixel)."""
+    return 2.0
+
+
+def render_frames(plan, frames, size, supersample: float | None = None):
+    """Frames (list of indices) as RGB arrays, rendered in this process; also returns the
+    session so tests can project world points.  Caller closes the session."""
+    from .session import RenderSession
+
+    session = RenderSession(plan, size, supersample or default_supersample(size))
+    return [session.frame(f) for f in frames], session
+
+
+class _Progress:
+    def __init__(self, label: str, total: int, enabled: bool):
+        self.label, self.total, self.enabled = label, total, enabled
+        self.tty = enabled and sys.stderr.isatty()
+        self.t0 = time.perf_counter()
+        self.last = 0.0
+        self.next_mark = 0.25
+
+    def update(self, done: int):
+        if not self.enabled:
+            return
+        now = time.perf_counter()
+        frac = done / self.total
+        if self.tty and (now - self.last > 0.2 or done == self.total):
+            self.last = now
+            rate = done / (now - self.t0) if now > self.t0 else 0.0
+            eta = (self.total - done) / rate if rate > 0 else 0.0
+            bar = "#" * int(30 * frac)
+            sys.stderr.write(f"\r{self.label} [{bar:<30}] {done}/{self.total} frames {rate:5.1f} fps  {eta:4.0f} s left ")
+            if done == self.total:
+                sys.stderr.write("\n")
+            sys.stderr.flush()
+        elif not self.tty and frac >= self.next_mark:
+            sys.stderr.write(f"{self.label}: {int(100 * frac)} % ({done}/{self.total} frames)\n")
+            while self.next_mark <= frac:
+                self.next_mark += 0.25
+
+
+def _segment_worker(index, plan, size, supersample, lo, hi, path, poster_f, msgs, stop):
+    """Render frames lo..hi-1 into the MP4 segment ``path``; report progress on ``msgs``."""
+    try:
+        # one rasterizer thread per worker: the workers already fill the cores
+        os.environ.setdefault("LP_NUM_THREADS", "1")
+        from .session import RenderSession
+
+        session = RenderSession(plan, size, supersample)
+        writer = Mp4Writer(path, size, plan.spec.fps, threads=1)
+        msgs.put(("ready", index, None))
+        done = 0
+        for f in range(lo, hi):
+            if stop.is_set():
+                break
+            img = session.frame(f)
+            writer.write(img)
+            if f == poster_f:
+                msgs.put(("poster", index, img.tobytes()))
+            done += 1
+            if done % 4 == 0 or f == hi - 1:
+                msgs.put(("progress", index, done))
+        writer.close()
+        session.close()
+        msgs.put(("done", index, None))
+    except BaseException:
+        msgs.put(("error", index, traceback.format_exc()))
+
+
+def render_video(plan, out: str, size=None, workers: int | None = None, supersample: float | None = None,
+                 progress: bool = True, poster: bool = True, max_frames: int | None = None) -> RenderResult:
+    """Render ``plan`` to ``out`` (.mp4 or .gif) and a PNG poster beside it; atomically.
+
+    workers : render processes for MP4 (default: one per core, at most 4); 1 renders in-process.
+    max_frames : stop after this many frames (benchmarks).
+    """
+    size = tuple(size or plan.spec.size)
+    supersample = supersample or default_supersample(size)
+    F = plan.frames if max_frames is None else min(plan.frames, max_frames)
+    fmt = os.path.splitext(out)[1].lower()
+    workers = workers or default_workers()
+    if fmt != ".mp4" or F < 4 * workers:
+        workers = 1
+    poster_f = min(int(round(plan.spec.poster * (plan.frames - 1))), F - 1)
+    target = AtomicPath(out)
+    bar = _Progress(f"rendering {out}", F, progress)
+    start = time.perf_counter()
+    try:
+        if workers == 1:
+            poster_img, startup = _render_in_process(plan, target.tmp, size, supersample, F, poster_f, bar)
+        else:
+            poster_img, startup = _render_segments(plan, target.tmp, size, supersample, F, poster_f, workers, bar)
+        target.commit()
+    except BaseException:
+        target.discard()
+        raise
+    seconds = time.perf_counter() - start
+    poster_path = None
+    if poster and poster_img is not None:
+        poster_path = os.path.splitext(out)[0] + ".png"
+        write_png(poster_path, poster_img)
+    return RenderResult(path=out, poster=poster_path, frames=F, size=size, seconds=seconds,
+                        startup_seconds=startup, workers=workers)
+
+
+def _render_in_process(plan, path, size, supersample, F, poster_f, bar):
+    from .session import RenderSession
+
+    t0 = time.perf_counter()
+    session = RenderSession(plan, size, supersample)
+    startup = time.perf_counter() - t0
+    writer = open_writer(path, size, plan.spec.fps)
+    poster_img = None
+    try:
+        for f in range(F):
+            img = session.frame(f)
+            writer.write(img)
+            if f == poster_f:
+                poster_img = img
+            bar.update(f + 1)
+    finally:
+        writer.close()
+        session.close()
+    return poster_img, startup
+
+
+def _render_segments(plan, path, size, supersample, F, poster_f, workers, bar):
+    import multiprocessing as mp
+
+    ctx = mp.get_context("spawn")                   # fresh interpreters: no GL state shared by fork
+    stop = ctx.Event()
+    msgs = ctx.Queue()
+    bounds = np.linspace(0, F, workers + 1).round().astype(int)
+    tmpdir = tempfile.mkdtemp(prefix=".spinviz-segments-", dir=os.path.dirname(os.path.abspath(path)))
+    segs = [os.path.join(tmpdir, f"part{k}.mp4") for k in range(workers)]
+    procs = [ctx.Process(target=_segment_worker, daemon=True,
+                         args=(k, plan, size, supersample, int(bounds[k]), int(bounds[k + 1]), segs[k], poster_f, msgs, stop))
+             for k in range(workers)]
+    t0 = time.perf_counter()
+    startup = None
+    poster_img = None
+    counts = [0] * workers
+    try:
+        for p in procs:
+            p.start()
+        pending = set(range(workers))
+        ready = 0
+        while pending:
+            try:
+                kind, k, payload = msgs.get(timeout=1.0)
+            except _queue.Empty:
+                dead = [i for i in pending if not procs[i].is_alive()]
+                if dead:
+                    raise RenderError(f"render worker {dead[0]} exited with status {procs[dead[0]].exitcode}") from None
+                continue
+            if kind == "error":
+                raise RenderError(f"render worker {k} failed: {payload.strip().splitlines()[-1]}")
+            if kind == "ready":
+                ready += 1
+                if ready == workers:
+                    startup = time.perf_counter() - t0
+            elif kind == "progress":
+                counts[k] = payload
+                bar.update(sum(counts))
+            elif kind == "poster":
+                poster_img = np.frombuffer(payload, dtype=np.uint8).reshape(size[1], size[0], 3)
+            elif kind == "done":
+                pending.discard(k)
+        _concat(segs, path)
+    finally:
+        stop.set()
+        for p in procs:
+            p.join(timeout=5)
+            if p.is_alive():
+                p.terminate()
+        shutil.rmtree(tmpdir, ignore_errors=True)
+    return poster_img, startup or 0.0
+
+
+def _concat(segments, path):
+    """Join MP4 segments by stream copy (no re-encoding) with ffmpeg's concat demuxer."""
+    import imageio_ffmpeg
+
+    listing = os.path.join(os.path.dirname(segments[0]), "segments.txt")
+    with open(listing, "w") as fh:
+        for s in segments:
+            fh.write(f"file '{s}'\n")
+    cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-hide_banner", "-loglevel", "error", "-y", "-f", "concat", "-safe", "0",
+           "-i", listing, "-c", "copy", "-movflags", "+faststart", "-f", "mp4", path]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RenderError(f"joining the video segments failed: {r.stderr.strip().splitlines()[-1] if r.stderr else r.returncode}")

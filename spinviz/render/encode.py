@@ -1,0 +1,69 @@
+"""Video and image writers; every output goes through ``spinviz.atomic`` (temporary file,
+then rename), so nothing half-written ever sits at the output path."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+from PIL import Image
+
+from ..atomic import AtomicPath, atomic_path
+
+FORMATS = {".mp4": "mp4", ".gif": "gif"}
+
+
+class Mp4Writer:
+    """H.264 (libx264), yuv420p, through imageio-ffmpeg's ffmpeg (a separate process, so
+    encoding runs beside rendering).  Width and height must be even."""
+
+    def __init__(self, path: str, size, fps: int, crf: int = 20, preset: str = "veryfast", threads: int = 0):
+        import imageio_ffmpeg
+
+        W, H = size
+        if W % 2 or H % 2:
+            raise ValueError(f"MP4 (H.264, yuv420p) needs an even width and height, got {W}x{H}")
+        params = ["-preset", preset, "-crf", str(crf), "-movflags", "+faststart", "-f", "mp4"]
+        if threads:
+            params += ["-threads", str(threads)]
+        self._gen = imageio_ffmpeg.write_frames(
+            path, (W, H), fps=fps, codec="libx264", pix_fmt_in="rgb24", pix_fmt_out="yuv420p", quality=None,
+            macro_block_size=2, ffmpeg_log_level="error", output_params=params,
+        )
+        self._gen.send(None)
+
+    def write(self, img: np.ndarray):
+        self._gen.send(np.ascontiguousarray(img))
+
+    def close(self):
+        self._gen.close()
+
+
+class GifWriter:
+    """Animated GIF via Pillow (adaptive palette per frame, frames kept in memory)."""
+
+    def __init__(self, path: str, size, fps: int):
+        self.path, self.fps, self.frames = path, fps, []
+
+    def write(self, img: np.ndarray):
+        self.frames.append(Image.fromarray(img).quantize(colors=128, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE))
+
+    def close(self):
+        if self.frames:
+            self.frames[0].save(self.path, format="GIF", save_all=True, append_images=self.frames[1:],
+                                duration=int(round(1000 / self.fps)), loop=0, optimize=True, disposal=1)
+
+
+def open_writer(path: str, size, fps: int):
+    ext = os.path.splitext(path)[1].lower()
+    if ext == ".mp4":
+        return Mp4Writer(path, size, fps)
+    if ext == ".gif":
+        return GifWriter(path, size, fps)
+    raise ValueError(f"unknown video format {ext!r}; use .mp4 or .gif")
+
+
+def write_png(path: str, img: np.ndarray):
+    """A PNG written atomically."""
+    with atomic_path(path) as tmp:
+        Image.fromarray(img).save(tmp, format="PNG")

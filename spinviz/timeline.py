@@ -1,0 +1,262 @@
+"""From trajectories to frames: which time each frame shows and what each panel displays.
+
+Pure NumPy (no rendering library): the renderer only draws what this module computes,
+and frames are sampled from stored trajectories (``Trajectory.sample``), never by stepping
+an integrator.
+
+Time on screen.  Video time v in [0, duration] maps to simulation time linearly,
+t = t_end v/duration, or logarithmically, t = k ((1 + t_end/k)^(v/duration) - 1) with a
+knee k (default t_end/1000), so early braking and late asymptotics both get screen time.
+
+Spin on screen.  Real spin rates are 1e16-1e25 turns per braking time; no frame rate can
+show them.  Two honest modes:
+
+* ``true`` -- each frame shows the simulated orientation at its time.  Used when the body
+  turns less than 30 deg between frames and the phase is resolved.
+* ``slowed`` -- for symmetric tops.  The motion is written in ZXZ angles about L_world:
+  nutation theta_L (angle of e3 from L), precession phase phi_L (rate |L|/I1) and spin
+  phase psi_L (rate delta Omega3).  theta_L and L are shown exactly; the two phases advance
+  at ``spin_turns_per_second`` x (their true rate)/(|L|/I1 at t = 0) turns per video
+  second, so the braking stays visible while the spin is slowed by a factor (true rad per
+  video second / shown rad per video second) that the heads-up line states.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import rotations as R
+from . import units as U
+from .scene import RenderSpec
+from .trajectory import Trajectory
+
+MAX_TRUE_DEG_PER_FRAME = 30.0
+
+MODEL_LABELS = {"reduced": "reduced (2.2)+(2.3)", "truncated": "truncated (2.5)", "free": "free (d = 0)"}
+
+
+def frame_times(spec: RenderSpec, t_end: float, frames: int | None = None):
+    """(video_t, sim_t, dsim_dvideo), each shape (F,): frame times and the map's slope."""
+    F = frames or spec.frames
+    v = np.linspace(0.0, spec.duration, F)
+    s = v / spec.duration
+    if spec.time_map == "linear":
+        t = t_end * s
+        slope = np.full(F, t_end / spec.duration)
+    else:
+        k = spec.log_knee or t_end / 1000.0
+        base = 1.0 + t_end / k
+        t = k * np.expm1(s * math.log(base))
+        slope = k * math.log(base) * base**s / spec.duration
+    t[-1] = t_end
+    return v, t, slope
+
+
+def time_map_label(spec: RenderSpec, t_end: float, units: str) -> str:
+    if spec.time_map == "linear":
+        return "time: linear"
+    k = spec.log_knee or t_end / 1000.0
+    return f"time: logarithmic after {format_time(k, units)}"
+
+
+def format_time(t: float, units: str) -> str:
+    """Physical time in the best human unit (CGS), or in tau0 (dimensionless)."""
+    return U.human_time(t) if units == "cgs" else f"{t:.4g} \u03c40"
+
+
+def format_omega(w: float, units: str) -> str:
+    return f"|\u03a9| = {w:.3g} rad/s" if units == "cgs" else f"|\u03c9| = {w:.3g} /\u03c40"
+
+
+@dataclass
+class Panel:
+    """What one model's panel shows at each frame (F frames).
+
+    q : (F, 4) display orientation, body -> world, (w, x, y, z); dipole : (F, 3) unit, world;
+    omega, L : (F, 3) world vectors scaled to |x(t)|/|x(0)| of the reference panel;
+    omega_body : (F, 3) body-frame angular velocity / |omega(0)| (hodograph);
+    omega_mag : (F,) |Omega| in scene units; angle_dL_deg : (F,) angle between d and L.
+    Arrays a scene does not show are None (not computed).
+    """
+
+    model: str
+    omega_mag: np.ndarray
+    q: np.ndarray | None = None
+    dipole: np.ndarray | None = None
+    omega: np.ndarray | None = None
+    L: np.ndarray | None = None
+    omega_body: np.ndarray | None = None
+    angle_dL_deg: np.ndarray | None = None
+
+    @property
+    def label(self) -> str:
+        return MODEL_LABELS.get(self.model, self.model)
+
+
+@dataclass
+class FramePlan:
+    """Everything the renderer needs: frame times, per-panel arrays, spin mode, labels."""
+
+    spec: RenderSpec
+    video_t: np.ndarray
+    sim_t: np.ndarray
+    panels: list[Panel]
+    units: str
+    body_name: str
+    shape: object            # physics.bodies.Shape
+    dipole_body: np.ndarray  # unit, body frame
+    spin_mode: str
+    slowdown: np.ndarray | None = None      # (F,) true / shown phase rate (slowed mode)
+    time_label: str = ""
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def frames(self) -> int:
+        return self.video_t.size
+
+    def hud_lines(self, panel_index: int, f: int) -> list[str]:
+        """The heads-up lines of one panel at frame f."""
+        p = self.panels[panel_index]
+        lines = [p.label, f"t = {format_time(self.sim_t[f], self.units)}", format_omega(p.omega_mag[f], self.units)]
+        if p.angle_dL_deg is not None:
+            lines.append(f"\u2220(d, L) = {p.angle_dL_deg[f]:.3g}\u00b0")
+        if self.spin_mode == "slowed":
+            lines.append(f"spin shown slowed {self.slowdown[f]:.2g}\u00d7")
+        elif self.spin_mode == "aliased":
+            lines.append("spin too fast for the frame rate (aliased)")
+        return lines
+
+    def footer(self) -> str:
+        parts = [self.spec.title or self.body_name, self.time_label]
+        return "   \u00b7   ".join(x for x in parts if x)
+
+
+def _rotation_per_frame(trajs, sim_t) -> float:
+    """Upper bound of the rotation between frames in true mode, deg."""
+    dt = np.diff(sim_t)
+    worst = 0.0
+    for tr in trajs:
+        w = tr.sample(sim_t).omega_magnitude
+        worst = max(worst, float(np.max(np.maximum(w[:-1], w[1:]) * dt)))
+    return math.degrees(worst)
+
+
+def choose_spin_mode(spec: RenderSpec, trajs: list[Trajectory], sim_t) -> tuple[str, str]:
+    """("true" | "slowed" | "aliased", why)."""
+    if not spec.needs_orientation:
+        return "true", "no orientation shown"
+    body = trajs[0].body
+    resolved = all(tr.phase_resolved and tr.q is not None for tr in trajs)
+    if spec.spin == "slowed" and not body.is_symmetric:
+        raise ValueError("spin = \"slowed\" needs a symmetric top (I1 = I2); this body is asymmetric")
+    if spec.spin == "true":
+        if not resolved:
+            raise ValueError("spin = \"true\" needs a resolved spin phase; this run is beyond float64 "
+                             "resolution (use spin = \"slowed\" or \"auto\")")
+        return "true", "requested"
+    if spec.spin == "slowed":
+        return "slowed", "requested"
+    deg = _rotation_per_frame(trajs, sim_t) if resolved else math.inf
+    if deg <= MAX_TRUE_DEG_PER_FRAME:
+        return "true", f"at most {deg:.3g} deg per frame"
+    if body.is_symmetric:
+        return "slowed", (f"up to {deg:.3g} deg per frame" if resolved else "spin phase beyond float64 resolution")
+    return "aliased", f"asymmetric body turning up to {deg:.3g} deg per frame: shown as simulated, aliased"
+
+
+def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = None) -> FramePlan:
+    """Frame times and per-panel display data for one or two trajectories of the same body
+    and initial state (one panel per trajectory)."""
+    if not 1 <= len(trajs) <= 2:
+        raise ValueError("a video shows one or two models")
+    body = trajs[0].body
+    t_end = float(trajs[0].t[-1])
+    video_t, sim_t, slope = frame_times(spec, t_end, frames)
+    mode, why = choose_spin_mode(spec, trajs, sim_t)
+    samples = [tr.sample(sim_t) for tr in trajs]
+    ref = samples[0]
+    w_ref = float(np.linalg.norm(ref.omega[0])) or 1.0
+    J = np.asarray(body.inertia, dtype=float)
+    L_ref = float(np.linalg.norm(J * ref.omega[0])) or 1.0
+    show = set(spec.show)
+    slowdown = None
+    panels = []
+    if mode == "slowed":
+        geo = [_slow_geometry(s, body) for s in samples]
+        rate_ref = geo[0]["phidot"][0] or 1.0
+        two_pi_r0 = 2.0 * math.pi * spec.spin_turns_per_second
+        # true rad per video second / shown rad per video second (the same for every panel)
+        slowdown = rate_ref * slope / two_pi_r0
+    for k, s in enumerate(samples):
+        panel = Panel(model=s.model, omega_mag=s.omega_magnitude)
+        if spec.needs_orientation:
+            if mode == "slowed":
+                g = geo[k]
+                scale = two_pi_r0 / rate_ref
+                phi = g["phi0"] + _cumtrapz(scale * g["phidot"], video_t)
+                psi = g["psi0"] + _cumtrapz(scale * g["psidot"], video_t)
+                q = R.multiply(g["q_L"], R.quat_from_euler_zxz(np.stack([phi, g["theta_L"], psi], axis=-1)))
+                q = R.multiply(q, g["q_frame"][None, :])
+                wb_frame = np.stack([g["wp"] * np.sin(psi), g["wp"] * np.cos(psi), g["w3"]], axis=-1)  # p = pi/2 - psi
+                omega_body = R.body_from_world(g["q_frame"], wb_frame)
+            else:
+                q = s.q
+                omega_body = s.omega
+            panel.q = q
+            if "dipole" in show or "trail" in show or "hud" in show:
+                panel.dipole = R.world_from_body(q, body.dipole_direction)
+            L_world = R.world_from_body(q, J * omega_body) if ("L" in show or "hud" in show) else None
+            if "omega" in show:
+                panel.omega = R.world_from_body(q, omega_body) / w_ref
+            if "L" in show:
+                panel.L = L_world / L_ref
+            if "hud" in show:
+                Lh = L_world / np.linalg.norm(L_world, axis=-1, keepdims=True)
+                panel.angle_dL_deg = np.degrees(np.arccos(np.clip(np.sum(Lh * panel.dipole, axis=-1), -1.0, 1.0)))
+        if "hodograph" in show:
+            panel.omega_body = s.omega / w_ref
+        panels.append(panel)
+    return FramePlan(
+        spec=spec, video_t=video_t, sim_t=sim_t, panels=panels, units=body.units, body_name=body.name,
+        shape=body.shape, dipole_body=body.dipole_direction, spin_mode=mode, slowdown=slowdown,
+        time_label=time_map_label(spec, t_end, body.units), notes=[f"spin: {mode} ({why})"],
+    )
+
+
+def _cumtrapz(y, x):
+    out = np.zeros_like(y)
+    out[1:] = np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(x))
+    return out
+
+
+def _slow_geometry(s: Trajectory, body) -> dict:
+    """theta_L, the L frame, the two phase rates and the starting phases, at the frames.
+
+    From the ``secular`` slow geometry when present (its phases may be unresolved: only the
+    starting phases are used), otherwise from q and Omega.
+    """
+    J3 = body.I3 / body.I1
+    delta = 1.0 - J3
+    w = s.omega
+    q_frame = np.array([1.0, 0.0, 0.0, 0.0])
+    if s.slow is not None:
+        q_frame = np.asarray(s.slow["q_frame"], dtype=float)
+        w = R.world_from_body(q_frame, w)                   # into the frame where e3 is the symmetry (or d) axis
+    wp, w3 = np.hypot(w[:, 0], w[:, 1]), w[:, 2]
+    out = {"wp": wp, "w3": w3, "phidot": np.hypot(wp, J3 * w3), "psidot": delta * w3, "q_frame": q_frame}
+    if s.slow is not None:
+        q_L = np.broadcast_to(np.asarray(s.slow["q_L"], dtype=float), (w.shape[0], 4))
+        out.update(q_L=q_L, theta_L=np.asarray(s.slow["theta_L"]), phi0=float(s.slow["phi_L"][0]),
+                   psi0=float(s.slow["psi_L"][0]))
+        return out
+    L_world = s.angular_momentum_world()
+    Lh = L_world / np.linalg.norm(L_world, axis=-1, keepdims=True)
+    q_L = np.array([R.quat_between((0.0, 0.0, 1.0), v) for v in Lh])
+    e3 = R.world_from_body(s.q, np.array([0.0, 0.0, 1.0]))
+    theta_L = np.arccos(np.clip(np.sum(e3 * Lh, axis=-1), -1.0, 1.0))
+    ang0 = R.euler_zxz_from_quat(R.multiply(R.conjugate(q_L[0]), s.q[0]))
+    out.update(q_L=q_L, theta_L=theta_L, phi0=float(ang0[0]), psi0=float(ang0[2]))
+    return out

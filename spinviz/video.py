@@ -1,0 +1,68 @@
+"""Scene -> trajectories -> frame plan -> video: the orchestration behind ``spinviz render``.
+
+Each model is simulated once, with the frame times as output instants, and only with the
+orientation when something shown needs it.  Rendering (the heavy optional stack) is
+imported only here, only when a video is asked for.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import replace
+
+from .scene import RenderSpec, Scene
+from .simulate import simulate
+from .timeline import frame_times, plan_frames
+
+OPTIONAL_RENDER_MODULES = {"pyvista", "vtk", "vtkmodules", "imageio", "imageio_ffmpeg", "PIL"}
+
+
+class MissingRenderStack(ImportError):
+    """The rendering extra is not installed; str() says what to install."""
+
+
+def require_render_stack():
+    """Import spinviz.render, or explain in one line which optional package is missing."""
+    try:
+        from . import render  # noqa: F401
+        import imageio_ffmpeg  # noqa: F401
+    except ImportError as e:
+        name = (e.name or "").split(".")[0]
+        if name in OPTIONAL_RENDER_MODULES:
+            raise MissingRenderStack(
+                f"rendering needs the optional package {name!r}: pip install 'spinviz[render]'"
+            ) from None
+        raise
+    from . import render
+
+    return render
+
+
+def spec_with(scene: Scene, size=None, fps=None, duration=None) -> RenderSpec:
+    """The scene's render spec with command-line overrides."""
+    kw = {}
+    if size is not None:
+        kw["size"] = tuple(size)
+    if fps is not None:
+        kw["fps"] = int(fps)
+    if duration is not None:
+        kw["duration"] = float(duration)
+    return replace(scene.render, **kw)
+
+
+def scene_trajectories(scene: Scene, spec: RenderSpec):
+    """One trajectory per model, stored at the frame times (kinematics only if shown)."""
+    _, sim_t, _ = frame_times(spec, scene.t_end)
+    kw = scene.simulation_kwargs(kinematics="quaternion" if spec.needs_orientation else "none")
+    kw.pop("t_end")
+    kw.pop("samples")
+    return [simulate(scene.body, m, t_eval=sim_t, **kw) for m in scene.models]
+
+
+def plan_scene(scene: Scene, spec: RenderSpec):
+    return plan_frames(spec, scene_trajectories(scene, spec))
+
+
+def default_output(scene: Scene, directory: str = "renders") -> str:
+    stem = os.path.splitext(os.path.basename(scene.path))[0]
+    return os.path.join(directory, f"{stem}.mp4")

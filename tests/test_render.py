@@ -1,0 +1,269 @@
+"""Rendering, checked from the pictures: arrow tips against the camera projection of O d,
+two panels, frame counts and sizes, atomic outputs, and what is (not) built.
+
+Small frames (a few hundred pixels) keep these fast; off-screen software OpenGL (EGL)."""
+
+import math
+import os
+import tomllib
+
+import numpy as np
+import pytest
+
+from spinviz import rotations as R
+from spinviz import timeline, video
+from spinviz.render import RenderError, render_frames, render_video
+from spinviz.scene import parse_scene
+
+DIPOLE_RGB = np.array([0.86, 0.08, 0.24]) * 255
+
+
+def scene_from(text: str, path="test.toml"):
+    return parse_scene(tomllib.loads(text), path)
+
+
+ASKEW = """
+title = "askew"
+[body]
+delta = -0.6
+chi_deg = 55.0
+[initial]
+omega = [0.02, 0.05, 0.03]
+euler_zxz = [0.3, 1.1, -0.4]
+[simulation]
+{models}
+t_end = 60.0
+samples = 50
+[render]
+duration = 1.0
+fps = 12
+size = [{w}, {h}]
+show = {show}
+spin = "true"
+"""
+
+
+def askew(models='model = "reduced"', show='["dipole"]', w=320, h=240):
+    return scene_from(ASKEW.format(models=models, show=show, w=w, h=h))
+
+
+def dipole_mask(img):
+    """Pixels the dipole arrow covers, even partly: red clearly above green and blue (the
+    arrow is the only red thing; anti-aliased edge pixels of ~25 % coverage still qualify)."""
+    px = img.astype(int)
+    return (px[..., 0] - px[..., 1] > 30) & (px[..., 0] - px[..., 2] > 25)
+
+
+def tip_pixel(mask, origin):
+    """The masked pixel farthest from ``origin`` (column, row): the arrow's tip."""
+    rows, cols = np.nonzero(mask)
+    d = (cols - origin[0]) ** 2 + (rows - origin[1]) ** 2
+    i = int(np.argmax(d))
+    return np.array([cols[i], rows[i]], dtype=float)
+
+
+def test_dipole_arrow_tip_follows_the_simulated_orientation():
+    """For several frames, the arrow tip found in the pixels lies within 2.5 px of the camera
+    projection of O d (the simulated orientation applied to the body-frame dipole)."""
+    sc = askew()
+    spec = sc.render
+    trajs = video.scene_trajectories(sc, spec)
+    plan = timeline.plan_frames(spec, trajs)
+    assert plan.spin_mode == "true"
+    frames = [0, 5, 11]
+    imgs, session = render_frames(plan, frames, spec.size)
+    try:
+        for f, img in zip(frames, imgs):
+            q = trajs[0].sample(plan.sim_t[f:f + 1]).q[0]
+            d_world = R.world_from_body(q, sc.body.dipole_direction)
+            np.testing.assert_allclose(plan.panels[0].dipole[f], d_world, atol=1e-12)
+            want = np.array(session.project(0, d_world))
+            origin = session.project(0, (0.0, 0.0, 0.0))
+            got = tip_pixel(dipole_mask(img), origin)
+            assert np.linalg.norm(got - want) < 2.5, (f, got, want)
+    finally:
+        session.close()
+
+
+def test_two_models_are_two_panels_with_their_own_orientations():
+    """A two-model scene renders two side-by-side panels; each arrow tip matches its own
+    model's projected dipole (a shared frame buffer would show the same picture twice)."""
+    sc = scene_from("""
+[body]
+preset = "dast_cube"
+[initial]
+omega = [0.0, 3.141592653589793e10, 3.141592653589793e10]
+euler_zxz_deg = [0.0, 45.0, 0.0]
+[simulation]
+models = ["reduced", "truncated"]
+t_end_Theta = 4.0
+samples = 10
+[render]
+duration = 1.0
+fps = 10
+size = [480, 200]
+show = ["dipole", "hud"]
+""")
+    spec = sc.render
+    plan = video.plan_scene(sc, spec)
+    assert [p.model for p in plan.panels] == ["reduced", "truncated"]
+    assert plan.spin_mode == "slowed"                  # 1e16 turns: the phase is beyond float64
+    f = plan.frames - 1
+    (img,), session = render_frames(plan, [f], spec.size)
+    try:
+        assert img.shape == (200, 480, 3)
+        tips = []
+        for k in range(2):
+            half = np.zeros(img.shape[:2], dtype=bool)
+            half[:, k * 240:(k + 1) * 240] = True
+            mask = dipole_mask(img) & half
+            want = np.array(session.project(k, plan.panels[k].dipole[f]))
+            got = tip_pixel(mask, session.project(k, (0.0, 0.0, 0.0)))
+            assert np.linalg.norm(got - want) < 2.5, (k, got, want)
+            tips.append(got - [k * 240, 0])
+        # the physics shows: reduced has d almost on the axis (theta -> 0), truncated keeps 45 deg
+        assert plan.panels[0].angle_dL_deg[f] < 3.0 and abs(plan.panels[1].angle_dL_deg[f] - 45.0) < 1e-6
+        assert np.linalg.norm(tips[0] - tips[1]) > 10.0
+    finally:
+        session.close()
+
+
+def test_video_has_the_expected_frames_and_size(tmp_path):
+    """MP4 through two worker processes (segments joined by stream copy) and a GIF: the
+    frame count, size, codec and pixel format are what was asked for; a poster PNG is written."""
+    import imageio
+
+    sc = askew(show='["body", "dipole", "trail", "sphere", "axes", "hud"]', w=160, h=96)
+    spec = video.spec_with(sc, fps=16, duration=1.5)
+    plan = video.plan_scene(sc, spec)
+    out = tmp_path / "v.mp4"
+    res = render_video(plan, str(out), workers=2, progress=False)
+    assert res.workers == 2 and res.frames == 24
+    r = imageio.get_reader(str(out))
+    meta = r.get_meta_data()
+    assert meta["codec"] == "h264" and meta["pix_fmt"].startswith("yuv420p")
+    assert tuple(meta["size"]) == (160, 96) and r.count_frames() == 24
+    r.close()
+    from PIL import Image
+
+    assert Image.open(res.poster).size == (160, 96)
+    gif = tmp_path / "v.gif"
+    render_video(plan, str(gif), progress=False, poster=False)
+    im = Image.open(gif)
+    assert im.size == (160, 96) and im.n_frames == 24
+
+
+def test_failed_render_leaves_the_previous_file_intact(tmp_path, monkeypatch):
+    """An error in the middle of a render deletes the partial output and keeps the old file."""
+    from spinviz.render import session as S
+
+    sc = askew(w=64, h=48)
+    plan = video.plan_scene(sc, sc.render)
+    out = tmp_path / "old.mp4"
+    out.write_bytes(b"previous video")
+    calls = {"n": 0}
+    original = S.RenderSession.frame
+
+    def failing(self, f):
+        calls["n"] += 1
+        if calls["n"] == 5:
+            raise RuntimeError("disk on fire")
+        return original(self, f)
+
+    monkeypatch.setattr(S.RenderSession, "frame", failing)
+    with pytest.raises(RuntimeError, match="disk on fire"):
+        render_video(plan, str(out), workers=1, progress=False)
+    assert out.read_bytes() == b"previous video"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["old.mp4"]
+
+
+def test_worker_failure_is_reported_and_cleaned_up(tmp_path):
+    """A worker that cannot render (odd width for H.264) fails the render with a clear error,
+    and no partial file or segment directory is left behind."""
+    sc = askew(w=96, h=48)
+    plan = video.plan_scene(sc, video.spec_with(sc, size=(96, 48), duration=2.0))
+    with pytest.raises(RenderError, match="render worker .* failed"):
+        render_video(plan, str(tmp_path / "x.mp4"), size=(97, 48), workers=2, progress=False)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_only_listed_actors_are_built():
+    sc = askew(show='["dipole"]', w=64, h=48)
+    plan = video.plan_scene(sc, sc.render)
+    _, session = render_frames(plan, [0], sc.render.size)
+    try:
+        assert set(session.solids[0].parts) == {"dipole"}
+        assert session.curves[0] == {}
+        assert len(session.plotters[0].renderer.actors) == 1          # no sphere, axes, trail, body
+        assert plan.panels[0].omega is None and plan.panels[0].L is None   # not computed either
+    finally:
+        session.close()
+
+
+def test_hodograph_only_scene_integrates_no_orientation(monkeypatch):
+    """show = ["hodograph"]: the trajectories carry no orientation (kinematics "none")."""
+    import spinviz.video as V
+
+    seen = []
+    real = V.simulate
+
+    def spy(*a, **k):
+        seen.append(k["kinematics"])
+        return real(*a, **k)
+
+    monkeypatch.setattr(V, "simulate", spy)
+    sc = askew(models='models = ["reduced", "truncated"]', show='["hodograph", "axes"]', w=128, h=64)
+    trajs = V.scene_trajectories(sc, sc.render)
+    assert seen == ["none", "none"] and all(t.q is None for t in trajs)
+    plan = timeline.plan_frames(sc.render, trajs)
+    (img,), session = render_frames(plan, [plan.frames - 1], (128, 64))
+    session.close()
+    assert plan.panels[0].q is None and plan.panels[0].omega_body is not None
+    blue = (img[..., 2] > 150) & (img[..., 0] < 100)
+    assert blue[:, :64].any() and blue[:, 64:].any()               # a hodograph curve in each panel
+
+
+def test_log_time_map_and_slowed_spin_label():
+    """Log time map: starts at 0, ends at t_end, increasing; the slowed-spin factor is the
+    true precession rate (rad per video second) over the shown one, the same in both panels."""
+    spec = scene_from(ASKEW.format(models='model = "reduced"', show='["dipole"]', w=64, h=48)).render
+    from dataclasses import replace
+
+    spec = replace(spec, time_map="log", log_knee=0.5, duration=2.0, fps=10, spin="slowed", spin_turns_per_second=0.5)
+    v, t, slope = timeline.frame_times(spec, 60.0)
+    assert t[0] == 0.0 and t[-1] == 60.0 and np.all(np.diff(t) > 0)
+    np.testing.assert_allclose(np.gradient(t, v)[5:-5], slope[5:-5], rtol=0.05)
+    sc = askew(w=64, h=48)
+    trajs = video.scene_trajectories(sc, spec)
+    plan = timeline.plan_frames(spec, trajs)
+    assert plan.spin_mode == "slowed"
+    w0 = trajs[0].omega[0]
+    J3 = sc.body.I3 / sc.body.I1
+    phidot0 = math.hypot(math.hypot(w0[0], w0[1]), J3 * w0[2])
+    np.testing.assert_allclose(plan.slowdown, phidot0 * slope / (2 * math.pi * 0.5), rtol=1e-12)
+    assert "spin shown slowed" in plan.hud_lines(0, 3)[-1]
+    # the slow geometry is kept: the angle between e3 and L is the simulated one
+    s = trajs[0].sample(plan.sim_t)
+    L = s.angular_momentum_world()
+    e3_true = R.world_from_body(s.q, [0.0, 0.0, 1.0])
+    e3_shown = R.world_from_body(plan.panels[0].q, [0.0, 0.0, 1.0])
+    Lh = L / np.linalg.norm(L, axis=1, keepdims=True)
+    np.testing.assert_allclose(np.sum(e3_shown * Lh, 1), np.sum(e3_true * Lh, 1), atol=1e-9)
+
+
+def test_render_command_errors_are_one_line(tmp_path, capsys):
+    from spinviz.cli import main
+
+    good = tmp_path / "s.toml"
+    good.write_text(ASKEW.format(models='model = "reduced"', show='["dipole"]', w=64, h=48))
+    assert main(["render", str(good), "--out", str(tmp_path / "x.mp4"), "--size", "65x48"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith("MP4 (H.264, yuv420p) needs an even width and height, got 65x48") and "\n" not in err
+    assert main(["render", str(good), "--out", str(tmp_path / "x.avi")]) == 2
+    assert "use .mp4 or .gif" in capsys.readouterr().err
+    bad = tmp_path / "b.toml"
+    bad.write_text(ASKEW.format(models='model = "reduced"', show='["dipole", "halo"]', w=64, h=48))
+    assert main(["render", str(bad)]) == 2
+    assert capsys.readouterr().err.strip() == f"spinviz: error: {bad}: [render].show: unknown item 'halo'; valid: " \
+        "body, dipole, omega, L, axes, trail, sphere, hud, hodograph"
+    assert not any(p.suffix == ".mp4" for p in tmp_path.iterdir())

@@ -1,0 +1,224 @@
+"""``spinviz compare``: how far apart the reduced and truncated predictions drift.
+
+For a two-model scene: the misorientation angle between the two predicted orientations
+and the angle between the two predicted dipole directions over time, the first times
+they exceed 1 and 10 degrees, and each model's final state (residual rotation about the
+dipole, or spin-down to rest).  When the spin phase is beyond float64 resolution (real
+particles, ``secular`` runs), orientations cannot be compared turn by turn; then the
+slow, physical comparison is reported instead: each model's angle between the dipole and
+its rotation axis L, and their difference.
+
+Numbers come from NumPy; matplotlib is imported only to draw the PNGs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import rotations as R
+from .atomic import atomic_path
+from .timeline import format_time
+from .trajectory import Trajectory
+
+THRESHOLDS_DEG = (1.0, 10.0)
+
+
+@dataclass
+class ModelSummary:
+    model: str
+    omega_final: float               # |Omega| at t_end, scene units
+    omega_ratio: float               # |Omega(t_end)| / |Omega(0)|
+    spin_exponent: float             # d ln|Omega| / d ln t over the last third
+    angle_omega_d_deg: float         # angle between Omega and d at t_end
+    angle_d_L_deg: np.ndarray        # (N,) angle between d and L
+    final_state: str
+
+
+@dataclass
+class Comparison:
+    t: np.ndarray
+    units: str
+    phase_resolved: bool
+    misorientation_deg: np.ndarray | None
+    dipole_angle_deg: np.ndarray | None
+    cone_difference_deg: np.ndarray
+    first_exceed: dict = field(default_factory=dict)      # metric -> {threshold: time or None}
+    models: list = field(default_factory=list)
+    omega: dict = field(default_factory=dict)             # model -> (N, 3) body-frame Omega
+
+    def record(self) -> dict:
+        return {
+            "phase_resolved": self.phase_resolved,
+            "units": self.units,
+            "first_exceed": self.first_exceed,
+            "models": [{"model": m.model, "final_state": m.final_state, "omega_final": m.omega_final,
+                        "omega_ratio": m.omega_ratio, "spin_exponent": m.spin_exponent,
+                        "angle_omega_d_deg": m.angle_omega_d_deg, "angle_d_L_final_deg": float(m.angle_d_L_deg[-1])}
+                       for m in self.models],
+        }
+
+
+def compare_times(t_end: float, n: int) -> np.ndarray:
+    """Output times: n evenly spaced and n log-spaced from t_end 1e-6 (early departures)."""
+    lin = np.linspace(0.0, t_end, n)
+    log = np.geomspace(t_end * 1e-6, t_end, n)
+    return np.unique(np.concatenate([lin, log]))
+
+
+def first_crossing(t, angle_deg, threshold):
+    """The first time ``angle_deg`` exceeds ``threshold`` (linear interpolation), or None."""
+    above = np.nonzero(angle_deg > threshold)[0]
+    if above.size == 0:
+        return None
+    i = int(above[0])
+    if i == 0:
+        return float(t[0])
+    a0, a1 = angle_deg[i - 1], angle_deg[i]
+    return float(t[i - 1] + (threshold - a0) / (a1 - a0) * (t[i] - t[i - 1]))
+
+
+def _angle(a, b):
+    """Angle between row vectors, degrees (atan2: accurate near 0 and 180)."""
+    cross = np.linalg.norm(np.cross(a, b), axis=-1)
+    dot = np.sum(a * b, axis=-1)
+    return np.degrees(np.arctan2(cross, dot))
+
+
+def summarize(tr: Trajectory) -> ModelSummary:
+    w = tr.omega
+    mag = np.linalg.norm(w, axis=1)
+    d = tr.body.dipole_direction
+    L_body = np.asarray(tr.body.inertia) * w
+    ang_wd = float(_angle(w[-1:], d[None, :])[0])
+    ang_wd = min(ang_wd, 180.0 - ang_wd)             # rotation about d or about -d is the same state
+    cone = _angle(L_body, np.broadcast_to(d, L_body.shape))
+    late = tr.t >= tr.t[-1] * (2.0 / 3.0)
+    late &= tr.t > 0
+    expo = float(np.polyfit(np.log(tr.t[late]), np.log(mag[late]), 1)[0]) if late.sum() >= 3 else float("nan")
+    ratio = float(mag[-1] / mag[0]) if mag[0] > 0 else float("nan")
+    if ang_wd < 2.0 and abs(expo) < 0.05:
+        state = f"residual rotation about the dipole (|Omega| -> {ratio:.3g} |Omega0|, angle(Omega, d) = {ang_wd:.2g} deg)"
+    elif expo < -0.2:
+        state = f"spinning down to rest (|Omega| ~ t^{expo:.2f}, now {ratio:.3g} |Omega0|)"
+    else:
+        state = f"still evolving (|Omega| ~ t^{expo:.2f}, angle(Omega, d) = {ang_wd:.3g} deg)"
+    return ModelSummary(tr.model, float(mag[-1]), ratio, expo, ang_wd, cone, state)
+
+
+def compare(trajs: list[Trajectory]) -> Comparison:
+    """Compare two trajectories of the same body and initial state, stored at the same times."""
+    if len(trajs) != 2:
+        raise ValueError("compare needs a scene with two models (models = [\"reduced\", \"truncated\"])")
+    a, b = trajs
+    resolved = a.phase_resolved and b.phase_resolved and a.q is not None and b.q is not None
+    mis = dip = None
+    first = {}
+    if resolved:
+        mis = np.degrees(R.misorientation(a.q, b.q))
+        dip = _angle(a.dipole_world(), b.dipole_world())
+        first["misorientation"] = {f"{x:g} deg": first_crossing(a.t, mis, x) for x in THRESHOLDS_DEG}
+        first["dipole_direction"] = {f"{x:g} deg": first_crossing(a.t, dip, x) for x in THRESHOLDS_DEG}
+    sa, sb = summarize(a), summarize(b)
+    cone_diff = np.abs(sa.angle_d_L_deg - sb.angle_d_L_deg)
+    first["angle(d, L)"] = {f"{x:g} deg": first_crossing(a.t, cone_diff, x) for x in THRESHOLDS_DEG}
+    return Comparison(t=np.asarray(a.t), units=a.units, phase_resolved=resolved, misorientation_deg=mis,
+                      dipole_angle_deg=dip, cone_difference_deg=cone_diff, first_exceed=first, models=[sa, sb],
+                      omega={sa.model: a.omega, sb.model: b.omega})
+
+
+def format_table(c: Comparison, title: str) -> str:
+    units = c.units
+    lines = [title, ""]
+    if not c.phase_resolved:
+        lines.append("orientations not compared turn by turn: the spin phase is beyond float64 resolution here;")
+        lines.append("compared instead: each model's angle between d and its rotation axis L (a slow, physical quantity)")
+        lines.append("")
+    lines.append(f"{'first time the models differ by':<40} {'> 1 deg':>16} {'> 10 deg':>16}")
+    names = {"misorientation": "misorientation (whole rotation)", "dipole_direction": "angle between the dipoles",
+             "angle(d, L)": "difference of angle(d, L)"}
+    for key, row in c.first_exceed.items():
+        cells = [format_time(v, units) if v is not None else "never" for v in row.values()]
+        lines.append(f"{names[key]:<40} {cells[0]:>16} {cells[1]:>16}")
+    lines.append("")
+    lines.append(f"at t = {format_time(c.t[-1], units)}:")
+    for m in c.models:
+        lines.append(f"  {m.model:<10} {m.final_state}; angle(d, L) = {m.angle_d_L_deg[-1]:.3g} deg")
+    return "\n".join(lines)
+
+
+def plot(c: Comparison, path: str, title: str) -> None:
+    """Angles between the predictions, |Omega| and angle(d, L) against time (PNG, atomic)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t = c.t
+    tl = "t [s]" if c.units == "cgs" else "t [tau0]"
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4))
+    ax = axes[0]
+    if c.phase_resolved:
+        ax.plot(t, c.misorientation_deg, label="misorientation")
+        ax.plot(t, c.dipole_angle_deg, label="angle between dipoles")
+    ax.plot(t, c.cone_difference_deg, label="difference of angle(d, L)")
+    for x in THRESHOLDS_DEG:
+        ax.axhline(x, color="grey", lw=0.8, ls=":")
+    ax.set_xscale("symlog", linthresh=max(t[1], t[-1] * 1e-6))
+    ax.set_xlim(left=0.0)
+    ax.set_xlabel(tl)
+    ax.set_ylabel("deg")
+    ax.set_title("reduced vs truncated")
+    ax.legend(fontsize=8)
+    ax = axes[1]
+    for m, w in c.omega.items():
+        ax.loglog(t[1:], np.linalg.norm(w[1:], axis=1), label=m)
+    ax.set_xlabel(tl)
+    ax.set_ylabel("|Omega| [rad/s]" if c.units == "cgs" else "|omega| [1/tau0]")
+    ax.set_title("spin rate")
+    ax.legend(fontsize=8)
+    ax = axes[2]
+    for m in c.models:
+        ax.plot(t, m.angle_d_L_deg, label=m.model)
+    ax.set_xscale("symlog", linthresh=max(t[1], t[-1] * 1e-6))
+    ax.set_xlim(left=0.0)
+    ax.set_xlabel(tl)
+    ax.set_ylabel("angle(d, L) [deg]")
+    ax.set_title("dipole vs rotation axis")
+    ax.legend(fontsize=8)
+    fig.suptitle(title)
+    fig.tight_layout()
+    _save(fig, path)
+    plt.close(fig)
+
+
+def plot_hodograph(c: Comparison, path: str, title: str) -> None:
+    """Omega(t) in the body frame for both models, as in the paper's figures 3 and 4."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(11, 5))
+    scale = max(float(np.linalg.norm(w[0])) for w in c.omega.values()) or 1.0
+    for k, (m, w) in enumerate(c.omega.items()):
+        ax = fig.add_subplot(1, 2, k + 1, projection="3d")
+        x = w / scale
+        ax.plot(x[:, 0], x[:, 1], x[:, 2], lw=1.2)
+        ax.scatter(*x[0], color="green", s=15, label="start")
+        ax.scatter(*x[-1], color="crimson", s=15, label="end")
+        ax.set_xlabel("omega1")
+        ax.set_ylabel("omega2")
+        ax.set_zlabel("omega3")
+        ax.set_title(f"{m}  (units of |omega0|)")
+        ax.legend(fontsize=8)
+    fig.suptitle(title)
+    fig.tight_layout()
+    _save(fig, path)
+    plt.close(fig)
+
+
+def _save(fig, path: str) -> None:
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")

@@ -1,0 +1,74 @@
+"""``spinviz compare``: the angles between the two predictions and the final states."""
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from spinviz import compare as C
+from spinviz.cli import main
+from spinviz.physics import bodies as B
+from spinviz.simulate import simulate
+
+SCENES = Path(__file__).resolve().parents[1] / "scenes"
+
+
+def test_first_crossing_interpolates():
+    t = np.array([0.0, 1.0, 2.0, 3.0])
+    a = np.array([0.0, 0.5, 1.5, 20.0])
+    assert C.first_crossing(t, a, 1.0) == pytest.approx(1.5)
+    assert C.first_crossing(t, a, 10.0) == pytest.approx(2.0 + 8.5 / 18.5)
+    assert C.first_crossing(t, a, 50.0) is None
+
+
+def test_resolved_askew_comparison_grows_from_zero():
+    """Same start, two models: the orientations agree at t = 0 and part later, 1 deg before 10 deg."""
+    body = B.symmetric_top(-0.6, math.radians(55.0))
+    t = C.compare_times(200.0, 200)
+    trajs = [simulate(body, m, (0.05, 0.1, 0.2), t_eval=t) for m in ("reduced", "truncated")]
+    c = C.compare(trajs)
+    assert c.phase_resolved
+    assert c.misorientation_deg[0] == 0.0 and c.dipole_angle_deg[0] == 0.0
+    one, ten = c.first_exceed["misorientation"]["1 deg"], c.first_exceed["misorientation"]["10 deg"]
+    assert 0.0 < one < ten < 200.0
+    # the crossing is where the curve says it is
+    assert np.interp(one, c.t, c.misorientation_deg) == pytest.approx(1.0, abs=0.05)
+
+
+def test_dast_cube_final_states_residual_rotation_vs_rest():
+    """Real DAST cube over 6 Theta: reduced ends rotating about d at |Omega3| (5.2)/(6.7);
+    truncated spins down by the power law of (6.9), exponent -(tau0 W^2 t)/F^2 -> -6/13 here."""
+    cube = B.dast_cube()
+    W = math.pi * 1e10
+    Th = 1.0 / (cube.tau0 * W**2)
+    t = C.compare_times(6.0 * Th, 200)
+    trajs = [simulate(cube, m, (0.0, W, W), t_eval=t) for m in ("reduced", "truncated")]
+    c = C.compare(trajs)
+    assert not c.phase_resolved and c.misorientation_deg is None       # 1e16 turns: not comparable turn by turn
+    red, tru = c.models
+    assert red.final_state.startswith("residual rotation about the dipole")
+    assert red.omega_ratio == pytest.approx(1 / math.sqrt(2), rel=1e-3)      # |Omega| -> Omega30 = |Omega0|/sqrt(2)
+    assert tru.final_state.startswith("spinning down to rest")
+    assert tru.spin_exponent == pytest.approx(-0.45, abs=0.03)
+    assert tru.angle_d_L_deg[-1] == pytest.approx(45.0, abs=1e-6)              # (6.10)
+    assert c.first_exceed["angle(d, L)"]["1 deg"] < c.first_exceed["angle(d, L)"]["10 deg"] < 6.0 * Th
+
+
+def test_compare_command_json_and_plots(tmp_path, capsys):
+    code = main(["compare", str(SCENES / "hodograph_askew.toml"), "--out", str(tmp_path / "h"), "--samples", "200", "--json"])
+    assert code == 0
+    rec = json.loads(capsys.readouterr().out)
+    assert rec["phase_resolved"] is True
+    assert [m["model"] for m in rec["models"]] == ["reduced", "truncated"]
+    from PIL import Image
+
+    for p in rec["plots"]:
+        w, h = Image.open(p).size
+        assert w > 600 and h > 300
+
+
+def test_compare_needs_two_models(tmp_path, capsys):
+    assert main(["compare", str(SCENES / "check_6_10_cube_truncated.toml"), "--out", str(tmp_path / "x")]) == 2
+    assert "compare needs two models" in capsys.readouterr().err

@@ -45,6 +45,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="measure frames per second at 1280x720 and 1920x1080, encoding included (writes to a temporary directory)")
     r.add_argument("--frames", type=int, default=150, help="frames per benchmark size (with --bench)")
     r.add_argument("--json", metavar="PATH", help="with --bench: also write the results as JSON")
+    r.add_argument("--plot", metavar="PATH", help="with --bench: also draw frames per second against the targets (PNG)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
 
     c2 = sub.add_parser("compare", help="reduced vs truncated for a two-model scene: angles, crossing times, final states, plots")
@@ -219,7 +220,36 @@ def _render_bench(sc, args, render, video) -> int:
     print("anti-aliasing: 2x2 supersampling; encoder: libx264 yuv420p (veryfast, crf 20)")
     if args.json:
         _write_json(args.json, rows)
+    if args.plot:
+        _plot_render_bench(args.plot, rows)
     return EXIT_OK
+
+
+RENDER_TARGETS_FPS = {"1280x720": 30.0, "1920x1080": 15.0}
+
+
+def _plot_render_bench(path: str, rows) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .atomic import atomic_path
+
+    fig, ax = plt.subplots(figsize=(6, 3.6))
+    x = range(len(rows))
+    ax.bar([i - 0.2 for i in x], [r["steady_fps"] for r in rows], 0.4, label="steady (workers up)")
+    ax.bar([i + 0.2 for i in x], [r["fps"] for r in rows], 0.4, label="total (with start-up)")
+    for i, r in enumerate(rows):
+        ax.hlines(RENDER_TARGETS_FPS[r["size"]], i - 0.45, i + 0.45, colors="k", linestyles="--")
+    ax.set_xticks(list(x), [r["size"] for r in rows])
+    ax.set_ylabel("frames per second (encoding included)")
+    ax.set_title("spinviz render --bench (dashed: targets)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)
 
 
 def _write_json(path: str, data) -> None:

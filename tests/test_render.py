@@ -267,3 +267,12 @@ def test_render_command_errors_are_one_line(tmp_path, capsys):
     assert capsys.readouterr().err.strip() == f"spinviz: error: {bad}: [render].show: unknown item 'halo'; valid: " \
         "body, dipole, omega, L, axes, trail, sphere, hud, hodograph"
     assert not any(p.suffix == ".mp4" for p in tmp_path.iterdir())
+
+
+def test_progress_is_reported_while_rendering(tmp_path, capsys):
+    sc = askew(w=64, h=48)
+    plan = video.plan_scene(sc, video.spec_with(sc, fps=8, duration=1.0))
+    render_video(plan, str(tmp_path / "p.mp4"), workers=1, progress=True, poster=False)
+    err = capsys.readouterr().err.splitlines()
+    assert [line.split(": ")[-1] for line in err] == ["25 % (2/8 frames)", "50 % (4/8 frames)", "75 % (6/8 frames)",
+                                                     "100 % (8/8 frames)"]

@@ -20,6 +20,8 @@ _STATUS = {
     KN.STEP_UNDERFLOW: "step size fell below round-off (the problem is too stiff for an explicit method)",
     KN.NOT_FINITE: "the solution left the finite numbers (overflow)",
     KN.STIFF: "stiffness detected (Hairer's test: 15 steps in a row limited by stability)",
+    KN.TURN_TOO_LARGE: "a step turns the body by more than half a turn (exponential coordinates are singular "
+                       "at a full turn); use a smaller step",
 }
 
 MAX_STEPS = 200_000_000

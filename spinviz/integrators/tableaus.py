@@ -234,3 +234,28 @@ DOP853_E5 = E5
 DOP853_D = D
 DOP853 = Tableau(name="dop853", c=C[:N_STAGES].copy(), A=A[:N_STAGES, :N_STAGES].copy(), b=B.copy(), order=8)
 del A, B, C, E3, E5, D
+
+
+# --- symmetric compositions of Strang splitting ----------------------------------------
+# S_p(h) = S(g_1 h) ... S(g_s h) with S(h) = A(h/2) B(h) A(h/2) (second order, symmetric).
+# Order 4: Yoshida's triple jump.  Orders 6 and 8: Kahan & Li, "Composition constants for
+# raising the orders of unconventional schemes", Math. Comp. 66 (1997), s9odr6a and
+# s17odr8a (as listed in Hairer, Lubich & Wanner, Geometric Numerical Integration, V.3.2).
+_CBRT2 = 2.0 ** (1.0 / 3.0)
+_KL6 = (0.39216144400731413927925056, 0.33259913678935943859974864, -0.70624617255763935980996482,
+        0.08221359629355080023149045, 0.79854399093482996339895035)
+_KL8 = (0.13020248308889008087881763, 0.56116298177510838456196441, -0.38947496264484728640807860,
+        0.15884190655515560089621075, -0.39590389413323757733623154, 0.18453964097831570709183254,
+        0.25837438768632204729397911, 0.29501172360931029887096624, -0.60550853383003451169892108)
+
+
+def _palindrome(half):
+    return np.array(list(half) + list(half[-2::-1]))
+
+
+COMPOSITIONS = {
+    2: np.array([1.0]),
+    4: np.array([1.0 / (2.0 - _CBRT2), -_CBRT2 / (2.0 - _CBRT2), 1.0 / (2.0 - _CBRT2)]),
+    6: _palindrome(_KL6),
+    8: _palindrome(_KL8),
+}

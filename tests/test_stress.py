@@ -1,0 +1,41 @@
+"""The stress cases of ``spinviz stress`` that run in a few seconds, each must pass.
+
+(The real-parameter DAST cube over 10 Theta is also in test_secular.py.)"""
+
+import pytest
+
+from spinviz import stress
+
+FAST = [
+    stress.case_thin_longitudinal,
+    stress.case_thin_askew,
+    stress.case_flat_disk,
+    stress.case_chi_zero,
+    stress.case_chi_right_angle,
+    lambda: stress.case_spin_magnitude(1e-3),
+    lambda: stress.case_spin_magnitude(1e3),
+    stress.case_truncated_singularity,
+    stress.case_real_cgs_rod,
+    stress.case_real_dast_cube,
+    stress.case_pole_passage,
+    stress.case_separatrix,
+    stress.case_million_turns_free,
+    stress.case_million_turns_braked,
+]
+
+
+@pytest.mark.parametrize("case", FAST, ids=lambda f: getattr(f, "__name__", "spin_magnitude"))
+def test_stress_case_passes(case):
+    r = case()
+    assert r.passed, r.record()
+
+
+def test_driver_says_why_it_picked_a_stiff_method():
+    r = stress.case_thin_askew()
+    assert r.method in ("radau", "bdf", "lsoda") and "stiff" in r.reason
+
+
+def test_euler_angles_struggle_at_the_pole_where_quaternions_do_not():
+    r = stress.case_pole_passage()
+    assert r.error < 1e-9
+    assert "(6.4)" in r.notes

@@ -25,6 +25,11 @@ class AtomicPath:
     def __init__(self, path):
         self.path = os.fspath(path)
         d = os.path.dirname(os.path.abspath(self.path))
+        self._created = []                     # directories made for this output, innermost first
+        probe = d
+        while not os.path.isdir(probe):
+            self._created.append(probe)
+            probe = os.path.dirname(probe)
         os.makedirs(d, exist_ok=True)
         stem, ext = os.path.splitext(os.path.basename(self.path))
         fd, self.tmp = tempfile.mkstemp(prefix=f".{stem}.", suffix=f".partial{ext}", dir=d)
@@ -37,6 +42,11 @@ class AtomicPath:
     def discard(self):
         if os.path.exists(self.tmp):
             os.unlink(self.tmp)
+        for d in self._created:                # leave no new, empty directories behind
+            try:
+                os.rmdir(d)
+            except OSError:
+                break
 
 
 @contextlib.contextmanager

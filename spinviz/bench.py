@@ -33,6 +33,7 @@ from .integrators import Problem, get
 from .physics import closed_forms as CF
 from .physics.bodies import symmetric_top
 from .physics.equations import System
+from .simulate import spin_problem
 
 TARGET_ERROR = 1e-8
 N_OUT = 41
@@ -107,24 +108,25 @@ PROBLEMS = ("6.10", "3.9", "5.2+q", "askew")
 
 def reference(p: BenchProblem):
     """Tight reference for problems without an exact orientation (all symmetric tops here):
-    split8 at 1/6-turn steps.  Its accuracy is estimated by its distance to split8 at 1/4
-    turn, and checked independently against lie-dop853 at rtol 1e-14 (a different method,
-    whose own error is ~ rtol x the phase).  Returns (solution, accuracy, independent)."""
+    split8 at 1/6-turn steps.  Its accuracy is estimated from its distance d to split8 at
+    1/4 turn: an 8th-order method's error shrinks by r = (4/6)^8 between the two, so the
+    finer one is off by ~ d r / (1 - r) (Richardson).  It is checked independently against
+    lie-dop853 at rtol 1e-14 (a different method, whose own error is ~ rtol x the phase).
+    Returns (solution, accuracy, distance to lie-dop853)."""
     eps = float(np.linalg.norm(p.omega0))
     period = 2.0 * math.pi / eps
     a = _run(p, "split8", {"step": period / 6})[0]
     b = _run(p, "split8", {"step": period / 4})[0]
     c = _run(p, "lie-dop853", {"rtol": 1e-14, "atol": 1e-16})[0]
-    return a, float(R.misorientation(a.q, b.q).max()), float(R.misorientation(a.q, c.q).max())
+    r = (4.0 / 6.0) ** 8
+    d = float(R.misorientation(a.q, b.q).max())
+    return a, d * r / (1.0 - r), float(R.misorientation(a.q, c.q).max())
 
 
 # --- running ---------------------------------------------------------------------------------
 def _spin_units(p: BenchProblem):
-    """The problem in spin units (|omega(0)| = 1), as simulate() would hand it over."""
-    eps = float(np.linalg.norm(p.omega0))
-    k = math.sqrt(eps)
-    s = System(p.system.model, p.system.inertia, tuple(k * x for x in p.system.coupling))
-    return Problem(system=s, omega0=p.omega0 / eps, t_eval=p.t * eps, q0=p.q0), eps
+    """The problem in spin units (|omega(0)| = 1), exactly as simulate() hands it over."""
+    return spin_problem(p.system, p.omega0, p.t, p.q0)
 
 
 def _run(p: BenchProblem, method: str, kw: dict):
@@ -279,7 +281,7 @@ def run(plan: Plan, progress=None) -> list[Row]:
                 ref, acc, indep = reference(p)
                 q_ref = ref.q
                 plan.notes.append(f"{name} at {turns:.0e} turns: reference split8 at 1/6 turn, accurate to ~{acc:.1e} rad "
-                                  f"(distance to 1/4 turn); lie-dop853 at rtol 1e-14 differs from it by {indep:.1e} rad")
+                                  f"(Richardson, from 1/4 turn); lie-dop853 at rtol 1e-14 differs from it by {indep:.1e} rad")
             for method, kw, setting in _configs(p, plan, turns):
                 key = (method, setting)
                 if key in per_turn and per_turn[key] * turns > plan.max_run_seconds:
@@ -382,12 +384,9 @@ def format_table(rows: list[Row], summ: list[dict], notes) -> str:
 
 def plot(rows: list[Row], path: str) -> None:
     """Error against time, log-log, one line per method; one panel per problem and horizon."""
-    import matplotlib
+    from .plotting import pyplot, save
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .atomic import atomic_path
+    plt = pyplot()
 
     keys = sorted({(r.problem, r.turns) for r in rows}, key=lambda k: (PROBLEMS.index(k[0]), k[1]))
     ncol = 3
@@ -411,6 +410,4 @@ def plot(rows: list[Row], path: str) -> None:
     for ax in list(axes.flat)[len(keys):]:
         ax.axis("off")
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=100, format="png")
-    plt.close(fig)
+    save(fig, path, dpi=100)

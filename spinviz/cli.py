@@ -38,12 +38,12 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("scene")
     r.add_argument("--out", help="output .mp4 or .gif (default renders/<scene>.mp4)")
     r.add_argument("--size", type=_size, help="WIDTHxHEIGHT in pixels, e.g. 1280x720")
-    r.add_argument("--fps", type=int, help="frames per second")
-    r.add_argument("--duration", type=float, help="video length in seconds")
-    r.add_argument("--workers", type=int, help="render processes (default: one per core)")
+    r.add_argument("--fps", type=_fps, help="frames per second (1..240)")
+    r.add_argument("--duration", type=_duration, help="video length in seconds")
+    r.add_argument("--workers", type=_positive_int, help="render processes (default: one per core)")
     r.add_argument("--bench", action="store_true",
                    help="measure frames per second at 1280x720 and 1920x1080, encoding included (writes to a temporary directory)")
-    r.add_argument("--frames", type=int, default=150, help="frames per benchmark size (with --bench)")
+    r.add_argument("--frames", type=_positive_int, default=150, help="frames per benchmark size (with --bench)")
     r.add_argument("--json", metavar="PATH", help="with --bench: also write the results as JSON")
     r.add_argument("--plot", metavar="PATH", help="with --bench: also draw frames per second against the targets (PNG)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -51,7 +51,7 @@ def _parser() -> argparse.ArgumentParser:
     c2 = sub.add_parser("compare", help="reduced vs truncated for a two-model scene: angles, crossing times, final states, plots")
     c2.add_argument("scene")
     c2.add_argument("--out", help="prefix of the PNG plots (default renders/<scene>): <prefix>_compare.png, <prefix>_hodograph.png")
-    c2.add_argument("--samples", type=int, default=800, help="evenly spaced plus as many log-spaced output times")
+    c2.add_argument("--samples", type=_positive_int, default=800, help="evenly spaced plus as many log-spaced output times")
     c2.add_argument("--json", action="store_true", help="print the results as JSON")
 
     b = sub.add_parser("bench", help="work-precision benchmark: error against run time, per method and horizon")
@@ -69,6 +69,33 @@ def _parser() -> argparse.ArgumentParser:
 
     sub.add_parser("methods", help="list the integrators")
     return p
+
+
+def _positive_int(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {v}")
+    return v
+
+
+def _fps(text: str) -> int:
+    v = _positive_int(text)
+    if v > 240:
+        raise argparse.ArgumentTypeError(f"must be at most 240, got {v}")
+    return v
+
+
+def _duration(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seconds, got {text!r}") from None
+    if not (0.0 < v < 3600.0):
+        raise argparse.ArgumentTypeError(f"must be between 0 and 3600 s, got {text}")
+    return v
 
 
 def _size(text: str):
@@ -97,6 +124,15 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("spinviz: interrupted", file=sys.stderr)
         return 130
+    except (ValueError, OSError, ImportError) as e:
+        # the safety net: whatever input slipped past the specific checks still gets one
+        # line, not a traceback (SPINVIZ_DEBUG=1 shows the traceback)
+        if os.environ.get("SPINVIZ_DEBUG"):
+            raise
+        what = getattr(e, "filename", None)
+        msg = f"{what}: {e.strerror}" if isinstance(e, OSError) and what and e.strerror else str(e)
+        print(f"spinviz: error: {msg}", file=sys.stderr)
+        return EXIT_USAGE
 
 
 def _cmd_check(args) -> int:
@@ -116,7 +152,8 @@ def _cmd_info(args) -> int:
 
     target = args.target
     if target in PRESETS:
-        body, title, omega = PRESETS[target](), f"{PRESETS[target]().name}  (preset {target})", None
+        body = PRESETS[target]()
+        title, omega = f"{body.name}  (preset {target})", None
     elif os.path.exists(target) or target.endswith(".toml"):
         from .scene import load_scene
 
@@ -185,16 +222,21 @@ def _cmd_render(args) -> int:
     spec = video.spec_with(sc, size=args.size, fps=args.fps, duration=args.duration)
     if ext == ".mp4" and (spec.size[0] % 2 or spec.size[1] % 2):
         raise UserError(f"{out}: MP4 (H.264, yuv420p) needs an even width and height, got {spec.size[0]}x{spec.size[1]}")
+    if spec.size[0] % len(sc.models):
+        raise UserError(f"{args.scene}: {len(sc.models)} panels side by side need a width divisible by "
+                        f"{len(sc.models)}, got {spec.size[0]}")
     try:
         render = video.require_render_stack()
     except video.MissingRenderStack as e:
         raise UserError(str(e)) from None
-    if args.bench:
-        return _render_bench(sc, args, render, video)
     try:
+        if args.bench:
+            return _render_bench(sc, args, render, video)
         plan = video.plan_scene(sc, spec)
     except ValueError as e:
         raise UserError(f"{args.scene}: {e}") from None
+    except render.RenderError as e:
+        raise SimulationError(str(e)) from None
     try:
         res = render.render_video(plan, out, workers=args.workers, progress=not args.quiet)
     except render.RenderError as e:
@@ -242,13 +284,9 @@ RENDER_TARGETS_FPS = {"1280x720": 30.0, "1920x1080": 15.0}
 
 
 def _plot_render_bench(path: str, rows) -> None:
-    import matplotlib
+    from .plotting import pyplot, save
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .atomic import atomic_path
-
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.6))
     x = range(len(rows))
     ax.bar([i - 0.2 for i in x], [r["steady_fps"] for r in rows], 0.4, label="steady (workers up)")
@@ -260,9 +298,7 @@ def _plot_render_bench(path: str, rows) -> None:
     ax.set_title("spinviz render --bench (dashed: targets)")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
+    save(fig, path)
 
 
 def _write_json(path: str, data) -> None:
@@ -281,20 +317,26 @@ def _cmd_compare(args) -> int:
     sc = load_scene(args.scene)
     if len(sc.models) != 2:
         raise UserError(f"{args.scene}: [simulation].models: compare needs two models, e.g. models = [\"reduced\", \"truncated\"]")
-    kw = sc.simulation_kwargs()
-    kw.pop("t_end")
-    kw.pop("samples")
-    t = compare.compare_times(sc.t_end, max(2, args.samples))
-    trajs = [simulate(sc.body, m, t_eval=t, **kw) for m in sc.models]
-    c = compare.compare(trajs)
-    prefix = args.out or os.path.join("renders", os.path.splitext(os.path.basename(args.scene))[0])
-    paths = (f"{prefix}_compare.png", f"{prefix}_hodograph.png")
     try:
         import matplotlib  # noqa: F401
     except ImportError:
         raise UserError("compare's plots need matplotlib: pip install 'spinviz[render]'") from None
-    compare.plot(c, paths[0], sc.title)
-    compare.plot_hodograph(c, paths[1], sc.title)
+    kw = sc.simulation_kwargs()
+    kw.pop("t_end")
+    kw.pop("samples")
+    t = compare.compare_times(sc.t_end, max(2, args.samples))
+    try:
+        trajs = [simulate(sc.body, m, t_eval=t, **kw) for m in sc.models]
+    except ValueError as e:
+        raise UserError(f"{args.scene}: {e}") from None
+    c = compare.compare(trajs)
+    prefix = args.out or os.path.join("renders", os.path.splitext(os.path.basename(args.scene))[0])
+    paths = (f"{prefix}_compare.png", f"{prefix}_hodograph.png")
+    try:
+        compare.plot(c, paths[0], sc.title)
+        compare.plot_hodograph(c, paths[1], sc.title)
+    except OSError as e:
+        raise UserError(f"{prefix}: cannot write the plots: {e.strerror or e}") from None
     if args.json:
         print(json.dumps({**c.record(), "plots": list(paths)}, indent=2, default=float))
     else:
@@ -329,10 +371,7 @@ def _cmd_bench(args) -> int:
 def _cmd_stress(args) -> int:
     from . import stress
 
-    results = []
-    for fn in stress.CASES:
-        results.append(fn())
-        _progress(f"{results[-1].case}: {'pass' if results[-1].passed else 'FAIL'}")
+    results = stress.run_all(progress=lambda r: _progress(f"{r.case}: {'pass' if r.passed else 'FAIL'}"))
     if args.json:
         print(json.dumps([r.record() for r in results], indent=2, default=float))
     else:
@@ -360,7 +399,7 @@ def _cmd_report(args) -> int:
     bench.plot(rows, plot_path)
     _write_json(os.path.join(args.out_dir, "bench.json"), {"rows": [r.record() for r in rows], "summary": summ,
                                                             "notes": plan.notes})
-    results = [fn() for fn in stress.CASES]
+    results = stress.run_all(progress=lambda r: _progress(f"{r.case}: {'pass' if r.passed else 'FAIL'}"))
     _write_json(os.path.join(args.out_dir, "stress.json"), [r.record() for r in results])
     body = "\n".join([
         REPORT_BEGIN, "",

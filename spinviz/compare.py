@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import rotations as R
-from .atomic import atomic_path
+from .plotting import pyplot, save
 from .timeline import format_time
 from .trajectory import Trajectory
 
@@ -80,10 +80,8 @@ def first_crossing(t, angle_deg, threshold):
 
 
 def _angle(a, b):
-    """Angle between row vectors, degrees (atan2: accurate near 0 and 180)."""
-    cross = np.linalg.norm(np.cross(a, b), axis=-1)
-    dot = np.sum(a * b, axis=-1)
-    return np.degrees(np.arctan2(cross, dot))
+    """Angle between row vectors, degrees."""
+    return np.degrees(R.angle_between(a, b))
 
 
 def summarize(tr: Trajectory) -> ModelSummary:
@@ -150,10 +148,7 @@ def format_table(c: Comparison, title: str) -> str:
 
 def plot(c: Comparison, path: str, title: str) -> None:
     """Angles between the predictions, |Omega| and angle(d, L) against time (PNG, atomic)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     t = c.t
     tl = "t [s]" if c.units == "cgs" else "t [tau0]"
@@ -189,16 +184,12 @@ def plot(c: Comparison, path: str, title: str) -> None:
     ax.legend(fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
-    _save(fig, path)
-    plt.close(fig)
+    save(fig, path)
 
 
 def plot_hodograph(c: Comparison, path: str, title: str) -> None:
     """Omega(t) in the body frame for both models, as in the paper's figures 3 and 4."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig = plt.figure(figsize=(11, 5))
     scale = max(float(np.linalg.norm(w[0])) for w in c.omega.values()) or 1.0
@@ -215,10 +206,4 @@ def plot_hodograph(c: Comparison, path: str, title: str) -> None:
         ax.legend(fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
-    _save(fig, path)
-    plt.close(fig)
-
-
-def _save(fig, path: str) -> None:
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
+    save(fig, path)

@@ -36,6 +36,8 @@ __all__ = [
     "body_from_world",
     "misorientation",
     "quat_between",
+    "angle_between",
+    "euler_zxz_about",
     "allclose_up_to_sign",
     "unflip",
     "slerp_series",
@@ -199,6 +201,24 @@ def quat_between(a, b) -> np.ndarray:
         perp = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
         return quat_from_axis_angle(perp, np.pi)
     return exp_rotvec(v / s * np.arctan2(s, c))
+
+
+def angle_between(a, b) -> np.ndarray:
+    """Angle (rad, [0, pi]) between vectors, shapes (..., 3) broadcast; atan2 of |a x b| and
+    a . b, so small angles keep full precision (arccos of a dot product does not)."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    return np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1))
+
+
+def euler_zxz_about(axis, q):
+    """ZXZ angles of R(q) in a frame whose z axis is ``axis`` (world, shape (3,)).
+
+    Returns (q_axis, angles): q_axis (w, x, y, z) takes the world z axis to ``axis`` and
+    R(q) = R(q_axis) Rz(phi) Rx(theta) Rz(psi); theta is the angle of the body e3 from
+    ``axis`` (for axis = L: the nutation of a symmetric top)."""
+    q_axis = quat_between((0.0, 0.0, 1.0), axis)
+    return q_axis, euler_zxz_from_quat(multiply(conjugate(q_axis), q))
 
 
 def misorientation(q1, q2) -> np.ndarray:

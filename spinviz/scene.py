@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 import os
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -125,7 +125,7 @@ class _Table:
         if self.has(k) and self.has(k + "_deg"):
             raise self.error(k, f"give {k} (rad) or {k}_deg, not both")
         if self.has(k + "_deg"):
-            return math.radians(self.number(k + "_deg"))
+            return float(U.deg_to_rad(self.number(k + "_deg")))
         return self.number(k, default, required)
 
     def one_of(self, *keys: str) -> str | None:
@@ -311,7 +311,7 @@ def _preset(t: _Table) -> B.Body:
     name = t.string("preset", choices=tuple(B.PRESETS) + ("dast_box",))
     density = t.number("density", positive=True)
     if name == "cellulose_rod":
-        return B.cellulose_rod()
+        return B.cellulose_rod(density=density)
     if name == "dast_cube":
         return B.dast_cube(t.number("a_nm", 100.0, positive=True), density=density)
     if name == "dast_family1":
@@ -347,7 +347,9 @@ def parse_scene(data: dict, path: str = "<scene>") -> Scene:
     st = top.sub("simulation", required=True)
     units_hint = st.string("units", choices=U.UNIT_SYSTEMS)
     body = _body(bt, units_hint)
-    bt.string("name")
+    label = bt.string("name")
+    if label is not None and label != body.name:
+        body = replace(body, name=label)
     bt.finish()
     if units_hint is not None and units_hint != body.units:
         raise st.error("units", f"{units_hint!r} does not match the body, which is given in {body.units!r} units")
@@ -358,7 +360,7 @@ def parse_scene(data: dict, path: str = "<scene>") -> Scene:
     if form == "euler_zxz":
         q0 = R.quat_from_euler_zxz(it.vector("euler_zxz"))
     elif form == "euler_zxz_deg":
-        q0 = R.quat_from_euler_zxz(np.radians(it.vector("euler_zxz_deg")))
+        q0 = R.quat_from_euler_zxz(U.deg_to_rad(it.vector("euler_zxz_deg")))
     elif form == "quaternion":
         qv = it.vector("quaternion", 4)
         if not np.linalg.norm(qv) > 0:
@@ -430,6 +432,8 @@ def load_scene(path) -> Scene:
         raise SceneError(path, "(file)", "is a directory, not a scene file") from None
     except tomllib.TOMLDecodeError as e:
         raise SceneError(path, "(file)", f"invalid TOML: {e}") from None
+    except UnicodeDecodeError:
+        raise SceneError(path, "(file)", "not a text (UTF-8) file; a scene is TOML") from None
     except OSError as e:
         raise SceneError(path, "(file)", e.strerror or str(e)) from None
     return parse_scene(data, path)

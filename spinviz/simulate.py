@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from . import rotations as R
+from . import units as U
 from .integrators import Problem, get
 from .physics.bodies import Body
 from .physics.equations import System
@@ -29,15 +30,21 @@ def spin_scaling(body: Body, omega0) -> float:
     """eps_rad = tau0 |Omega0|: dimensionless spin, the ratio of braking to spin rate.
 
     Returns 1 for a body at rest (any scale will do)."""
-    w = float(np.linalg.norm(np.asarray(omega0, dtype=float))) * body.tau0
+    w = float(np.linalg.norm(U.omega_to_dimensionless(omega0, body.tau0)))
     return w if w > 0.0 else 1.0
 
 
-def spin_system(body: Body, model: str, eps_rad: float) -> System:
-    """The body's system (4.1) in spin units: same J, coupling scaled by sqrt(eps_rad)."""
-    s = body.system(model)
-    k = math.sqrt(eps_rad)
-    return System(model=s.model, inertia=s.inertia, coupling=tuple(k * x for x in s.coupling))
+def spin_problem(system: System, omega0, t_eval, q0=None, euler0=None, kinematics: str = "quaternion"):
+    """(Problem, eps_rad): a dimensionless problem (4.1) -- system with tau0 = 1, omega0 and
+    t_eval in 1/tau0 and tau0 -- put in spin units, |omega(0)| = 1: time times eps_rad, the
+    coupling times sqrt(eps_rad) (the torque is quadratic in it)."""
+    omega0 = np.asarray(omega0, dtype=float)
+    eps = float(np.linalg.norm(omega0)) or 1.0
+    k = math.sqrt(eps)
+    s = System(model=system.model, inertia=system.inertia, coupling=tuple(k * x for x in system.coupling))
+    problem = Problem(system=s, omega0=omega0 / eps, t_eval=np.asarray(t_eval, dtype=float) * eps, q0=q0,
+                      euler0=euler0, kinematics=kinematics)
+    return problem, eps
 
 
 def simulate(
@@ -91,9 +98,10 @@ def simulate(
         q_init = R.quat_from_euler_zxz(euler_init)
 
     tau0 = body.tau0
-    eps = spin_scaling(body, omega0)
+    problem, eps = spin_problem(body.system(model), U.omega_to_dimensionless(omega0, tau0),
+                                U.time_to_dimensionless(t_eval, tau0), q_init, euler_init, kinematics)
     time_scale = eps / tau0                     # spin-unit time per unit of t
-    system = spin_system(body, model, eps)
+    method = str(method).lower()
     if method == "auto":
         method, reason = choose_method(body, model, omega0, float(t_eval[-1]), kinematics)
     else:
@@ -103,14 +111,6 @@ def simulate(
         raise ValueError(f"method {integrator.name!r} does not support kinematics {kinematics!r}")
     if integrator.symmetric_only and not body.is_symmetric:
         raise ValueError(f"method {integrator.name!r} needs a symmetric top (I1 = I2)")
-    problem = Problem(
-        system=system,
-        omega0=omega0 * tau0 / eps,
-        t_eval=t_eval * time_scale,
-        q0=q_init,
-        euler0=euler_init,
-        kinematics=kinematics,
-    )
     kw = {"rtol": rtol, "atol": atol}
     if step is not None:
         kw["step"] = step * time_scale
@@ -132,7 +132,7 @@ def simulate(
         stats["step"] = step
     return Trajectory(
         t=t_eval,
-        omega=sol.omega * eps / tau0,
+        omega=U.omega_from_dimensionless(sol.omega * eps, tau0),
         q=sol.q,
         euler=sol.euler,
         body=body,
@@ -153,10 +153,8 @@ def stiffness_ratio(body: Body, model: str, omega0) -> float:
     comes from the radiation torque -- |omega| ~ 1 or more in units of 1/tau0, or a thin
     body (eps = I3/I1 -> 0) with an askew dipole, where (4.4) divides by 1 - delta = eps.
     """
-    eps = spin_scaling(body, omega0)
-    s = spin_system(body, model, eps)
-    w = np.asarray(omega0, dtype=float) * body.tau0 / eps
-    lam = np.linalg.eigvals(s.jacobian(w))
+    problem, _ = spin_problem(body.system(model), U.omega_to_dimensionless(omega0, body.tau0), [0.0, 1.0])
+    lam = np.linalg.eigvals(problem.system.jacobian(problem.omega0))
     return float(max(0.0, -np.min(lam.real)))
 
 
@@ -177,8 +175,7 @@ def choose_method(body: Body, model: str, omega0, t_end: float, kinematics: str 
         from .integrators.secular import NotApplicable, prepare
 
         try:
-            prepare(Problem(system=spin_system(body, model, eps), omega0=np.asarray(omega0) * body.tau0 / eps,
-                            t_eval=np.array([0.0, 1.0]), q0=None))
+            prepare(spin_problem(body.system(model), U.omega_to_dimensionless(omega0, body.tau0), [0.0, 1.0])[0])
             ulp = float(np.spacing(2.0 * math.pi * turns))
             phase = f"; the spin phase is beyond float64 (1 ulp = {ulp:.2g} rad)" if ulp > 1e-3 else ""
             return "secular", (f"{turns:.3g} turns of a symmetric top: averaged slow flow "

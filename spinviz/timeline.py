@@ -214,8 +214,7 @@ def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = 
             if "L" in show:
                 panel.L = L_world / L_ref
             if "hud" in show:
-                Lh = L_world / np.linalg.norm(L_world, axis=-1, keepdims=True)
-                panel.angle_dL_deg = np.degrees(np.arccos(np.clip(np.sum(Lh * panel.dipole, axis=-1), -1.0, 1.0)))
+                panel.angle_dL_deg = np.degrees(R.angle_between(panel.dipole, L_world))
         if "hodograph" in show:
             panel.omega_body = s.omega / w_ref
         panels.append(panel)
@@ -253,10 +252,8 @@ def _slow_geometry(s: Trajectory, body) -> dict:
                    psi0=float(s.slow["psi_L"][0]))
         return out
     L_world = s.angular_momentum_world()
-    Lh = L_world / np.linalg.norm(L_world, axis=-1, keepdims=True)
-    q_L = np.array([R.quat_between((0.0, 0.0, 1.0), v) for v in Lh])
-    e3 = R.world_from_body(s.q, np.array([0.0, 0.0, 1.0]))
-    theta_L = np.arccos(np.clip(np.sum(e3 * Lh, axis=-1), -1.0, 1.0))
-    ang0 = R.euler_zxz_from_quat(R.multiply(R.conjugate(q_L[0]), s.q[0]))
+    q_L = np.array([R.quat_between((0.0, 0.0, 1.0), v) for v in L_world])
+    theta_L = R.angle_between(R.world_from_body(s.q, np.array([0.0, 0.0, 1.0])), L_world)
+    _, ang0 = R.euler_zxz_about(L_world[0], s.q[0])
     out.update(q_L=q_L, theta_L=theta_L, phi0=float(ang0[0]), psi0=float(ang0[2]))
     return out

@@ -15,9 +15,13 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from . import rotations as R
+from . import units as U
 from .atomic import atomic_path
 from .physics.bodies import Body
 from .physics.equations import angular_momentum_world, kinetic_energy
+
+
+SLOW_SERIES = ("phi_L", "theta_L", "psi_L")       # the time series of a ``slow`` record
 
 
 def _frozen(a):
@@ -68,11 +72,6 @@ class Trajectory:
         """tau0 in s (CGS) or 1 (dimensionless)."""
         return self.body.tau0
 
-    @property
-    def time_seconds(self) -> np.ndarray | None:
-        """Physical time in s, or None for a dimensionless run."""
-        return self.t if self.units == "cgs" else None
-
     # -- derived series ------------------------------------------------------------------
     @property
     def phase_resolved(self) -> bool:
@@ -115,7 +114,8 @@ class Trajectory:
         """Omega_dot of the model at the stored states, shape (N, 3), in the body's units."""
         s = self.body.system(self.model)
         tau0 = self.tau0
-        return s.omega_dot(self.omega * tau0) / tau0**2
+        # d omega / d tau in (4.1) units, then d/dt = (1/tau0) d/dtau and Omega = omega / tau0
+        return U.omega_from_dimensionless(s.omega_dot(U.omega_to_dimensionless(self.omega, tau0)), tau0) / tau0
 
     def _need_q(self, what: str):
         if self.q is None:
@@ -124,7 +124,12 @@ class Trajectory:
     # -- resampling ----------------------------------------------------------------------
     def sample(self, times) -> "Trajectory":
         """The trajectory at ``times`` (within [t0, t_end]): Omega by cubic Hermite with the
-        model's Omega_dot, q by slerp between stored orientations.  No integration."""
+        model's Omega_dot, q by slerp between stored orientations.  No integration.
+
+        Between stored instants this is only as good as the storage: slerp needs neighbours
+        less than half a turn apart (the renderer stores every frame for that reason), and
+        for a run whose spin phase is unresolved (``phase_resolved`` False) only the nodes
+        and the slow geometry are meaningful."""
         times = np.atleast_1d(np.asarray(times, dtype=float))
         t = self.t
         lo, hi = t[0], t[-1]
@@ -147,8 +152,7 @@ class Trajectory:
             euler = np.stack([np.interp(times, t, self.euler[:, k]) for k in range(3)], axis=-1)
         slow = None
         if self.slow is not None:
-            slow = {k: (np.interp(times, t, v) if isinstance(v, np.ndarray) and v.shape == t.shape else v)
-                    for k, v in self.slow.items()}
+            slow = {k: (np.interp(times, t, v) if k in SLOW_SERIES else v) for k, v in self.slow.items()}
         return replace(self, t=times, omega=omega, q=q, euler=euler, slow=slow)
 
     # -- output --------------------------------------------------------------------------

@@ -56,11 +56,6 @@ def time_to_dimensionless(t, tau0: float):
     return np.asarray(t, dtype=float) / tau0
 
 
-def time_from_dimensionless(tau, tau0: float):
-    """t = tau * tau0 (4.1)."""
-    return np.asarray(tau, dtype=float) * tau0
-
-
 def omega_to_dimensionless(omega, tau0: float):
     """omega = tau0 * Omega (4.1); Omega in rad/s."""
     return np.asarray(omega, dtype=float) * tau0
@@ -69,16 +64,6 @@ def omega_to_dimensionless(omega, tau0: float):
 def omega_from_dimensionless(omega, tau0: float):
     """Omega = omega / tau0 (4.1); rad/s."""
     return np.asarray(omega, dtype=float) / tau0
-
-
-def debye_to_cgs(d_debye):
-    """Dipole in Debye -> statC cm."""
-    return np.asarray(d_debye, dtype=float) * DEBYE
-
-
-def nm_to_cm(x_nm):
-    """Length in nm -> cm."""
-    return np.asarray(x_nm, dtype=float) * NM
 
 
 def deg_to_rad(x_deg):

@@ -24,8 +24,12 @@ class MissingRenderStack(ImportError):
 def require_render_stack():
     """Import spinviz.render, or explain in one line which optional package is missing."""
     try:
-        from . import render  # noqa: F401
         import imageio_ffmpeg  # noqa: F401
+        import PIL  # noqa: F401
+        import pyvista  # noqa: F401
+        import vtk  # noqa: F401
+
+        from . import render  # noqa: F401
     except ImportError as e:
         name = (e.name or "").split(".")[0]
         if name in OPTIONAL_RENDER_MODULES:
@@ -42,11 +46,17 @@ def spec_with(scene: Scene, size=None, fps=None, duration=None) -> RenderSpec:
     """The scene's render spec with command-line overrides."""
     kw = {}
     if size is not None:
-        kw["size"] = tuple(size)
+        kw["size"] = tuple(int(x) for x in size)
+        if len(kw["size"]) != 2 or min(kw["size"]) < 16:
+            raise ValueError(f"size must be (width, height) of at least 16 px, got {size!r}")
     if fps is not None:
         kw["fps"] = int(fps)
+        if not 1 <= kw["fps"] <= 240:
+            raise ValueError(f"fps must be between 1 and 240, got {fps!r}")
     if duration is not None:
         kw["duration"] = float(duration)
+        if not 0.0 < kw["duration"] < 3600.0:
+            raise ValueError(f"duration must be between 0 and 3600 s, got {duration!r}")
     return replace(scene.render, **kw)
 
 

@@ -177,5 +177,5 @@ def test_no_orientation_when_not_asked():
 
 
 def test_unknown_method_lists_the_valid_ones():
-    with pytest.raises(KeyError, match="unknown method 'rk99'; valid: .*lie-dop853"):
+    with pytest.raises(ValueError, match="unknown method 'rk99'; valid: auto, .*lie-dop853"):
         simulate(ASKEW, "reduced", (0.1, 0.1, 0.1), t_end=1.0, samples=2, method="rk99")

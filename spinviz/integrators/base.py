@@ -101,7 +101,7 @@ def get(name: str) -> Integrator:
     try:
         return _REGISTRY[key]
     except KeyError:
-        raise KeyError(f"unknown method {name!r}; valid: {', '.join(sorted(_REGISTRY))}") from None
+        raise ValueError(f"unknown method {name!r}; valid: auto, {', '.join(sorted(_REGISTRY))}") from None
 
 
 def names() -> list[str]:

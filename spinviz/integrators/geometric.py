@@ -73,7 +73,7 @@ def _fixed(tableau: T.Tableau):
             raise ValueError(f"method lie-{tableau.name} is fixed-step: give step > 0")
         model, J, g, w0, q0, t, with_q = _args(problem)
         w, q, nfev, nsteps, status = KN.lie_fixed(
-            model, J, g, w0, q0, t, float(step), tableau.A, tableau.b, tableau.c, with_q, int(max_steps)
+            model, J, g, w0, q0, t, float(step), tableau.A, tableau.b, with_q, int(max_steps)
         )
         return _solution(problem, w, q, status, {"nfev": int(nfev), "nsteps": int(nsteps)})
 

@@ -121,14 +121,6 @@ def add_compensated(y, k, increment, err):
     y[k] = s
 
 
-@_jit
-def _rms(v, n):
-    s = 0.0
-    for i in range(n):
-        s += v[i] * v[i]
-    return math.sqrt(s / n)
-
-
 # status codes shared with the Python wrappers
 OK, TOO_MANY_STEPS, STEP_UNDERFLOW, NOT_FINITE, STIFF, TURN_TOO_LARGE = 0, 1, 2, 3, 4, 5
 
@@ -138,7 +130,7 @@ U_MAX = math.pi
 
 
 @_jit
-def lie_fixed(model, J, g, w0, q0, t_eval, h, A, b, c, with_q, max_steps):
+def lie_fixed(model, J, g, w0, q0, t_eval, h, A, b, with_q, max_steps):
     """Fixed-step Lie-group RK with tableau (A, b, c): each output interval is cut into
     ceil(dt/h) equal steps, so the outputs are hit exactly.  Returns
     (omega (N,3), q (N,4), nfev, nsteps, status)."""
@@ -197,7 +189,7 @@ def lie_fixed(model, J, g, w0, q0, t_eval, h, A, b, c, with_q, max_steps):
 
 @_jit
 def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps, stop_on_stiff,
-               A, B, C, E3, E5, D):
+               A, B, E3, E5, D):
     """Adaptive Lie-group DOP853 (error control and 7th-order dense output as in
     Hairer's DOP853 / SciPy), with Hairer's stiffness detection (15 stiff steps in a row:
     record the time, and return with status STIFF when ``stop_on_stiff``).
@@ -409,7 +401,7 @@ def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps
     return out_w, out_q, nfev, nsteps, nrej, OK, stiff_at
 
 
-DOP853_ARRAYS = (T.DOP853_A, T.DOP853_B, T.DOP853_C, T.DOP853_E3, T.DOP853_E5, T.DOP853_D)
+DOP853_ARRAYS = (T.DOP853_A, T.DOP853_B, T.DOP853_E3, T.DOP853_E5, T.DOP853_D)   # the system is autonomous: no c
 
 
 # --- splitting: exact torque-free flow of a symmetric top + radiation torque ------------

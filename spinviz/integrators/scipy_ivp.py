@@ -85,7 +85,7 @@ def _make_solver(method: str, implicit: bool):
 
 _DESCRIPTIONS = {
     "RK45": "scipy Dormand-Prince 5(4), adaptive",
-    "DOP853": "scipy Dormand-Prince 8(5,3), adaptive; the default for non-stiff runs",
+    "DOP853": "scipy Dormand-Prince 8(5,3), adaptive; also integrates the Euler-angle kinematics (6.4)",
     "Radau": "scipy implicit Radau IIA order 5, exact Jacobian; for stiff runs",
     "BDF": "scipy variable-order BDF, exact Jacobian; for stiff runs",
     "LSODA": "scipy LSODA, switches between Adams and BDF automatically, exact Jacobian",

@@ -84,14 +84,15 @@ def prepare(problem: Problem):
     """Validate and set up: (flow, frame rotation for spheres, initial slow state, geometry)."""
     s = problem.system
     J1, J2, J3 = (float(x) for x in s.inertia)
-    if abs(J1 - J2) > 1e-12 * J1:
+    if not s.is_symmetric:
         raise NotApplicable("secular needs a symmetric top (I1 = I2); this body is asymmetric")
     g = np.asarray(s.coupling, dtype=float)
     w0 = np.asarray(problem.omega0, dtype=float)
     q0 = np.asarray(problem.q0 if problem.q0 is not None else (1.0, 0.0, 0.0, 0.0), dtype=float)
     delta = 1.0 - J3 / J1
     q_frame = np.array([1.0, 0.0, 0.0, 0.0])          # body' = frame with e3 along d (spheres)
-    if abs(delta) < 1e-12 and np.linalg.norm(g[:2]) > 1e-15 * np.linalg.norm(g):
+    rotated = abs(delta) < 1e-12 and np.linalg.norm(g[:2]) > 1e-15 * np.linalg.norm(g)
+    if rotated:
         q_frame = R.quat_between(g, (0.0, 0.0, 1.0))    # rotation taking d to e3
         g = R.world_from_body(q_frame, g)
         w0 = R.world_from_body(q_frame, w0)
@@ -111,10 +112,11 @@ def prepare(problem: Problem):
     flow = SlowFlow(sys_p, equivariant)
     L_body = np.array([w0[0], w0[1], J3 / J1 * w0[2]])
     L_world = R.world_from_body(q0, L_body)
-    nL = float(np.linalg.norm(L_world))
-    q_L = R.quat_between((0.0, 0.0, 1.0), L_world) if nL > 0 else np.array([1.0, 0.0, 0.0, 0.0])
-    ang0 = R.euler_zxz_from_quat(R.multiply(R.conjugate(q_L), q0))
-    return flow, q_frame, np.array([wp0, float(w0[2]), 0.0, 0.0]), q_L, ang0, eps_rad
+    if float(np.linalg.norm(L_world)) > 0:
+        q_L, ang0 = R.euler_zxz_about(L_world, q0)
+    else:
+        q_L, ang0 = np.array([1.0, 0.0, 0.0, 0.0]), R.euler_zxz_from_quat(q0)
+    return flow, (q_frame if rotated else None), np.array([wp0, float(w0[2]), 0.0, 0.0]), q_L, ang0, eps_rad
 
 
 def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, step: float | None = None) -> Solution:
@@ -140,10 +142,12 @@ def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, st
     q = None
     if problem.kinematics == "quaternion":
         q = R.multiply(q_L[None, :], R.quat_from_euler_zxz(np.stack([phi_L, theta_L, psi_L], axis=-1)))
-    if q_frame[0] != 1.0:                               # back from the dipole frame of a sphere
+    if q_frame is not None:                             # back from the dipole frame of a sphere
         omega = R.body_from_world(q_frame, omega)
         if q is not None:
             q = R.multiply(q, q_frame[None, :])
+    else:
+        q_frame = np.array([1.0, 0.0, 0.0, 0.0])
     biggest = float(np.max(np.abs(np.concatenate([phi_L, psi_L]))))
     stats = {
         "nfev": int(res.nfev),

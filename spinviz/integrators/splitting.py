@@ -17,12 +17,10 @@ the 8th-order DOP853 formula in substeps of at most 1/50 of the local decay time
 
 from __future__ import annotations
 
-import numpy as np
-
 from . import kernels as KN
 from . import tableaus as T
 from .base import Integrator, Problem, Solution, register
-from .geometric import MAX_STEPS, _STATUS, _args
+from .geometric import MAX_STEPS, _args, _solution
 
 RH_MAX = 0.02
 
@@ -33,17 +31,12 @@ def _solver(order: int):
     def solve(problem: Problem, rtol=None, atol=None, step: float | None = None, max_steps: int = MAX_STEPS) -> Solution:
         if step is None or not step > 0:
             raise ValueError(f"method split{order} is fixed-step: give step > 0")
-        J1, J2, _ = problem.system.inertia
-        if abs(J1 - J2) > 1e-12 * abs(J1):
+        if not problem.system.is_symmetric:
             raise ValueError(f"method split{order} needs a symmetric top (I1 = I2)")
         model, J, g, w0, q0, t, with_q = _args(problem)
         w, q, nfev, nsteps, status = KN.split_symmetric(model, J, g, w0, q0, t, float(step), gammas, with_q,
                                                         int(max_steps), RH_MAX, T.DOP853.A, T.DOP853.b)
-        ok = status == KN.OK
-        return Solution(t=t, omega=w if ok else np.full_like(w, np.nan),
-                        q=(q if ok else np.full_like(q, np.nan)) if with_q else None, success=ok,
-                        message="" if ok else _STATUS.get(status, f"status {status}"),
-                        stats={"nfev": int(nfev), "nsteps": int(nsteps), "stages": len(gammas)})
+        return _solution(problem, w, q, status, {"nfev": int(nfev), "nsteps": int(nsteps), "stages": len(gammas)})
 
     return solve
 

@@ -359,12 +359,12 @@ def dast_box(a_nm: float, b_nm: float, c_nm: float, density: float | None = None
 
 
 # --- presets of section 6 ------------------------------------------------------------------
-def cellulose_rod() -> Body:
+def cellulose_rod(density: float | None = None) -> Body:
     """Cellulose nanocrystal, section 6.1 (Ref. [F-PBL14]): L = 315 nm, L/D = 10,
-    rho = 1.6 g/cm^3, 4400 D along the axis (chi = 0)."""
+    rho = 1.6 g/cm^3 (or ``density``), 4400 D along the axis (chi = 0)."""
     L = 315.0 * U.NM
     return rod(
-        L, L / 10.0, 1.6, 4400.0 * U.DEBYE, 0.0,
+        L, L / 10.0, 1.6 if density is None else density, 4400.0 * U.DEBYE, 0.0,
         name="cellulose nanocrystal",
         source="section 6.1 after Ref. [F-PBL14]: L = 315 nm, L/D = 10, rho = 1.6 g/cm^3, 4400 D along the axis",
         reference_omega=OMEGA_PAPER,

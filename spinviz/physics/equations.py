@@ -209,7 +209,7 @@ class System:
     def is_symmetric(self) -> bool:
         """I1 = I2 (the paper's symmetric top, e3 the symmetry axis)."""
         J1, J2, _ = self.inertia
-        return abs(J1 - J2) <= 1e-14 * max(abs(J1), abs(J2))
+        return abs(J1 - J2) <= 1e-12 * max(abs(J1), abs(J2))   # the same tolerance as Body.is_symmetric
 
     def rate(self):
         """Closure (w1, w2, w3) -> Omega_dot components, parameters bound."""

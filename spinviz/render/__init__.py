@@ -25,7 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .encode import AtomicPath, Mp4Writer, open_writer, write_png
+from ..atomic import AtomicPath
+from .encode import Mp4Writer, open_writer, write_png
 
 __all__ = ["render_video", "render_frames", "RenderResult", "RenderError"]
 
@@ -59,9 +60,7 @@ def default_workers() -> int:
     return max(1, min(4, os.cpu_count() or 1))
 
 
-def default_supersample(size) -> float:
-    """2 x 2 supersampling (4 samples per pixel)."""
-    return 2.0
+SUPERSAMPLE = 2.0      # 2 x 2 supersampling: four samples per pixel (see session.py)
 
 
 def render_frames(plan, frames, size, supersample: float | None = None):
@@ -69,7 +68,7 @@ def render_frames(plan, frames, size, supersample: float | None = None):
     session so tests can project world points.  Caller closes the session."""
     from .session import RenderSession
 
-    session = RenderSession(plan, size, supersample or default_supersample(size))
+    session = RenderSession(plan, size, supersample or SUPERSAMPLE)
     return [session.frame(f) for f in frames], session
 
 
@@ -137,7 +136,7 @@ def render_video(plan, out: str, size=None, workers: int | None = None, supersam
     max_frames : stop after this many frames (benchmarks).
     """
     size = tuple(size or plan.spec.size)
-    supersample = supersample or default_supersample(size)
+    supersample = supersample or SUPERSAMPLE
     F = plan.frames if max_frames is None else min(plan.frames, max_frames)
     fmt = os.path.splitext(out)[1].lower()
     workers = workers or default_workers()
@@ -246,7 +245,7 @@ def _concat(segments, path):
     listing = os.path.join(os.path.dirname(segments[0]), "segments.txt")
     with open(listing, "w") as fh:
         for s in segments:
-            fh.write(f"file '{s}'\n")
+            fh.write("file '" + s.replace("'", "'\\''") + "'\n")     # the concat demuxer's quoting
     cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-hide_banner", "-loglevel", "error", "-y", "-f", "concat", "-safe", "0",
            "-i", listing, "-c", "copy", "-movflags", "+faststart", "-f", "mp4", path]
     r = subprocess.run(cmd, capture_output=True, text=True)

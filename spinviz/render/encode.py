@@ -8,10 +8,7 @@ import os
 import numpy as np
 from PIL import Image
 
-from ..atomic import AtomicPath, atomic_path
-
-FORMATS = {".mp4": "mp4", ".gif": "gif"}
-
+from ..atomic import atomic_path
 
 class Mp4Writer:
     """H.264 (libx264), yuv420p, through imageio-ffmpeg's ffmpeg (a separate process, so

@@ -1,0 +1,134 @@
+"""Bad input and odd corners: one line and exit 2, never a traceback or a stray file."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from spinviz.atomic import AtomicPath
+from spinviz.cli import main
+from spinviz.physics import bodies as B
+from spinviz.simulate import simulate
+
+SCENES = Path(__file__).resolve().parents[1] / "scenes"
+
+TINY = """
+[body]
+{body}
+[initial]
+omega = [0.0, 0.05, 0.1]
+[simulation]
+{sim}
+t_end = 50.0
+samples = 6
+[render]
+duration = 1.0
+fps = 8
+size = [96, 48]
+show = ["dipole"]
+"""
+
+
+def scene(tmp_path, body='delta = 0.3\nchi = 0.5', sim='model = "reduced"', name="s.toml"):
+    p = tmp_path / name
+    p.write_text(TINY.format(body=body, sim=sim))
+    return p
+
+
+def one_line_error(capsys, argv, contains):
+    code = main([str(a) for a in argv])
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert "\n" not in err and "Traceback" not in err, err
+    assert contains in err, err
+    return err
+
+
+def test_binary_file_as_scene(tmp_path, capsys):
+    p = tmp_path / "picture.png"
+    p.write_bytes(b"\x89PNG\r\n\x1a\n\xff\xfe\x00")
+    one_line_error(capsys, ["info", p], "(file): not a text (UTF-8) file")
+
+
+def test_preset_name_and_density_are_used(tmp_path):
+    from spinviz.scene import load_scene
+
+    sc = load_scene(scene(tmp_path, body='preset = "cellulose_rod"\nname = "my rod"\ndensity = 1.5'))
+    assert sc.body.name == "my rod"
+    assert sc.body.extra["density"] == 1.5
+    assert sc.body.I1 == pytest.approx(B.cellulose_rod().I1 * 1.5 / 1.6, rel=1e-12)
+
+
+def test_failed_write_leaves_no_new_directories(tmp_path):
+    target = tmp_path / "a" / "b" / "out.mp4"
+    t = AtomicPath(target)
+    assert (tmp_path / "a" / "b").is_dir()
+    t.discard()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_scene_method_needing_a_step_is_one_line(tmp_path, capsys):
+    p = scene(tmp_path, body='delta = 0.3\nchi = 0.0', sim='models = ["reduced", "truncated"]\nmethod = "lie-rk4"')
+    one_line_error(capsys, ["compare", p, "--out", tmp_path / "c"], "is fixed-step: give step > 0")
+    one_line_error(capsys, ["simulate", p, "--out", tmp_path / "x.npz"], "is fixed-step: give step > 0")
+
+
+def test_render_width_not_divisible_by_panels(tmp_path, capsys):
+    p = scene(tmp_path, sim='models = ["reduced", "truncated"]')
+    one_line_error(capsys, ["render", p, "--out", tmp_path / "x.gif", "--size", "97x48"], "need a width divisible by 2")
+    assert not (tmp_path / "x.gif").exists()
+
+
+def test_render_option_ranges(tmp_path, capsys):
+    p = scene(tmp_path)
+    cases = {("--fps", "0"): "must be at least 1", ("--fps", "1000"): "must be at most 240",
+             ("--duration", "-5"): "must be between 0 and 3600 s", ("--duration", "inf"): "must be between 0 and 3600 s",
+             ("--workers", "-1"): "must be at least 1"}
+    for (opt, value), reason in cases.items():
+        with pytest.raises(SystemExit) as e:
+            main(["render", str(p), opt, value])
+        assert e.value.code == 2
+        assert f"error: argument {opt}: {reason}" in capsys.readouterr().err
+
+
+def test_slowed_spin_on_an_asymmetric_body_is_one_line(tmp_path, capsys):
+    p = scene(tmp_path, body='inertia = [1.0, 0.8, 0.5]\ndipole = [0.0, 0.0, 1.0]')
+    text = p.read_text().replace('show = ["dipole"]', 'show = ["dipole"]\nspin = "slowed"')
+    p.write_text(text)
+    one_line_error(capsys, ["render", p, "--out", tmp_path / "x.gif"], "needs a symmetric top")
+
+
+def test_sample_keeps_the_slow_frame_with_four_samples():
+    """With exactly four stored instants the (4,) q_L must not be taken for a time series."""
+    cube = B.dast_cube()
+    W = math.pi * 1e10
+    tr = simulate(cube, "reduced", (0.0, W, W), t_end=1.0 / (cube.tau0 * W * W), samples=4)
+    assert tr.stats["method"] == "secular"
+    s = tr.sample(tr.t)
+    np.testing.assert_array_equal(s.slow["q_L"], tr.slow["q_L"])
+
+
+def test_segments_join_in_a_directory_with_a_quote(tmp_path):
+    """Two workers' MP4 segments are joined by ffmpeg's concat list, which needs quoting."""
+    import imageio
+
+    from spinviz import video
+    from spinviz.render import render_video
+    from spinviz.scene import load_scene
+
+    d = tmp_path / "it's here"
+    sc = load_scene(scene(tmp_path))
+    plan = video.plan_scene(sc, video.spec_with(sc, fps=8, duration=1.0))
+    render_video(plan, str(d / "v.mp4"), workers=2, progress=False, poster=False)
+    r = imageio.get_reader(str(d / "v.mp4"))
+    assert r.count_frames() == 8
+    r.close()
+
+
+def test_method_names_are_case_insensitive_and_unknown_ones_are_value_errors():
+    body = B.symmetric_top(0.3, 0.5)
+    a = simulate(body, "reduced", (0.0, 0.05, 0.1), t_end=10.0, samples=3, method="AUTO")
+    assert a.stats["method"] == "lie-dop853"
+    with pytest.raises(ValueError, match="unknown method 'rk99'"):
+        simulate(body, "reduced", (0.0, 0.05, 0.1), t_end=10.0, samples=3, method="rk99")

@@ -71,31 +71,27 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def _positive_int(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"must be at least 1, got {v}")
-    return v
+def _bounded(cast, lo, hi, what):
+    """An argparse type: ``cast(text)`` within [lo, hi] (lo exclusive for floats)."""
+    def parse(text: str):
+        try:
+            v = cast(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}") from None
+        if cast is int and v < lo:
+            raise argparse.ArgumentTypeError(f"must be at least {lo}, got {v}")
+        if cast is int and hi is not None and v > hi:
+            raise argparse.ArgumentTypeError(f"must be at most {hi}, got {v}")
+        if cast is float and not (lo < v < hi):
+            raise argparse.ArgumentTypeError(f"must be between {lo:g} and {hi:g} s, got {text}")
+        return v
+
+    return parse
 
 
-def _fps(text: str) -> int:
-    v = _positive_int(text)
-    if v > 240:
-        raise argparse.ArgumentTypeError(f"must be at most 240, got {v}")
-    return v
-
-
-def _duration(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected seconds, got {text!r}") from None
-    if not (0.0 < v < 3600.0):
-        raise argparse.ArgumentTypeError(f"must be between 0 and 3600 s, got {text}")
-    return v
+_positive_int = _bounded(int, 1, None, "a whole number")
+_fps = _bounded(int, 1, 240, "a whole number")
+_duration = _bounded(float, 0.0, 3600.0, "seconds")
 
 
 def _size(text: str):

@@ -160,12 +160,7 @@ def plot(c: Comparison, path: str, title: str) -> None:
     ax.plot(t, c.cone_difference_deg, label="difference of angle(d, L)")
     for x in THRESHOLDS_DEG:
         ax.axhline(x, color="grey", lw=0.8, ls=":")
-    ax.set_xscale("symlog", linthresh=max(t[1], t[-1] * 1e-6))
-    ax.set_xlim(left=0.0)
-    ax.set_xlabel(tl)
-    ax.set_ylabel("deg")
-    ax.set_title("reduced vs truncated")
-    ax.legend(fontsize=8)
+    _time_axis(ax, t, tl, "deg", "reduced vs truncated")
     ax = axes[1]
     for m, w in c.omega.items():
         ax.loglog(t[1:], np.linalg.norm(w[1:], axis=1), label=m)
@@ -176,15 +171,20 @@ def plot(c: Comparison, path: str, title: str) -> None:
     ax = axes[2]
     for m in c.models:
         ax.plot(t, m.angle_d_L_deg, label=m.model)
-    ax.set_xscale("symlog", linthresh=max(t[1], t[-1] * 1e-6))
-    ax.set_xlim(left=0.0)
-    ax.set_xlabel(tl)
-    ax.set_ylabel("angle(d, L) [deg]")
-    ax.set_title("dipole vs rotation axis")
-    ax.legend(fontsize=8)
+    _time_axis(ax, t, tl, "angle(d, L) [deg]", "dipole vs rotation axis")
     fig.suptitle(title)
     fig.tight_layout()
     save(fig, path)
+
+
+def _time_axis(ax, t, xlabel, ylabel, title):
+    """Time from 0, linear near 0 and logarithmic beyond (early and late both visible)."""
+    ax.set_xscale("symlog", linthresh=max(t[1], t[-1] * 1e-6))
+    ax.set_xlim(left=0.0)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(fontsize=8)
 
 
 def plot_hodograph(c: Comparison, path: str, title: str) -> None:

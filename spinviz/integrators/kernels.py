@@ -45,13 +45,21 @@ _truncated = _jit(E.truncated_terms)
 
 
 @_jit
-def rate(model, w1, w2, w3, J, g):
-    """Omega_dot components of model 0 (free), 1 (reduced) or 2 (truncated)."""
+def terms(model, w1, w2, w3, J, g, free):
+    """Omega_dot of model 0 (free), 1 (reduced) or 2 (truncated); ``free`` = 0 keeps only the
+    radiation part (see physics.equations.reduced_terms)."""
     if model == 1:
-        return _reduced(w1, w2, w3, J, g, 1.0)
+        return _reduced(w1, w2, w3, J, g, free)
     if model == 2:
-        return _truncated(w1, w2, w3, J, g, 1.0)
-    return _free(w1, w2, w3, J, g)
+        return _truncated(w1, w2, w3, J, g, free)
+    a = _free(w1, w2, w3, J, g)
+    return free * a[0], free * a[1], free * a[2]
+
+
+@_jit
+def rate(model, w1, w2, w3, J, g):
+    """The whole Omega_dot."""
+    return terms(model, w1, w2, w3, J, g, 1.0)
 
 
 @_jit
@@ -121,6 +129,23 @@ def add_compensated(y, k, increment, err):
     y[k] = s
 
 
+@_jit
+def stage_point(A, K, y, h, i, n, ys):
+    """ys = y + h sum_{l < i} A[i, l] K[l] (first n components): the point of RK stage i."""
+    for k in range(n):
+        acc = 0.0
+        for l in range(i):
+            acc += A[i, l] * K[l, k]
+        ys[k] = y[k] + h * acc
+
+
+@_jit
+def substeps(dt, h):
+    """Fixed-step methods cut an output interval dt into m equal steps of at most h: (m, dt/m)."""
+    m = max(1, int(math.ceil(dt / h - 1e-9)))
+    return m, dt / m
+
+
 # status codes shared with the Python wrappers
 OK, TOO_MANY_STEPS, STEP_UNDERFLOW, NOT_FINITE, STIFF, TURN_TOO_LARGE = 0, 1, 2, 3, 4, 5
 
@@ -150,9 +175,7 @@ def lie_fixed(model, J, g, w0, q0, t_eval, h, A, b, with_q, max_steps):
     nfev = 0
     nsteps = 0
     for j in range(N - 1):
-        dt = t_eval[j + 1] - t_eval[j]
-        m = max(1, int(math.ceil(dt / h - 1e-9)))
-        hh = dt / m
+        m, hh = substeps(t_eval[j + 1] - t_eval[j], h)
         for _ in range(m):
             for i in range(s):
                 for k in range(n):
@@ -259,11 +282,7 @@ def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps
             h = t_end - t
         # stages 1..11 and the new solution
         for i in range(1, 12):
-            for k in range(n):
-                acc = 0.0
-                for l in range(i):
-                    acc += A[i, l] * K[l, k]
-                ys[k] = y[k] + h * acc
+            stage_point(A, K, y, h, i, n, ys)
             lie_rhs(model, J, g, ys, K[i], with_q)
         for k in range(n):
             acc = 0.0
@@ -337,11 +356,7 @@ def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps
             # dense output for every requested time in (t_old, t]
             if j_out < N and t_eval[j_out] <= t:
                 for s in range(13, 16):
-                    for k in range(n):
-                        acc = 0.0
-                        for l in range(s):
-                            acc += A[s, l] * K[l, k]
-                        ys[k] = y[k] + h * acc
+                    stage_point(A, K, y, h, s, n, ys)
                     lie_rhs(model, J, g, ys, K[s], with_q)
                 nfev += 3
                 for k in range(n):
@@ -408,11 +423,7 @@ DOP853_ARRAYS = (T.DOP853_A, T.DOP853_B, T.DOP853_E3, T.DOP853_E5, T.DOP853_D)  
 @_jit
 def radiation(model, w1, w2, w3, J, g):
     """The radiation part of Omega_dot alone (no free part to cancel against)."""
-    if model == 1:
-        return _reduced(w1, w2, w3, J, g, 0.0)
-    if model == 2:
-        return _truncated(w1, w2, w3, J, g, 0.0)
-    return 0.0, 0.0, 0.0
+    return terms(model, w1, w2, w3, J, g, 0.0)
 
 
 @_jit
@@ -518,9 +529,7 @@ def split_symmetric(model, J, g, w0, q0, t_eval, h, gammas, with_q, max_steps, r
     nfev = 0
     nsteps = 0
     for j in range(N - 1):
-        dt = t_eval[j + 1] - t_eval[j]
-        m = max(1, int(math.ceil(dt / h - 1e-9)))
-        hh = dt / m
+        m, hh = substeps(t_eval[j + 1] - t_eval[j], h)
         ns = gammas.shape[0]
         for step in range(m):
             # A(g1 h/2) B(g1 h) A((g1+g2) h/2) B(g2 h) ... B(gs h) A(gs h/2): neighbouring half

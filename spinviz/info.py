@@ -44,11 +44,13 @@ def rows(body: Body, omega=None) -> list[dict]:
         out.append(r)
     if omega is not None:
         w = np.asarray(omega, dtype=float)
-        w0, w3 = float(np.linalg.norm(w)), abs(float(w[2]))
+        w0, w_perp, w3 = float(np.linalg.norm(w)), math.hypot(w[0], w[1]), abs(float(w[2]))
         tu = "s" if body.units == "cgs" else "tau0"
+        if w_perp > 0:   # the unit of a scene's t_end_T
+            T = body.braking_time_T(w_perp)
+            out.append({"key": "T_scene", "label": "T for this scene's Omega_perp", "value": T, "unit": tu,
+                        "human": _human(T, tu)})
         if w0 > 0:
-            T = body.braking_time_T(w0)
-            out.append({"key": "T_scene", "label": "T for this scene's |Omega0|", "value": T, "unit": tu, "human": _human(T, tu)})
             out.append({"key": "eps_rad", "label": "tau0 |Omega0| (spin/braking ratio)", "value": body.tau0 * w0, "unit": "",
                         "human": f"{body.tau0 * w0:.3g}"})
         if w3 > 0:

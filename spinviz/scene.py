@@ -408,12 +408,17 @@ def parse_scene(data: dict, path: str = "<scene>") -> Scene:
 
 
 def _time_scale(body: B.Body, omega0, key: str, st: _Table) -> float:
-    """T = 1/(tau0 Omega0^2) or Theta = 1/(tau0 Omega3^2 eps^2) of the initial state."""
-    w0 = float(np.linalg.norm(omega0))
+    """T = 1/(tau0 Omega20^2) or Theta = 1/(tau0 Omega3^2 eps^2) of the initial state.
+
+    T is the paper's (after (3.9) and in (6.1)): Omega20 is the spin across the symmetry
+    axis, here |Omega_perp(0)| = hypot(Omega1, Omega2), so the check scenes run the horizons
+    `spinviz check` uses.
+    """
     if key == "t_end_T":
-        if w0 == 0.0:
-            raise st.error(key, "T = 1/(tau0 Omega0^2) is infinite for Omega0 = 0")
-        return body.braking_time_T(w0)
+        w_perp = math.hypot(float(omega0[0]), float(omega0[1]))
+        if w_perp == 0.0:
+            raise st.error(key, "T = 1/(tau0 Omega_perp^2) is infinite for Omega_perp = 0")
+        return body.braking_time_T(w_perp)
     w3 = abs(float(omega0[2]))
     if w3 == 0.0:
         raise st.error(key, "Theta = 1/(tau0 Omega3^2 (I3/I1)^2) is infinite for Omega3 = 0")

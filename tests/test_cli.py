@@ -2,7 +2,6 @@
 
 import json
 import math
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -13,6 +12,7 @@ import pytest
 from spinviz import rotations as R
 from spinviz.cli import main
 from spinviz.physics import closed_forms as CF
+from spinviz.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"
@@ -162,7 +162,19 @@ def test_info_json_for_a_scene(capsys):
     code, out, _ = run(["info", "--json", SCENES / "check_6_10_cube_truncated.toml"], capsys)
     rows = {r["key"]: r for r in json.loads(out)}
     assert code == 0
-    assert rows["T_scene"]["value"] == pytest.approx(1.0 / (0.1**2 + 0.1**2))   # T = 1/(tau0 Omega0^2)
+    assert rows["T_scene"]["value"] == pytest.approx(1.0 / 0.1**2)   # the paper's T = 1/(tau0 Omega20^2)
+
+
+@pytest.mark.parametrize("name, horizon", [
+    ("check_6_5_rod_reduced", 3.0 / 0.2**2),        # checks.check_eps_limit: 3 T, T = 1/Omega20^2
+    ("check_6_6_rod_truncated", 3.0 / 0.2**2),
+    ("check_6_10_cube_truncated", 3.0 / 0.1**2),    # checks.check_6_10: 3 T
+    ("check_5_4_longitudinal_truncated", 5.0 / 0.1**2),   # checks.check_longitudinal: 5 T
+    ("check_3_9_askew_both", 3.0 / 0.1**2),
+])
+def test_check_scenes_run_the_horizons_of_spinviz_check(name, horizon):
+    """t_end_T counts the paper's T = 1/(tau0 Omega20^2) (after (3.9), (6.1)), not 1/(tau0 |Omega0|^2)."""
+    assert load_scene(SCENES / f"{name}.toml").t_end == pytest.approx(horizon, rel=1e-14)
 
 
 def test_info_unknown_target(capsys):

@@ -18,20 +18,12 @@ from . import rotations as R
 from . import units as U
 from .integrators import Problem, get
 from .physics.bodies import Body
-from .physics.equations import System
+from .physics.equations import System, truncated_singularity
 from .trajectory import Trajectory
 
 
 class SimulationError(RuntimeError):
     """An integrator gave up; the message says which and why (never a silent NaN array)."""
-
-
-def spin_scaling(body: Body, omega0) -> float:
-    """eps_rad = tau0 |Omega0|: dimensionless spin, the ratio of braking to spin rate.
-
-    Returns 1 for a body at rest (any scale will do)."""
-    w = float(np.linalg.norm(U.omega_to_dimensionless(omega0, body.tau0)))
-    return w if w > 0.0 else 1.0
 
 
 def spin_problem(system: System, omega0, t_eval, q0=None, euler0=None, kinematics: str = "quaternion"):
@@ -100,10 +92,13 @@ def simulate(
     tau0 = body.tau0
     problem, eps = spin_problem(body.system(model), U.omega_to_dimensionless(omega0, tau0),
                                 U.time_to_dimensionless(t_eval, tau0), q_init, euler_init, kinematics)
+    if model == "truncated":
+        _check_truncated_solvable(body, omega0)
     time_scale = eps / tau0                     # spin-unit time per unit of t
     method = str(method).lower()
-    if method == "auto":
-        method, reason = choose_method(body, model, omega0, float(t_eval[-1]), kinematics)
+    auto = method == "auto"
+    if auto:
+        method, reason = choose_method(body, model, omega0, float(t_eval[-1]), kinematics, spin=(problem, eps))
     else:
         reason = "chosen by the user"
     integrator = get(method)
@@ -114,7 +109,6 @@ def simulate(
     kw = {"rtol": rtol, "atol": atol}
     if step is not None:
         kw["step"] = step * time_scale
-    auto = reason != "chosen by the user"
     start = time.perf_counter()
     sol = integrator.solve(problem, **kw, **({"stop_on_stiffness": True} if auto and integrator.detects_stiffness else {}))
     if auto and not sol.success and not integrator.stiff and integrator.name != "secular":
@@ -146,19 +140,38 @@ MAX_RESOLVED_TURNS = 1e6     # beyond this, resolving every turn costs more than
 STIFF_RATIO = 10.0           # radiation decay rate / spin rate above which explicit steps are stability-bound
 
 
-def stiffness_ratio(body: Body, model: str, omega0) -> float:
+def _check_truncated_solvable(body: Body, omega0) -> None:
+    """(2.5) is linear in Omega_dot with the factor J + g (g x Omega)^T, whose determinant is
+    det J (1 + (g x Omega) . J^-1 g) (tau0 = 1).  It is 1 at rest and 1 + O(tau0 |Omega|) for
+    any real particle; where it is <= 0 the truncated equation has no physical solution
+    (runs started there fall into the singular surface), so say so instead of integrating."""
+    s = body.system("truncated")
+    den = truncated_singularity(*U.omega_to_dimensionless(omega0, body.tau0), s.inertia, s.coupling)
+    if not den > 1e-12:
+        raise SimulationError(
+            f"the truncated equation (2.5) is singular at the initial state: 1 + (g x Omega).J^-1 g = {den:.3g} "
+            f"(tau0 |Omega| ~ 1; it is 1 + O(tau0 |Omega|) for real particles)")
+
+
+def _spin_problem_at(body: Body, model: str, omega0):
+    return spin_problem(body.system(model), U.omega_to_dimensionless(omega0, body.tau0), [0.0, 1.0])
+
+
+def stiffness_ratio(body: Body, model: str, omega0, problem=None) -> float:
     """Fastest decay rate of the linearized Euler equation at omega0, per radian of spin.
 
     The free motion has purely imaginary eigenvalues (rotation); a large negative real part
     comes from the radiation torque -- |omega| ~ 1 or more in units of 1/tau0, or a thin
     body (eps = I3/I1 -> 0) with an askew dipole, where (4.4) divides by 1 - delta = eps.
+    ``problem``: the spin-unit problem of (body, model, omega0) if already built.
     """
-    problem, _ = spin_problem(body.system(model), U.omega_to_dimensionless(omega0, body.tau0), [0.0, 1.0])
+    problem = problem if problem is not None else _spin_problem_at(body, model, omega0)[0]
     lam = np.linalg.eigvals(problem.system.jacobian(problem.omega0))
     return float(max(0.0, -np.min(lam.real)))
 
 
-def choose_method(body: Body, model: str, omega0, t_end: float, kinematics: str = "quaternion") -> tuple[str, str]:
+def choose_method(body: Body, model: str, omega0, t_end: float, kinematics: str = "quaternion",
+                  spin=None) -> tuple[str, str]:
     """The method ``method = "auto"`` picks, and why (stored as stats["method_reason"]).
 
     * more than 1e6 turns of a symmetric top: ``secular`` (slow flow averaged over the
@@ -166,8 +179,10 @@ def choose_method(body: Body, model: str, omega0, t_end: float, kinematics: str 
       representable in float64);
     * stiff (decay rate > 10 x spin rate): ``radau`` with the exact Jacobian;
     * otherwise ``lie-dop853``; if it then detects stiffness, the driver switches to radau.
+
+    ``spin``: (problem, eps_rad) from ``spin_problem`` if the caller already has them.
     """
-    eps = spin_scaling(body, omega0)
+    problem, eps = spin if spin is not None else _spin_problem_at(body, model, omega0)
     turns = t_end * eps / body.tau0 / (2.0 * math.pi)
     if kinematics == "euler_zxz":
         return "dop853", "Euler-angle kinematics (6.4) is integrated by scipy methods only"
@@ -175,14 +190,14 @@ def choose_method(body: Body, model: str, omega0, t_end: float, kinematics: str 
         from .integrators.secular import NotApplicable, prepare
 
         try:
-            prepare(spin_problem(body.system(model), U.omega_to_dimensionless(omega0, body.tau0), [0.0, 1.0])[0])
+            prepare(problem)
             ulp = float(np.spacing(2.0 * math.pi * turns))
             phase = f"; the spin phase is beyond float64 (1 ulp = {ulp:.2g} rad)" if ulp > 1e-3 else ""
             return "secular", (f"{turns:.3g} turns of a symmetric top: averaged slow flow "
                                f"(relative error O(tau0 Omega) = {eps:.2g}){phase}")
         except NotApplicable:
             pass                                        # precession too slow to average (mu > MU_MAX)
-    ratio = stiffness_ratio(body, model, omega0)
+    ratio = stiffness_ratio(body, model, omega0, problem)
     if ratio > STIFF_RATIO:
         return "radau", f"stiff: decay rate {ratio:.3g} x the spin rate; implicit Radau with the exact Jacobian"
     return "lie-dop853", f"non-stiff (decay/spin = {ratio:.2g}), {turns:.3g} turns resolved; |q| = 1 by construction"

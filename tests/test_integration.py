@@ -179,3 +179,14 @@ def test_no_orientation_when_not_asked():
 def test_unknown_method_lists_the_valid_ones():
     with pytest.raises(ValueError, match="unknown method 'rk99'; valid: auto, .*lie-dop853"):
         simulate(ASKEW, "reduced", (0.1, 0.1, 0.1), t_end=1.0, samples=2, method="rk99")
+
+
+def test_truncated_equation_refuses_a_start_beyond_its_singular_surface():
+    """(2.5) is linear in Omega_dot with the factor det J (1 + (g x Omega).J^-1 g); here that is
+    1 + 1.12 Omega2 (tau0 = 1).  Beyond the surface the driver stops with an error naming it
+    instead of integrating into the singularity; just inside, it integrates."""
+    body = B.custom((1.0, 1.0, 0.3), (0.6, 0.0, 0.8), units="dimensionless")
+    with pytest.raises(SimulationError, match=r"singular at the initial state: 1 \+ \(g x Omega\).J\^-1 g = -0.001"):
+        simulate(body, "truncated", (0.3, -1.001 / 1.12, 0.2), t_end=1.0, samples=3)
+    tr = simulate(body, "truncated", (0.3, -0.999 / 1.12, 0.2), t_end=1.0, samples=3)
+    assert np.all(np.isfinite(tr.omega)) and np.linalg.norm(tr.omega[-1]) < np.linalg.norm(tr.omega[0])

@@ -30,17 +30,22 @@ class AtomicPath:
         while not os.path.isdir(probe):
             self._created.append(probe)
             probe = os.path.dirname(probe)
-        os.makedirs(d, exist_ok=True)
-        stem, ext = os.path.splitext(os.path.basename(self.path))
-        fd, self.tmp = tempfile.mkstemp(prefix=f".{stem}.", suffix=f".partial{ext}", dir=d)
-        os.close(fd)
+        self.tmp = None
+        try:
+            os.makedirs(d, exist_ok=True)
+            stem, ext = os.path.splitext(os.path.basename(self.path))
+            fd, self.tmp = tempfile.mkstemp(prefix=f".{stem}.", suffix=f".partial{ext}", dir=d)
+            os.close(fd)
+        except BaseException:
+            self.discard()
+            raise
 
     def commit(self):
         os.chmod(self.tmp, 0o666 & ~_umask())
         os.replace(self.tmp, self.path)
 
     def discard(self):
-        if os.path.exists(self.tmp):
+        if self.tmp is not None and os.path.exists(self.tmp):
             os.unlink(self.tmp)
         for d in self._created:                # leave no new, empty directories behind
             try:

@@ -4,7 +4,6 @@ two panels, frame counts and sizes, atomic outputs, and what is (not) built.
 Small frames (a few hundred pixels) keep these fast; off-screen software OpenGL (EGL)."""
 
 import math
-import os
 import tomllib
 
 import numpy as np
@@ -161,6 +160,7 @@ def test_failed_render_leaves_the_previous_file_intact(tmp_path, monkeypatch):
     plan = video.plan_scene(sc, sc.render)
     out = tmp_path / "old.mp4"
     out.write_bytes(b"previous video")
+    (tmp_path / "old.png").write_bytes(b"previous poster")
     calls = {"n": 0}
     original = S.RenderSession.frame
 
@@ -171,10 +171,11 @@ def test_failed_render_leaves_the_previous_file_intact(tmp_path, monkeypatch):
         return original(self, f)
 
     monkeypatch.setattr(S.RenderSession, "frame", failing)
-    with pytest.raises(RuntimeError, match="disk on fire"):
+    with pytest.raises(RenderError, match="rendering frame 4 failed: disk on fire"):
         render_video(plan, str(out), workers=1, progress=False)
     assert out.read_bytes() == b"previous video"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["old.mp4"]
+    assert (tmp_path / "old.png").read_bytes() == b"previous poster"    # video and poster land together
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["old.mp4", "old.png"]
 
 
 def test_worker_failure_is_reported_and_cleaned_up(tmp_path):

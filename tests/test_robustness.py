@@ -68,6 +68,18 @@ def test_failed_write_leaves_no_new_directories(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_atomic_path_that_cannot_make_its_temporary_file_leaves_no_directories(tmp_path, monkeypatch):
+    import tempfile
+
+    def refuse(*a, **k):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
+    with pytest.raises(PermissionError):
+        AtomicPath(tmp_path / "a" / "b" / "out.mp4")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_scene_method_needing_a_step_is_one_line(tmp_path, capsys):
     p = scene(tmp_path, body='delta = 0.3\nchi = 0.0', sim='models = ["reduced", "truncated"]\nmethod = "lie-rk4"')
     one_line_error(capsys, ["compare", p, "--out", tmp_path / "c"], "is fixed-step: give step > 0")

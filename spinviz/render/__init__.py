@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..atomic import AtomicPath
-from .encode import Mp4Writer, open_writer, write_png
+from .encode import Mp4Writer, open_writer, save_png
 
 __all__ = ["render_video", "render_frames", "RenderResult", "RenderError"]
 
@@ -143,23 +143,26 @@ def render_video(plan, out: str, size=None, workers: int | None = None, supersam
     if fmt != ".mp4" or F < 4 * workers:
         workers = 1
     poster_f = min(int(round(plan.spec.poster * (plan.frames - 1))), F - 1)
-    target = AtomicPath(out)
+    poster_path = os.path.splitext(out)[0] + ".png" if poster else None
+    targets = [AtomicPath(out)]
     bar = _Progress(f"rendering {out}", F, progress)
     start = time.perf_counter()
     try:
+        if poster_path:
+            targets.append(AtomicPath(poster_path))
         if workers == 1:
-            poster_img, startup = _render_in_process(plan, target.tmp, size, supersample, F, poster_f, bar)
+            poster_img, startup = _render_in_process(plan, targets[0].tmp, size, supersample, F, poster_f, bar)
         else:
-            poster_img, startup = _render_segments(plan, target.tmp, size, supersample, F, poster_f, workers, bar)
-        target.commit()
+            poster_img, startup = _render_segments(plan, targets[0].tmp, size, supersample, F, poster_f, workers, bar)
+        if poster_path:                         # video and poster land together, or neither does
+            save_png(targets[1].tmp, poster_img)
+        for t in targets:
+            t.commit()
     except BaseException:
-        target.discard()
+        for t in targets:
+            t.discard()
         raise
     seconds = time.perf_counter() - start
-    poster_path = None
-    if poster and poster_img is not None:
-        poster_path = os.path.splitext(out)[0] + ".png"
-        write_png(poster_path, poster_img)
     return RenderResult(path=out, poster=poster_path, frames=F, size=size, seconds=seconds,
                         startup_seconds=startup, workers=workers)
 
@@ -179,6 +182,9 @@ def _render_in_process(plan, path, size, supersample, F, poster_f, bar):
             if f == poster_f:
                 poster_img = img
             bar.update(f + 1)
+    except RuntimeError as e:                   # VTK / OpenGL failures: one line, as from the workers
+        why = str(e).strip().splitlines()[-1] if str(e).strip() else type(e).__name__
+        raise RenderError(f"rendering frame {f} failed: {why}") from None
     finally:
         writer.close()
         session.close()

@@ -1,5 +1,6 @@
-"""Video and image writers; every output goes through ``spinviz.atomic`` (temporary file,
-then rename), so nothing half-written ever sits at the output path."""
+"""Video and image writers.  They write where they are told: callers hand them the
+temporary file of a ``spinviz.atomic.AtomicPath`` (renamed into place only on success), so
+nothing half-written ever sits at the output path."""
 
 from __future__ import annotations
 
@@ -8,7 +9,6 @@ import os
 import numpy as np
 from PIL import Image
 
-from ..atomic import atomic_path
 
 class Mp4Writer:
     """H.264 (libx264), yuv420p, through imageio-ffmpeg's ffmpeg (a separate process, so
@@ -60,7 +60,6 @@ def open_writer(path: str, size, fps: int):
     raise ValueError(f"unknown video format {ext!r}; use .mp4 or .gif")
 
 
-def write_png(path: str, img: np.ndarray):
-    """A PNG written atomically."""
-    with atomic_path(path) as tmp:
-        Image.fromarray(img).save(tmp, format="PNG")
+def save_png(path: str, img: np.ndarray):
+    """An RGB frame as PNG (callers write to an ``AtomicPath``'s temporary file)."""
+    Image.fromarray(img).save(path, format="PNG")

@@ -258,7 +258,6 @@ class Scene:
     atol: float = 1e-12
     step: float | None = None
     render: RenderSpec = field(default_factory=RenderSpec)
-    raw: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def units(self) -> str:
@@ -404,7 +403,7 @@ def parse_scene(data: dict, path: str = "<scene>") -> Scene:
     top.finish()
     return Scene(path=str(path), title=title, body=body, models=models, omega0=omega0, q0=q0,
                  t_end=t_end, samples=samples, method=method.lower(), rtol=rtol, atol=atol, step=step,
-                 render=render, raw=data)
+                 render=render)
 
 
 def _time_scale(body: B.Body, omega0, key: str, st: _Table) -> float:

@@ -205,7 +205,7 @@ def case_real_dast_cube() -> StressResult:
     ex = CF.omega_eq6_7(tr.t, cube.tau0, W, W)
     wp, wpe = np.hypot(tr.omega[:, 0], tr.omega[:, 1]), np.hypot(ex[:, 0], ex[:, 1])
     L = np.array(tr.stats["L_axis_world"])
-    theta = np.arccos(np.clip(tr.dipole_world() @ L, -1, 1))
+    theta = R.angle_between(tr.dipole_world(), L)
     e = max(float(np.max(np.abs(wp / wpe - 1))), float(np.max(np.abs(tr.omega[:, 2] / ex[:, 2] - 1))),
             float(np.max(np.abs(theta / np.arctan2(wpe, ex[:, 2]) - 1))))
     late = tr.t > 3 * Th

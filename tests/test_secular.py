@@ -43,7 +43,7 @@ def test_real_dast_cube_over_10_Theta_matches_6_7_6_9_and_6_8(model, form):
     np.testing.assert_allclose(tr.omega[:, 2], exact[:, 2], rtol=1e-6)
     # theta: angle between d (= e3) and the fixed rotation axis L_world
     L = np.array(tr.stats["L_axis_world"])
-    theta = np.arccos(np.clip(tr.dipole_world() @ L, -1, 1))
+    theta = R.angle_between(tr.dipole_world(), L)
     np.testing.assert_allclose(theta, np.arctan2(wpe, exact[:, 2]), rtol=1e-6, atol=1e-12)
     if model == "reduced":                                  # (6.8): theta ~ exp(-tau0 Omega3^2 t)
         late = tr.t > 3.0 * Th

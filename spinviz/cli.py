@@ -252,9 +252,11 @@ def _render_bench(sc, args, render, video) -> int:
     import tempfile
 
     rows = []
+    trajs = None
     for size in ((1280, 720), (1920, 1080)):
         spec = video.spec_with(sc, size=size, fps=args.fps, duration=args.duration)
-        plan = video.plan_scene(sc, spec)
+        trajs = trajs or video.scene_trajectories(sc, spec)      # the frame times do not depend on the size
+        plan = video.plan_frames(spec, trajs)
         with tempfile.TemporaryDirectory() as d:
             res = render.render_video(plan, os.path.join(d, "bench.mp4"), workers=args.workers, progress=False,
                                       poster=False, max_frames=args.frames)
@@ -317,12 +319,9 @@ def _cmd_compare(args) -> int:
         import matplotlib  # noqa: F401
     except ImportError:
         raise UserError("compare's plots need matplotlib: pip install 'spinviz[render]'") from None
-    kw = sc.simulation_kwargs()
-    kw.pop("t_end")
-    kw.pop("samples")
-    t = compare.compare_times(sc.t_end, max(2, args.samples))
+    kw = sc.simulation_kwargs(t_eval=compare.compare_times(sc.t_end, max(2, args.samples)))
     try:
-        trajs = [simulate(sc.body, m, t_eval=t, **kw) for m in sc.models]
+        trajs = [simulate(sc.body, m, **kw) for m in sc.models]
     except ValueError as e:
         raise UserError(f"{args.scene}: {e}") from None
     c = compare.compare(trajs)

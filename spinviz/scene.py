@@ -267,12 +267,12 @@ class Scene:
     def model(self) -> str:
         return self.models[0]
 
-    def simulation_kwargs(self, kinematics: str = "quaternion") -> dict:
-        """Keyword arguments for ``spinviz.simulate.simulate`` (without body and model)."""
-        return dict(
-            omega0=self.omega0, t_end=self.t_end, samples=self.samples, q0=self.q0,
-            method=self.method, rtol=self.rtol, atol=self.atol, step=self.step, kinematics=kinematics,
-        )
+    def simulation_kwargs(self, kinematics: str = "quaternion", t_eval=None) -> dict:
+        """Keyword arguments for ``spinviz.simulate.simulate`` (without body and model): the
+        scene's ``samples`` instants over [0, t_end], or the given ``t_eval``."""
+        times = {"t_end": self.t_end, "samples": self.samples} if t_eval is None else {"t_eval": t_eval}
+        return dict(omega0=self.omega0, q0=self.q0, method=self.method, rtol=self.rtol, atol=self.atol,
+                    step=self.step, kinematics=kinematics, **times)
 
 
 # --- body ---------------------------------------------------------------------------------

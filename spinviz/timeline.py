@@ -30,6 +30,7 @@ import numpy as np
 
 from . import rotations as R
 from . import units as U
+from .integrators.secular import pose_about_L
 from .scene import RenderSpec
 from .trajectory import Trajectory
 
@@ -198,10 +199,7 @@ def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = 
                 scale = two_pi_r0 / rate_ref
                 phi = g["phi0"] + _cumtrapz(scale * g["phidot"], video_t)
                 psi = g["psi0"] + _cumtrapz(scale * g["psidot"], video_t)
-                q = R.multiply(g["q_L"], R.quat_from_euler_zxz(np.stack([phi, g["theta_L"], psi], axis=-1)))
-                q = R.multiply(q, g["q_frame"][None, :])
-                wb_frame = np.stack([g["wp"] * np.sin(psi), g["wp"] * np.cos(psi), g["w3"]], axis=-1)  # p = pi/2 - psi
-                omega_body = R.body_from_world(g["q_frame"], wb_frame)
+                omega_body, q = pose_about_L(g["q_L"], phi, g["theta_L"], psi, g["wp"], g["w3"], g["q_frame"])
             else:
                 q = s.q
                 omega_body = s.omega

@@ -132,6 +132,8 @@ class Trajectory:
         and the slow geometry are meaningful."""
         times = np.atleast_1d(np.asarray(times, dtype=float))
         t = self.t
+        if times.shape == t.shape and np.array_equal(times, t):
+            return self                     # already stored at these instants (the renderer's case)
         lo, hi = t[0], t[-1]
         if np.any(times < lo - 1e-12 * abs(hi - lo)) or np.any(times > hi + 1e-12 * abs(hi - lo)):
             raise ValueError(f"sample times must lie in [{lo:g}, {hi:g}]")

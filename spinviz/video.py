@@ -63,10 +63,8 @@ def spec_with(scene: Scene, size=None, fps=None, duration=None) -> RenderSpec:
 def scene_trajectories(scene: Scene, spec: RenderSpec):
     """One trajectory per model, stored at the frame times (kinematics only if shown)."""
     _, sim_t, _ = frame_times(spec, scene.t_end)
-    kw = scene.simulation_kwargs(kinematics="quaternion" if spec.needs_orientation else "none")
-    kw.pop("t_end")
-    kw.pop("samples")
-    return [simulate(scene.body, m, t_eval=sim_t, **kw) for m in scene.models]
+    kw = scene.simulation_kwargs(kinematics="quaternion" if spec.needs_orientation else "none", t_eval=sim_t)
+    return [simulate(scene.body, m, **kw) for m in scene.models]
 
 
 def plan_scene(scene: Scene, spec: RenderSpec):

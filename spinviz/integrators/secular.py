@@ -119,6 +119,21 @@ def prepare(problem: Problem):
     return flow, (q_frame if rotated else None), np.array([wp0, float(w0[2]), 0.0, 0.0]), q_L, ang0, eps_rad
 
 
+def pose_about_L(q_L, phi, theta_L, psi, wp, w3, q_frame, with_q=True):
+    """(Omega_body, q) of a symmetric top from its ZXZ angles about L (arrays over time).
+
+    q = q_L (x) ZXZ(phi, theta_L, psi) (x) q_frame and Omega = (wp sin psi, wp cos psi, w3)
+    -- the free top's p = pi/2 - psi -- taken back from the frame q_frame (e3 along d for a
+    sphere; identity otherwise) to the body.  q is None unless ``with_q``.
+    """
+    q_frame = np.asarray(q_frame, dtype=float)
+    omega = R.body_from_world(q_frame, np.stack([wp * np.sin(psi), wp * np.cos(psi), w3], axis=-1))
+    if not with_q:
+        return omega, None
+    q = R.multiply(np.asarray(q_L, dtype=float), R.quat_from_euler_zxz(np.stack([phi, theta_L, psi], axis=-1)))
+    return omega, R.multiply(q, q_frame[None, :])
+
+
 def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, step: float | None = None) -> Solution:
     t = np.asarray(problem.t_eval, dtype=float)
     try:
@@ -137,17 +152,9 @@ def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, st
     phi_L = ang0[0] + Phi
     psi_L = ang0[2] + Psi
     theta_L = np.arctan2(wp, flow.J3 * w3)
-    p = 0.5 * np.pi - psi_L
-    omega = np.stack([wp * np.cos(p), wp * np.sin(p), w3], axis=-1)
-    q = None
-    if problem.kinematics == "quaternion":
-        q = R.multiply(q_L[None, :], R.quat_from_euler_zxz(np.stack([phi_L, theta_L, psi_L], axis=-1)))
-    if q_frame is not None:                             # back from the dipole frame of a sphere
-        omega = R.body_from_world(q_frame, omega)
-        if q is not None:
-            q = R.multiply(q, q_frame[None, :])
-    else:
+    if q_frame is None:
         q_frame = np.array([1.0, 0.0, 0.0, 0.0])
+    omega, q = pose_about_L(q_L, phi_L, theta_L, psi_L, wp, w3, q_frame, with_q=problem.kinematics == "quaternion")
     biggest = float(np.max(np.abs(np.concatenate([phi_L, psi_L]))))
     stats = {
         "nfev": int(res.nfev),

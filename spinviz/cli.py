@@ -120,7 +120,7 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("spinviz: interrupted", file=sys.stderr)
         return 130
-    except (ValueError, OSError, ImportError) as e:
+    except (ValueError, OSError, ImportError, ArithmeticError, RuntimeError) as e:
         # the safety net: whatever input slipped past the specific checks still gets one
         # line, not a traceback (SPINVIZ_DEBUG=1 shows the traceback)
         if os.environ.get("SPINVIZ_DEBUG"):

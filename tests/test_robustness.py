@@ -144,3 +144,16 @@ def test_method_names_are_case_insensitive_and_unknown_ones_are_value_errors():
     assert a.stats["method"] == "lie-dop853"
     with pytest.raises(ValueError, match="unknown method 'rk99'"):
         simulate(body, "reduced", (0.0, 0.05, 0.1), t_end=10.0, samples=3, method="rk99")
+
+
+def test_truncated_start_beyond_the_singular_surface_is_one_line(tmp_path, capsys):
+    """(2.5) at 1 + (g x Omega).J^-1 g < 0 (tau0 |Omega| ~ 1): the run is refused in one line
+    naming the scene and the singularity, exit 1 (a run that cannot be done, not a typo)."""
+    p = tmp_path / "singular.toml"
+    p.write_text(TINY.format(body="inertia = [1.0, 1.0, 0.3]\ndipole = [0.6, 0.0, 0.8]", sim='model = "truncated"')
+                 .replace("omega = [0.0, 0.05, 0.1]", "omega = [0.3, -0.8937, 0.2]"))
+    code = main(["simulate", str(p), "--out", str(tmp_path / "t.npz")])
+    err = capsys.readouterr().err.strip()
+    assert code == 1 and "\n" not in err and "Traceback" not in err
+    assert str(p) in err and "(2.5) is singular at the initial state" in err
+    assert not (tmp_path / "t.npz").exists()

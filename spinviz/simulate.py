@@ -143,8 +143,9 @@ STIFF_RATIO = 10.0           # radiation decay rate / spin rate above which expl
 def _check_truncated_solvable(body: Body, omega0) -> None:
     """(2.5) is linear in Omega_dot with the factor J + g (g x Omega)^T, whose determinant is
     det J (1 + (g x Omega) . J^-1 g) (tau0 = 1).  It is 1 at rest and 1 + O(tau0 |Omega|) for
-    any real particle; where it is <= 0 the truncated equation has no physical solution
-    (runs started there fall into the singular surface), so say so instead of integrating."""
+    any real particle.  Where it is <= 0 the state is cut off from rest by the singular
+    surface, and runs started there fall into it (the stress case shows one), so say so
+    instead of integrating."""
     s = body.system("truncated")
     den = truncated_singularity(*U.omega_to_dimensionless(omega0, body.tau0), s.inertia, s.coupling)
     if not den > 1e-12:

@@ -174,10 +174,13 @@ def _cmd_simulate(args) -> int:
         raise UserError(f"{args.scene}: --model {model!r} is not one of the scene's models ({', '.join(sc.models)})")
     kw = sc.simulation_kwargs()
     if args.method:
-        from .integrators import names
+        from .integrators import get
 
-        if args.method != "auto" and args.method.lower() not in names():
-            raise UserError(f"--method {args.method!r}: unknown method; valid: auto, {', '.join(names())}")
+        if args.method.lower() != "auto":
+            try:
+                get(args.method)
+            except ValueError as e:
+                raise UserError(f"--method: {e}") from None
         kw["method"] = args.method.lower()
     try:
         traj = simulate(sc.body, model, **kw)

@@ -391,10 +391,13 @@ def parse_scene(data: dict, path: str = "<scene>") -> Scene:
         t_end *= _time_scale(body, omega0, tkey, st)
     samples = st.integer("samples", required=True, minimum=2)
     method = st.string("method", "auto")
-    from .integrators import names as method_names  # registry lookup only, no integration
+    from .integrators import get as method_named  # registry lookup only, no integration
 
-    if method != "auto" and method.lower() not in method_names():
-        raise st.error("method", f"unknown method {method!r}; valid: auto, {', '.join(method_names())}")
+    if method.lower() != "auto":
+        try:
+            method_named(method)
+        except ValueError as e:
+            raise st.error("method", str(e)) from None
     rtol = st.number("rtol", 1e-10, positive=True)
     atol = st.number("atol", 1e-12, positive=True)
     step = st.number("step", positive=True)

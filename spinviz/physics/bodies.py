@@ -20,7 +20,7 @@ import numpy as np
 
 from .. import units as U
 from ..rotations import quat_from_axis_angle, world_from_body
-from .equations import System
+from .equations import System, is_symmetric
 
 
 class BodyError(ValueError):
@@ -119,7 +119,7 @@ class Body:
     @property
     def is_symmetric(self) -> bool:
         """I1 = I2, the symmetric top of section 3 (e3 the symmetry axis)."""
-        return math.isclose(self.I1, self.I2, rel_tol=1e-12)
+        return is_symmetric(self.inertia)
 
     @property
     def dipole_magnitude(self) -> float:

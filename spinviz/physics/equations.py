@@ -189,6 +189,13 @@ def euler_zxz_rate(phi, theta, psi, w1, w2, w3):
     return a / st, w1 * c - w2 * s, w3 - a * np.cos(theta) / st
 
 
+def is_symmetric(inertia) -> bool:
+    """I1 = I2 to 1e-12 relative: the paper's symmetric top, e3 the symmetry axis (for a
+    Body in g cm^2 and for a System's relative moments alike)."""
+    I1, I2 = float(inertia[0]), float(inertia[1])
+    return abs(I1 - I2) <= 1e-12 * max(abs(I1), abs(I2))
+
+
 @dataclass(frozen=True)
 class System:
     """What the integrators see: a model and the dimensionless body (4.1).
@@ -207,9 +214,7 @@ class System:
 
     @property
     def is_symmetric(self) -> bool:
-        """I1 = I2 (the paper's symmetric top, e3 the symmetry axis)."""
-        J1, J2, _ = self.inertia
-        return abs(J1 - J2) <= 1e-12 * max(abs(J1), abs(J2))   # the same tolerance as Body.is_symmetric
+        return is_symmetric(self.inertia)
 
     def rate(self):
         """Closure (w1, w2, w3) -> Omega_dot components, parameters bound."""

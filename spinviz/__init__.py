@@ -4,31 +4,60 @@ The reduced (2.2)+(2.3) and truncated (2.5) Euler equations of A. Duviryak, "Asy
 dynamics of askew-polarized spinning top under the radiation reaction torque", with
 quaternion kinematics, checked against the paper's closed forms, rendered off-screen.
 
-Importing the package is light: submodules load on first use (PEP 562), and nothing
-here imports pyvista, vtk or imageio.
+The public API (see the README's "Python" section)::
+
+    import spinviz
+    sc = spinviz.load_scene("scenes/askew_example.toml")
+    tr = spinviz.simulate(sc.body, "reduced", sc.omega0, t_end=10, samples=5)   # -> Trajectory
+    tr.save("run.npz"); tr = spinviz.Trajectory.load("run.npz")
+    img = spinviz.render_frame(sc, t=10.0)                                      # RGB array
+    spinviz.render("scenes/default.toml", out="renders/default.mp4")
+
+Importing the package is light: every name loads its module on first use (PEP 562), and
+nothing here imports numba, pyvista, vtk or imageio.  No public name is also a submodule
+name, so a name always means the same object however often it is used.
 """
 
 from __future__ import annotations
 
 import importlib
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
-_SUBMODULES = {
-    "units", "rotations", "physics", "integrators", "simulate", "trajectory", "scene", "checks", "info", "cli",
+# public name -> (module, attribute)
+_API = {
+    "load_scene": ("scene", "load_scene"),
+    "Scene": ("scene", "Scene"),
+    "simulate": ("driver", "simulate"),
+    "Trajectory": ("trajectory", "Trajectory"),
+    "render": ("pipeline", "render"),
+    "render_frame": ("pipeline", "render_frame"),
+    "Renderer": ("pipeline", "Renderer"),
+    "Body": ("physics.bodies", "Body"),
+    "symmetric_top": ("physics.bodies", "symmetric_top"),
+    "PRESETS": ("physics.presets", "PRESETS"),
+    "SpinvizError": ("errors", "SpinvizError"),
+    "SceneError": ("errors", "SceneError"),
+    "SimulationError": ("errors", "SimulationError"),
 }
-_ATTRS = {"simulate": ("simulate", "simulate"), "load_scene": ("scene", "load_scene"), "Trajectory": ("trajectory", "Trajectory")}
+_SUBMODULES = {
+    "units", "rotations", "errors", "atomic", "plotting", "physics", "integrators", "driver", "trajectory", "scene",
+    "rendering", "pipeline", "analysis", "validation", "cli",
+}
+
+__all__ = sorted(_API) + ["__version__"]
 
 
 def __getattr__(name: str):
-    if name in _ATTRS:
-        mod, attr = _ATTRS[name]
-        return getattr(importlib.import_module(f".{mod}", __name__), attr)
+    if name in _API:
+        mod, attr = _API[name]
+        value = getattr(importlib.import_module(f".{mod}", __name__), attr)
+        globals()[name] = value            # later uses skip this hook
+        return value
     if name in _SUBMODULES:
         return importlib.import_module(f".{name}", __name__)
     raise AttributeError(f"module 'spinviz' has no attribute {name!r}")
 
 
 def __dir__():
-    return sorted(set(globals()) | _SUBMODULES | set(_ATTRS))
-
+    return sorted(set(globals()) | _SUBMODULES | set(_API))

@@ -64,3 +64,16 @@ def atomic_path(path):
     except BaseException:
         target.discard()
         raise
+
+
+def write_text(path, text: str) -> None:
+    """A text file written atomically."""
+    with atomic_path(path) as tmp, open(tmp, "w") as fh:
+        fh.write(text)
+
+
+def write_json(path, data) -> None:
+    """JSON written atomically (NumPy scalars as floats)."""
+    import json
+
+    write_text(path, json.dumps(data, indent=2, default=float) + "\n")

@@ -17,12 +17,52 @@ def pyplot():
     return plt
 
 
-def save(fig, path: str, dpi: int = 110) -> None:
-    """Write ``fig`` as a PNG atomically, then close it."""
+def save(fig, path: str, dpi: int = 110, close: bool = True) -> None:
+    """Write ``fig`` as a PNG atomically, then close it (unless ``close`` is False)."""
     import matplotlib.pyplot as plt
 
     try:
         with atomic_path(path) as tmp:
             fig.savefig(tmp, dpi=dpi, format="png")
     finally:
-        plt.close(fig)
+        if close:
+            plt.close(fig)
+
+
+def plot_trajectory(traj, path: str | None = None):
+    """Three panels for one run: |Omega|(t) (log-log), the angle between d and L (t), and the
+    hodograph of Omega in the body frame (as the paper's figures 3 and 4).  Returns the
+    figure; also writes it to ``path`` (PNG, atomic) when given."""
+    import numpy as np
+
+    plt = pyplot()
+    cgs = traj.units == "cgs"
+    t, w = traj.t, traj.omega
+    tl = "t [s]" if cgs else "t [\u03c4\u2080]"
+    fig = plt.figure(figsize=(13, 4))
+    ax = fig.add_subplot(1, 3, 1)
+    m = t > 0
+    ax.loglog(t[m], np.linalg.norm(w[m], axis=1))
+    ax.set_xlabel(tl)
+    ax.set_ylabel("|\u03a9| [rad/s]" if cgs else "|\u03c9| [1/\u03c4\u2080]")
+    ax.set_title("spin rate")
+    ax = fig.add_subplot(1, 3, 2)
+    ax.plot(t, np.degrees(traj.angle_d_L()))
+    ax.set_xlabel(tl)
+    ax.set_ylabel("\u2220(d, L) [deg]")
+    ax.set_title("angle between dipole d and angular momentum L")
+    ax = fig.add_subplot(1, 3, 3, projection="3d")
+    x = w / (float(np.linalg.norm(w[0])) or 1.0)
+    ax.plot(x[:, 0], x[:, 1], x[:, 2], lw=1.0)
+    ax.scatter(*x[0], color="green", s=12, label="start")
+    ax.scatter(*x[-1], color="crimson", s=12, label="end")
+    ax.set_xlabel("\u03c9\u2081")
+    ax.set_ylabel("\u03c9\u2082")
+    ax.set_zlabel("\u03c9\u2083")
+    ax.set_title("hodograph, body frame (units of |\u03c9\u2080|)")
+    ax.legend(fontsize=8)
+    fig.suptitle(f"{traj.body.name}: {traj.model} model")
+    fig.tight_layout()
+    if path is not None:
+        save(fig, path, close=False)
+    return fig

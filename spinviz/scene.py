@@ -33,16 +33,13 @@ import numpy as np
 
 from . import rotations as R
 from . import units as U
+from .errors import SceneError, SpecError
 from .physics import bodies as B
+from .physics import presets as P
 from .physics.equations import MODELS
+from .rendering.spec import RenderSpec
 
-
-class SceneError(ValueError):
-    """A scene that cannot be used; str() is the one-line message for the user."""
-
-    def __init__(self, path: str, key: str, reason: str):
-        self.path, self.key, self.reason = str(path), key, reason
-        super().__init__(f"{self.path}: {key}: {reason}")
+__all__ = ["Scene", "SceneError", "load_scene", "parse_scene"]
 
 
 class _Table:
@@ -149,98 +146,6 @@ class _Table:
             raise self.error(k, "unknown key" + (f" (also unknown: {', '.join(unknown[1:])})" if len(unknown) > 1 else ""))
 
 
-SHOW_ITEMS = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud", "hodograph")
-DEFAULT_SHOW = ("body", "dipole", "axes", "trail", "sphere", "hud")
-ORIENTATION_ITEMS = ("body", "dipole", "omega", "L", "trail")
-
-
-@dataclass(frozen=True)
-class RenderSpec:
-    """What a video shows and how simulation time maps to video time (the [render] table).
-
-    duration : s of video; fps; size : (width, height) px.
-    time_map : "linear" or "log" -- video time s in [0, 1] maps to t = t_end s, or to
-        t = knee ((1 + t_end/knee)^s - 1) (logarithmic once t >> knee).
-    log_knee : knee of the log map, in the scene's time unit (default t_end / 1000).
-    spin : "auto", "true" (the simulated orientation at each frame) or "slowed" (symmetric
-        tops: slow geometry exact, spin and precession phases re-timed so that the shown
-        spin rate is ``spin_turns_per_second`` x |Omega_L(t)| / |Omega_L(0)|; labelled).
-    show : the actors to build (others are not built, and what they need is not computed).
-    trail_seconds : length of the dipole trail, video seconds.
-    camera : azimuth_deg, elevation_deg (view direction from the origin), zoom.
-    background : "white" or "black".  title : shown under the panels.
-    poster : where in the video (0..1) the PNG poster frame is taken.
-    """
-
-    duration: float = 12.0
-    fps: int = 30
-    size: tuple[int, int] = (1280, 720)
-    time_map: str = "linear"
-    log_knee: float | None = None
-    spin: str = "auto"
-    spin_turns_per_second: float = 0.75
-    show: tuple[str, ...] = DEFAULT_SHOW
-    trail_seconds: float = 2.0
-    azimuth_deg: float = -55.0
-    elevation_deg: float = 22.0
-    zoom: float = 1.0
-    background: str = "white"
-    title: str = ""
-    poster: float = 1.0
-
-    @property
-    def needs_orientation(self) -> bool:
-        """False when nothing shown depends on the orientation (e.g. a hodograph-only scene):
-        then no orientation is integrated at all."""
-        return any(item in self.show for item in ORIENTATION_ITEMS)
-
-    @property
-    def frames(self) -> int:
-        return max(2, int(round(self.duration * self.fps)))
-
-
-def parse_render(t: "_Table | None", title: str, t_end: float) -> RenderSpec:
-    """Validate a [render] table (None: all defaults)."""
-    if t is None:
-        return RenderSpec(title=title)
-    kw = {}
-    kw["duration"] = t.number("duration", 12.0, positive=True)
-    kw["fps"] = t.integer("fps", 30, minimum=1)
-    if kw["fps"] > 240:
-        raise t.error("fps", f"must be at most 240, got {kw['fps']}")
-    size = t.raw("size", [1280, 720])
-    if (not isinstance(size, list) or len(size) != 2 or not all(isinstance(x, int) and not isinstance(x, bool) for x in size)
-            or min(size) < 16 or max(size) > 7680):
-        raise t.error("size", f"must be [width, height] in pixels (16..7680), got {size!r}")
-    kw["size"] = (size[0], size[1])
-    kw["time_map"] = t.string("time_map", "linear", choices=("linear", "log"))
-    kw["log_knee"] = t.number("log_knee", positive=True)
-    if kw["log_knee"] is not None and kw["log_knee"] >= t_end:
-        raise t.error("log_knee", f"must be below t_end = {t_end:g}")
-    kw["spin"] = t.string("spin", "auto", choices=("auto", "true", "slowed"))
-    kw["spin_turns_per_second"] = t.number("spin_turns_per_second", 0.75, positive=True)
-    show = t.raw("show", list(DEFAULT_SHOW))
-    if not isinstance(show, list) or not show or not all(isinstance(x, str) for x in show):
-        raise t.error("show", f"must be a non-empty list of names from: {', '.join(SHOW_ITEMS)}")
-    for item in show:
-        if item not in SHOW_ITEMS:
-            raise t.error("show", f"unknown item {item!r}; valid: {', '.join(SHOW_ITEMS)}")
-    kw["show"] = tuple(dict.fromkeys(show))
-    kw["trail_seconds"] = t.number("trail_seconds", 2.0, nonneg=True)
-    kw["azimuth_deg"] = t.number("azimuth_deg", -55.0)
-    kw["elevation_deg"] = t.number("elevation_deg", 22.0)
-    if not -89.0 <= kw["elevation_deg"] <= 89.0:
-        raise t.error("elevation_deg", f"must lie in [-89, 89], got {kw['elevation_deg']:g}")
-    kw["zoom"] = t.number("zoom", 1.0, positive=True)
-    kw["background"] = t.string("background", "white", choices=("white", "black"))
-    kw["title"] = t.string("title", title)
-    kw["poster"] = t.number("poster", 1.0, nonneg=True)
-    if kw["poster"] > 1.0:
-        raise t.error("poster", f"must lie in [0, 1] (a fraction of the video), got {kw['poster']:g}")
-    t.finish()
-    return RenderSpec(**kw)
-
-
 @dataclass(frozen=True)
 class Scene:
     """A validated scene, in the body's units (CGS: s, rad/s; dimensionless: tau0, 1/tau0)."""
@@ -307,16 +212,16 @@ def _body(t: _Table, units_hint: str | None) -> B.Body:
 
 
 def _preset(t: _Table) -> B.Body:
-    name = t.string("preset", choices=tuple(B.PRESETS) + ("dast_box",))
+    name = t.string("preset", choices=tuple(P.PRESETS) + ("dast_box",))
     density = t.number("density", positive=True)
     if name == "cellulose_rod":
-        return B.cellulose_rod(density=density)
+        return P.cellulose_rod(density=density)
     if name == "dast_cube":
-        return B.dast_cube(t.number("a_nm", 100.0, positive=True), density=density)
+        return P.dast_cube(t.number("a_nm", 100.0, positive=True), density=density)
     if name == "dast_family1":
-        return B.dast_family1(t.number("a_nm", 100.0, positive=True), t.number("c_nm", 50.0, positive=True), density=density)
+        return P.dast_family1(t.number("a_nm", 100.0, positive=True), t.number("c_nm", 50.0, positive=True), density=density)
     a, b, c = (t.number(k, required=True, positive=True) for k in ("a_nm", "b_nm", "c_nm"))
-    return B.dast_box(a, b, c, density=density)
+    return P.dast_box(a, b, c, density=density)
 
 
 def _shape(t: _Table) -> B.Body:
@@ -352,8 +257,15 @@ def parse_scene(data: dict, path: str = "<scene>") -> Scene:
     bt.finish()
     if units_hint is not None and units_hint != body.units:
         raise st.error("units", f"{units_hint!r} does not match the body, which is given in {body.units!r} units")
+    omega0, q0 = _initial(it)
+    sim = _simulation(st, body, omega0)
+    render = _render(top, path, title, sim["t_end"])
+    top.finish()
+    return Scene(path=str(path), title=title, body=body, omega0=omega0, q0=q0, render=render, **sim)
 
-    # initial state
+
+def _initial(it: _Table):
+    """[initial]: (omega0 (3,), q0 (w, x, y, z))."""
     omega0 = it.vector("omega", required=True)
     form = it.one_of("euler_zxz", "euler_zxz_deg", "quaternion")
     if form == "euler_zxz":
@@ -368,21 +280,27 @@ def parse_scene(data: dict, path: str = "<scene>") -> Scene:
     else:
         q0 = np.array([1.0, 0.0, 0.0, 0.0])
     it.finish()
+    return omega0, q0
 
-    # simulation
+
+def _models(st: _Table) -> tuple[str, ...]:
     mkey = st.one_of("model", "models")
     if mkey is None:
         raise st.error("model", f"missing value; valid: {', '.join(MODELS)}")
     if mkey == "model":
-        models = (st.string("model", choices=MODELS),)
-    else:
-        ms = st.raw("models")
-        if not isinstance(ms, list) or not (1 <= len(ms) <= 2) or not all(isinstance(m, str) for m in ms):
-            raise st.error("models", f"must be a list of one or two model names, got {ms!r}")
-        for m in ms:
-            if m not in MODELS:
-                raise st.error("models", f"unknown model {m!r}; valid: {', '.join(MODELS)}")
-        models = tuple(ms)
+        return (st.string("model", choices=MODELS),)
+    ms = st.raw("models")
+    if not isinstance(ms, list) or not (1 <= len(ms) <= 2) or not all(isinstance(m, str) for m in ms):
+        raise st.error("models", f"must be a list of one or two model names, got {ms!r}")
+    for m in ms:
+        if m not in MODELS:
+            raise st.error("models", f"unknown model {m!r}; valid: {', '.join(MODELS)}")
+    return tuple(ms)
+
+
+def _simulation(st: _Table, body: B.Body, omega0) -> dict:
+    """[simulation]: models, horizon, samples and the integrator settings, as Scene fields."""
+    models = _models(st)
     tkey = st.one_of("t_end", "t_end_T", "t_end_Theta")
     if tkey is None:
         raise st.error("t_end", "missing value (or give t_end_T / t_end_Theta)")
@@ -391,9 +309,9 @@ def parse_scene(data: dict, path: str = "<scene>") -> Scene:
         t_end *= _time_scale(body, omega0, tkey, st)
     samples = st.integer("samples", required=True, minimum=2)
     method = st.string("method", "auto")
-    from .integrators import get as method_named  # registry lookup only, no integration
-
     if method.lower() != "auto":
+        from .integrators import get as method_named  # the registry only: no kernel is compiled
+
         try:
             method_named(method)
         except ValueError as e:
@@ -402,11 +320,18 @@ def parse_scene(data: dict, path: str = "<scene>") -> Scene:
     atol = st.number("atol", 1e-12, positive=True)
     step = st.number("step", positive=True)
     st.finish()
-    render = parse_render(top.sub("render"), title, t_end)
-    top.finish()
-    return Scene(path=str(path), title=title, body=body, models=models, omega0=omega0, q0=q0,
-                 t_end=t_end, samples=samples, method=method.lower(), rtol=rtol, atol=atol, step=step,
-                 render=render)
+    return dict(models=models, t_end=t_end, samples=samples, method=method.lower(), rtol=rtol, atol=atol, step=step)
+
+
+def _render(top: _Table, path: str, title: str, t_end: float) -> RenderSpec:
+    """[render], validated by ``RenderSpec`` itself (the one place render inputs are checked)."""
+    data = top.raw("render")
+    try:
+        spec = RenderSpec(title=title) if data is None else RenderSpec.from_mapping(data, title)
+        spec.check_horizon(t_end)
+    except SpecError as e:
+        raise SceneError(path, e.key if e.key.startswith("[") else f"[render].{e.key}", e.reason) from None
+    return spec
 
 
 def _time_scale(body: B.Body, omega0, key: str, st: _Table) -> float:

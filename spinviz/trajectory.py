@@ -157,19 +157,72 @@ class Trajectory:
             slow = {k: (np.interp(times, t, v) if k in SLOW_SERIES else v) for k, v in self.slow.items()}
         return replace(self, t=times, omega=omega, q=q, euler=euler, slow=slow)
 
-    # -- output --------------------------------------------------------------------------
+    # -- people and notebooks ------------------------------------------------------------
+    def __repr__(self) -> str:
+        w = self.omega_magnitude
+        tu, wu = ("s", "rad/s") if self.units == "cgs" else ("tau0", "1/tau0")
+        orient = "quaternion" if self.q is not None else ("euler_zxz (6.4)" if self.euler is not None else "none")
+        method = self.stats.get("method", "?")
+        return (f"Trajectory({self.model}, {self.body.name!r}, {self.t.size} samples, t = 0..{self.t[-1]:.4g} {tu}, "
+                f"|omega| {w[0]:.4g} -> {w[-1]:.4g} {wu}, orientation: {orient}, method: {method})")
+
+    def angle_d_L(self) -> np.ndarray:
+        """Angle between the dipole and the angular momentum, rad, shape (N,).  A body-frame
+        quantity (d . I Omega), so it needs no orientation."""
+        L_body = np.asarray(self.body.inertia, dtype=float) * self.omega
+        return R.angle_between(np.broadcast_to(self.body.dipole_direction, L_body.shape), L_body)
+
+    def plot(self, path: str | None = None):
+        """|Omega|(t), the angle between d and L, and the hodograph of Omega (body frame), as a
+        matplotlib figure; also written to ``path`` (PNG) when given."""
+        from .plotting import plot_trajectory
+
+        return plot_trajectory(self, path)
+
+    def to_xarray(self):
+        """An ``xarray.Dataset`` with labelled dims (time, axis, quaternion component), units
+        and the run's metadata as attributes -- ready for ``to_netcdf`` or ``to_zarr``."""
+        try:
+            import xarray as xr
+        except ImportError:
+            raise ImportError("to_xarray needs xarray: pip install 'spinviz[ensemble]'", name="xarray") from None
+        tu, wu = ("s", "rad/s") if self.units == "cgs" else ("tau0", "1/tau0")
+        data = {"omega": (("time", "axis"), np.array(self.omega),
+                          {"units": wu, "long_name": "angular velocity, body frame"})}
+        if self.q is not None:
+            data["q"] = (("time", "quaternion_component"), np.array(self.q),
+                         {"long_name": "orientation, body to world", "convention": "scalar first (w, x, y, z)"})
+        if self.q is not None or self.euler is not None:
+            data["euler_zxz"] = (("time", "euler_angle"), self.euler_zxz,
+                                 {"units": "rad", "convention": "ZXZ, O = Rz(phi) Rx(theta) Rz(psi), unwrapped"})
+        data["angle_d_L"] = (("time",), self.angle_d_L(), {"units": "rad", "long_name": "angle between d and L"})
+        coords = {"time": ("time", np.array(self.t), {"units": tu}), "axis": ["e1", "e2", "e3"],
+                  "quaternion_component": ["w", "x", "y", "z"], "euler_angle": ["phi", "theta", "psi"]}
+        ds = xr.Dataset(data, coords=coords)
+        ds.attrs.update({"spinviz_trajectory": json.dumps(self.metadata()), "model": self.model,
+                         "body": self.body.name, "units": self.units})
+        return ds
+
+    # -- files -----------------------------------------------------------------------------
     def arrays(self) -> dict[str, np.ndarray]:
-        """The arrays ``save_npz`` writes (t, omega, and q, euler_zxz when orientation exists)."""
+        """The arrays ``save`` writes: t, omega, q and euler_zxz (derived, for convenience)
+        when orientation exists; the raw Euler-angle solution and the slow geometry of a
+        ``secular`` run when present."""
         out = {"t": np.array(self.t), "omega": np.array(self.omega)}
         if self.q is not None:
             out["q"] = np.array(self.q)
         if self.q is not None or self.euler is not None:
             out["euler_zxz"] = self.euler_zxz
+        if self.euler is not None:
+            out["euler"] = np.array(self.euler)
+        for k, v in (self.slow or {}).items():
+            out[f"slow_{k}"] = np.asarray(v, dtype=float)
         return out
 
     def metadata(self) -> dict:
         b = self.body
         return {
+            "format": FORMAT,
             "units": self.units,
             "time_unit": "s" if self.units == "cgs" else "tau0",
             "omega_unit": "rad/s" if self.units == "cgs" else "1/tau0",
@@ -180,10 +233,44 @@ class Trajectory:
             "inertia": list(b.inertia),
             "dipole": list(b.dipole),
             "tau0_s": b.tau0 if self.units == "cgs" else None,
-            "stats": {k: v for k, v in self.stats.items() if isinstance(v, (int, float, str, bool, type(None)))},
+            "body_description": b.to_dict(),
+            "stats": _plain_stats(self.stats),
         }
 
-    def save_npz(self, path) -> None:
-        """Write the arrays and a JSON ``metadata`` entry atomically (temp file + rename)."""
+    def save(self, path) -> None:
+        """Write the arrays and a JSON ``metadata`` entry (.npz), atomically (temp file + rename).
+        ``Trajectory.load`` reads it back exactly."""
         with atomic_path(path) as tmp, open(tmp, "wb") as fh:
             np.savez(fh, metadata=np.array(json.dumps(self.metadata())), **self.arrays())
+
+    save_npz = save
+
+    @classmethod
+    def load(cls, path) -> "Trajectory":
+        """A trajectory written by ``save`` (or ``spinviz simulate --out``): arrays, body, model,
+        stats and slow geometry as they were."""
+        with np.load(path, allow_pickle=False) as z:
+            meta = json.loads(str(z["metadata"]))
+            if meta.get("format") != FORMAT:
+                raise ValueError(f"{path}: not a spinviz trajectory of format {FORMAT!r}")
+            arrays = {k: np.array(z[k]) for k in z.files if k != "metadata"}
+        slow = {k[5:]: v for k, v in arrays.items() if k.startswith("slow_")} or None
+        return cls(t=arrays["t"], omega=arrays["omega"], q=arrays.get("q"), euler=arrays.get("euler"),
+                   body=Body.from_dict(meta["body_description"]), model=meta["model"],
+                   stats=dict(meta["stats"]), slow=slow)
+
+
+FORMAT = "spinviz-trajectory-1"
+
+
+def _plain_stats(stats: dict) -> dict:
+    """The JSON-representable part of ``stats`` (numbers, strings, lists of numbers)."""
+    out = {}
+    for k, v in stats.items():
+        if isinstance(v, np.generic):
+            v = v.item()
+        if isinstance(v, (tuple, list, np.ndarray)):
+            v = np.asarray(v).tolist()
+        if isinstance(v, (int, float, str, bool, type(None), list)):
+            out[k] = v
+    return out

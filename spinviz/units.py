@@ -100,3 +100,13 @@ def human_time(seconds: float, digits: int = 3) -> str:
     if a < YEAR:
         return f"{s / DAY:.{digits}g} days"
     return f"{s / YEAR:.{digits}g} years"
+
+
+def format_time(t: float, units: str) -> str:
+    """Physical time in the best human unit (CGS), or in tau0 (dimensionless)."""
+    return human_time(t) if units == "cgs" else f"{t:.4g} \u03c40"
+
+
+def format_omega(w: float, units: str) -> str:
+    """|Omega| in rad/s (CGS), or |omega| in 1/tau0 (dimensionless)."""
+    return f"|\u03a9| = {w:.3g} rad/s" if units == "cgs" else f"|\u03c9| = {w:.3g} /\u03c40"

@@ -7,26 +7,27 @@ import pytest
 
 from spinviz import units as U
 from spinviz.physics import bodies as B
+from spinviz.physics import presets as P
 
 
 def test_cellulose_rod_section_6_1_figures():
     """Section 6.1: I1 = 3.3e-26 g cm^2, eps = 0.015, tau0 = 1.4e-35 s, T ~ 1e6 years,
     Theta ~ 1e10 years (at Omega = pi 1e10 rad/s)."""
-    rod = B.cellulose_rod()
+    rod = P.cellulose_rod()
     assert rod.I1 == pytest.approx(3.27e-26, rel=5e-3)
     assert rod.I3 == pytest.approx(4.87e-28, rel=5e-3)      # the paper prints 4.11e-28; its eps fits 4.87e-28
     assert rod.epsilon == pytest.approx(0.015, rel=0.02)
     assert rod.tau0 == pytest.approx(1.4e-35, rel=0.05)
     assert rod.chi == 0.0
-    T_years = rod.braking_time_T(B.OMEGA_PAPER) / U.YEAR
+    T_years = rod.braking_time_T(P.OMEGA_PAPER) / U.YEAR
     assert 1e6 <= T_years < 1e7                               # 2.2e6; the paper says "~3e6"
-    assert 0.5e10 < rod.residual_time_Theta(B.OMEGA_PAPER) / U.YEAR < 2e10
+    assert 0.5e10 < rod.residual_time_Theta(P.OMEGA_PAPER) / U.YEAR < 2e10
 
 
 def test_dast_density_and_dipole_density_from_cell_data():
     """rho = Z mu m_u / V = 1.30 g/cm^3 (the paper prints 1.37); 57 D/nm^3."""
-    assert B.DAST.density == pytest.approx(1.296, rel=1e-3)
-    assert B.DAST.dipole_density / U.DEBYE * U.NM**3 == pytest.approx(57.04, rel=1e-3)
+    assert P.DAST.density == pytest.approx(1.296, rel=1e-3)
+    assert P.DAST.dipole_density / U.DEBYE * U.NM**3 == pytest.approx(57.04, rel=1e-3)
 
 
 def test_dast_cube_section_6_2_figures():
@@ -34,15 +35,15 @@ def test_dast_cube_section_6_2_figures():
     and dipole (5.6e7 D) tau0 is 3.4e-27 s within 2 %; from the cell data (1.30 g/cm^3,
     5.70e7 D) it is larger by exactly (1.37/1.296) (5.704/5.6)^2, since tau0 = 2d^2/(3 I c^3)
     with I = rho a^5/6."""
-    cube = B.dast_cube()
+    cube = P.dast_cube()
     assert cube.delta == 0.0 and cube.chi == 0.0              # e3 along d, as section 6.2 chooses
     assert cube.dipole_magnitude / U.DEBYE == pytest.approx(5.70e7, rel=2e-3)
-    paper = B.dast_cube(density=1.37)
+    paper = P.dast_cube(density=1.37)
     tau0_paper_inputs = U.tau0_cgs(5.6e7 * U.DEBYE, paper.I1)
     assert tau0_paper_inputs == pytest.approx(3.4e-27, rel=0.02)
-    ratio = (1.37 / B.DAST.density) * (cube.dipole_magnitude / (5.6e7 * U.DEBYE)) ** 2
+    ratio = (1.37 / P.DAST.density) * (cube.dipole_magnitude / (5.6e7 * U.DEBYE)) ** 2
     assert cube.tau0 == pytest.approx(tau0_paper_inputs * ratio, rel=1e-12)
-    days = cube.residual_time_Theta(B.OMEGA_PAPER) / U.DAY
+    days = cube.residual_time_Theta(P.OMEGA_PAPER) / U.DAY
     assert 2.0 < days < 5.0                                   # 3.15 days; the paper says "~4 days"
 
 
@@ -50,23 +51,23 @@ def test_dast_cube_drawn_with_crystal_faces():
     """The body frame has e3 along d; the shape frame is the crystal's, 35 deg from d to a."""
     from spinviz import rotations as R
 
-    cube = B.dast_cube()
+    cube = P.dast_cube()
     d_crystal = R.body_from_world(cube.shape.q_body_from_shape, cube.dipole_direction)
-    np.testing.assert_allclose(d_crystal, B.DAST.dipole_direction_crystal, atol=1e-14)
+    np.testing.assert_allclose(d_crystal, P.DAST.dipole_direction_crystal, atol=1e-14)
 
 
 def test_dast_family1_is_delta_minus_0_6_chi_55():
-    b = B.dast_family1()
+    b = P.dast_family1()
     assert b.delta == pytest.approx(-0.6, abs=1e-12)
     assert math.degrees(b.chi) == pytest.approx(55.0, abs=1e-10)
     assert b.dipole_magnitude / U.DEBYE == pytest.approx(2.85e7, rel=2e-3)  # paper 2.8e7
-    assert B.dast_family1(density=1.37).I1 == pytest.approx(7.14e-27, rel=5e-3)
+    assert P.dast_family1(density=1.37).I1 == pytest.approx(7.14e-27, rel=5e-3)
 
 
 def test_dast_box_any_size_keeps_chi():
     """Any a = b != c DAST box has chi = 55 deg; delta = (c^2 - a^2)/(c^2 + a^2) (section 6.2)."""
     for a, c in [(50.0, 200.0), (100.0, 30.0)]:
-        b = B.dast_box(a, a, c)
+        b = P.dast_box(a, a, c)
         assert math.degrees(b.chi) == pytest.approx(55.0, abs=1e-10)
         assert b.delta == pytest.approx((c * c - a * a) / (c * c + a * a), rel=1e-12)
 
@@ -107,7 +108,7 @@ def test_delta_range_3_6():
 
 def test_dimensionless_system_has_tau0_one():
     """system(): J = I/I1 and |g|^2/J1 = tau0 = 1, whatever the CGS scale."""
-    s = B.dast_family1().system("reduced")
+    s = P.dast_family1().system("reduced")
     assert s.inertia[0] == 1.0
     assert s.inertia[2] == pytest.approx(1.6)
     assert np.linalg.norm(s.coupling) == pytest.approx(1.0, rel=1e-15)

@@ -7,10 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from spinviz import compare as C
+from spinviz.analysis import compare as C
 from spinviz.cli import main
 from spinviz.physics import bodies as B
-from spinviz.simulate import simulate
+from spinviz.physics import presets as P
+from spinviz.driver import simulate
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 
@@ -40,7 +41,7 @@ def test_resolved_askew_comparison_grows_from_zero():
 def test_dast_cube_final_states_residual_rotation_vs_rest():
     """Real DAST cube over 6 Theta: reduced ends rotating about d at |Omega3| (5.2)/(6.7);
     truncated spins down by the power law of (6.9), exponent -(tau0 W^2 t)/F^2 -> -6/13 here."""
-    cube = B.dast_cube()
+    cube = P.dast_cube()
     W = math.pi * 1e10
     Th = 1.0 / (cube.tau0 * W**2)
     t = C.compare_times(6.0 * Th, 200)

@@ -5,11 +5,12 @@ import math
 import numpy as np
 import pytest
 
-from spinviz import checks
+from spinviz.validation import checks
 from spinviz import rotations as R
 from spinviz.physics import bodies as B
+from spinviz.physics import presets as P
 from spinviz.physics import closed_forms as CF
-from spinviz.simulate import SimulationError, simulate
+from spinviz.driver import SimulationError, simulate
 
 ASKEW = B.symmetric_top(-0.6, math.radians(55.0))          # DAST family-1 proportions
 
@@ -143,7 +144,7 @@ def test_cgs_and_dimensionless_runs_agree_through_4_1():
 def test_real_cellulose_rod_parameters_do_not_underflow():
     """tau0 = 1.4e-35 s and Omega = pi 1e10 /s: spin units keep the numbers O(1); over 100
     turns the spin-down is invisible (tau0 Omega^2 t ~ 1e-15) and the rotation is free."""
-    rod = B.cellulose_rod()
+    rod = P.cellulose_rod()
     W = np.array([0.0, math.pi * 1e10, 0.0])
     t_end = 100 * 2 * math.pi / W[1]
     tr = simulate(rod, "reduced", W, t_end=t_end, samples=11, rtol=1e-12, atol=1e-14)

@@ -10,8 +10,10 @@ import numpy as np
 import pytest
 
 from spinviz import rotations as R
-from spinviz import timeline, video
-from spinviz.render import RenderError, render_frames, render_video
+from spinviz import pipeline
+from spinviz.errors import RenderError
+from spinviz.rendering import timeline
+from spinviz.rendering.video import render_frames, render_video
 from spinviz.scene import parse_scene
 
 DIPOLE_RGB = np.array([0.86, 0.08, 0.24]) * 255
@@ -66,7 +68,7 @@ def test_dipole_arrow_tip_follows_the_simulated_orientation():
     projection of O d (the simulated orientation applied to the body-frame dipole)."""
     sc = askew()
     spec = sc.render
-    trajs = video.scene_trajectories(sc, spec)
+    trajs = pipeline.scene_trajectories(sc, spec)
     plan = timeline.plan_frames(spec, trajs)
     assert plan.spin_mode == "true"
     frames = [0, 5, 11]
@@ -104,7 +106,7 @@ size = [480, 200]
 show = ["dipole", "hud"]
 """)
     spec = sc.render
-    plan = video.plan_scene(sc, spec)
+    plan = pipeline.plan(sc)
     assert [p.model for p in plan.panels] == ["reduced", "truncated"]
     assert plan.spin_mode == "slowed"                  # 1e16 turns: the phase is beyond float64
     f = plan.frames - 1
@@ -133,8 +135,7 @@ def test_video_has_the_expected_frames_and_size(tmp_path):
     import imageio
 
     sc = askew(show='["body", "dipole", "trail", "sphere", "axes", "hud"]', w=160, h=96)
-    spec = video.spec_with(sc, fps=16, duration=1.5)
-    plan = video.plan_scene(sc, spec)
+    plan = pipeline.plan(sc, fps=16, duration=1.5)
     out = tmp_path / "v.mp4"
     res = render_video(plan, str(out), workers=2, progress=False)
     assert res.workers == 2 and res.frames == 24
@@ -154,10 +155,10 @@ def test_video_has_the_expected_frames_and_size(tmp_path):
 
 def test_failed_render_leaves_the_previous_file_intact(tmp_path, monkeypatch):
     """An error in the middle of a render deletes the partial output and keeps the old file."""
-    from spinviz.render import session as S
+    from spinviz.rendering import session as S
 
     sc = askew(w=64, h=48)
-    plan = video.plan_scene(sc, sc.render)
+    plan = pipeline.plan(sc)
     out = tmp_path / "old.mp4"
     out.write_bytes(b"previous video")
     (tmp_path / "old.png").write_bytes(b"previous poster")
@@ -182,7 +183,7 @@ def test_worker_failure_is_reported_and_cleaned_up(tmp_path):
     """A worker that cannot render (odd width for H.264) fails the render with a clear error,
     and no partial file or segment directory is left behind."""
     sc = askew(w=96, h=48)
-    plan = video.plan_scene(sc, video.spec_with(sc, size=(96, 48), duration=2.0))
+    plan = pipeline.plan(sc, size=(96, 48), duration=2.0)
     with pytest.raises(RenderError, match="render worker .* failed"):
         render_video(plan, str(tmp_path / "x.mp4"), size=(97, 48), workers=2, progress=False)
     assert list(tmp_path.iterdir()) == []
@@ -190,7 +191,7 @@ def test_worker_failure_is_reported_and_cleaned_up(tmp_path):
 
 def test_only_listed_actors_are_built():
     sc = askew(show='["dipole"]', w=64, h=48)
-    plan = video.plan_scene(sc, sc.render)
+    plan = pipeline.plan(sc)
     _, session = render_frames(plan, [0], sc.render.size)
     try:
         assert set(session.solids[0].parts) == {"dipole"}
@@ -203,7 +204,7 @@ def test_only_listed_actors_are_built():
 
 def test_hodograph_only_scene_integrates_no_orientation(monkeypatch):
     """show = ["hodograph"]: the trajectories carry no orientation (kinematics "none")."""
-    import spinviz.video as V
+    import spinviz.pipeline as V
 
     seen = []
     real = V.simulate
@@ -235,7 +236,7 @@ def test_log_time_map_and_slowed_spin_label():
     assert t[0] == 0.0 and t[-1] == 60.0 and np.all(np.diff(t) > 0)
     np.testing.assert_allclose(np.gradient(t, v)[5:-5], slope[5:-5], rtol=0.05)
     sc = askew(w=64, h=48)
-    trajs = video.scene_trajectories(sc, spec)
+    trajs = pipeline.scene_trajectories(sc, spec)
     plan = timeline.plan_frames(spec, trajs)
     assert plan.spin_mode == "slowed"
     w0 = trajs[0].omega[0]
@@ -272,7 +273,7 @@ def test_render_command_errors_are_one_line(tmp_path, capsys):
 
 def test_progress_is_reported_while_rendering(tmp_path, capsys):
     sc = askew(w=64, h=48)
-    plan = video.plan_scene(sc, video.spec_with(sc, fps=8, duration=1.0))
+    plan = pipeline.plan(sc, fps=8, duration=1.0)
     render_video(plan, str(tmp_path / "p.mp4"), workers=1, progress=True, poster=False)
     err = capsys.readouterr().err.splitlines()
     assert [line.split(": ")[-1] for line in err] == ["25 % (2/8 frames)", "50 % (4/8 frames)", "75 % (6/8 frames)",

@@ -9,7 +9,8 @@ import pytest
 from spinviz.atomic import AtomicPath
 from spinviz.cli import main
 from spinviz.physics import bodies as B
-from spinviz.simulate import simulate
+from spinviz.physics import presets as P
+from spinviz.driver import simulate
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 
@@ -57,7 +58,7 @@ def test_preset_name_and_density_are_used(tmp_path):
     sc = load_scene(scene(tmp_path, body='preset = "cellulose_rod"\nname = "my rod"\ndensity = 1.5'))
     assert sc.body.name == "my rod"
     assert sc.body.extra["density"] == 1.5
-    assert sc.body.I1 == pytest.approx(B.cellulose_rod().I1 * 1.5 / 1.6, rel=1e-12)
+    assert sc.body.I1 == pytest.approx(P.cellulose_rod().I1 * 1.5 / 1.6, rel=1e-12)
 
 
 def test_failed_write_leaves_no_new_directories(tmp_path):
@@ -93,15 +94,18 @@ def test_render_width_not_divisible_by_panels(tmp_path, capsys):
 
 
 def test_render_option_ranges(tmp_path, capsys):
+    """Out-of-range overrides are refused by the render spec (the one place render inputs are
+    validated), named by their option, in one line with exit 2; nothing is written."""
     p = scene(tmp_path)
-    cases = {("--fps", "0"): "must be at least 1", ("--fps", "1000"): "must be at most 240",
-             ("--duration", "-5"): "must be between 0 and 3600 s", ("--duration", "inf"): "must be between 0 and 3600 s",
-             ("--workers", "-1"): "must be at least 1"}
+    cases = {("--fps", "0"): "must be between 1 and 240, got 0", ("--fps", "1000"): "must be between 1 and 240",
+             ("--duration", "-5"): "must be above 0, got -5", ("--duration", "inf"): "must be finite",
+             ("--duration", "4000"): "must be at most 3600", ("--size", "8x600"): "must be [width, height] in pixels"}
     for (opt, value), reason in cases.items():
-        with pytest.raises(SystemExit) as e:
-            main(["render", str(p), opt, value])
-        assert e.value.code == 2
-        assert f"error: argument {opt}: {reason}" in capsys.readouterr().err
+        one_line_error(capsys, ["render", p, opt, value, "--out", tmp_path / "x.mp4"], f"{opt}: {reason}")
+        assert sorted(q.name for q in tmp_path.iterdir()) == [p.name]
+    with pytest.raises(SystemExit) as e:                    # not a number at all: argparse says so
+        main(["render", str(p), "--workers", "-1"])
+    assert e.value.code == 2 and "argument --workers: must be at least 1" in capsys.readouterr().err
 
 
 def test_slowed_spin_on_an_asymmetric_body_is_one_line(tmp_path, capsys):
@@ -113,7 +117,7 @@ def test_slowed_spin_on_an_asymmetric_body_is_one_line(tmp_path, capsys):
 
 def test_sample_keeps_the_slow_frame_with_four_samples():
     """With exactly four stored instants the (4,) q_L must not be taken for a time series."""
-    cube = B.dast_cube()
+    cube = P.dast_cube()
     W = math.pi * 1e10
     tr = simulate(cube, "reduced", (0.0, W, W), t_end=1.0 / (cube.tau0 * W * W), samples=4)
     assert tr.stats["method"] == "secular"
@@ -125,13 +129,13 @@ def test_segments_join_in_a_directory_with_a_quote(tmp_path):
     """Two workers' MP4 segments are joined by ffmpeg's concat list, which needs quoting."""
     import imageio
 
-    from spinviz import video
-    from spinviz.render import render_video
+    from spinviz import pipeline
+    from spinviz.rendering.video import render_video
     from spinviz.scene import load_scene
 
     d = tmp_path / "it's here"
     sc = load_scene(scene(tmp_path))
-    plan = video.plan_scene(sc, video.spec_with(sc, fps=8, duration=1.0))
+    plan = pipeline.plan(sc, fps=8, duration=1.0)
     render_video(plan, str(d / "v.mp4"), workers=2, progress=False, poster=False)
     r = imageio.get_reader(str(d / "v.mp4"))
     assert r.count_frames() == 8

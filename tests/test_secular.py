@@ -8,9 +8,11 @@ import pytest
 from spinviz import rotations as R
 from spinviz.integrators.secular import SlowFlow
 from spinviz.physics import bodies as B
+from spinviz.physics import presets as P
 from spinviz.physics import closed_forms as CF
 from spinviz.physics.equations import System
-from spinviz.simulate import SimulationError, choose_method, simulate
+from spinviz.driver import SimulationError, simulate
+from spinviz.integrators.auto import choose_method
 
 W = math.pi * 1e10                      # the spin of section 6, rad/s
 
@@ -32,7 +34,7 @@ def test_real_dast_cube_over_10_Theta_matches_6_7_6_9_and_6_8(model, form):
     10 Theta ~ 1.4e16 turns: |Omega_perp|, Omega3 and theta (d from the rotation axis) match
     (6.7)/(6.9) and (6.8)/(6.10) to 1e-6 relative (tolerance set by rtol = 1e-10 on a
     quantity that falls by e^-10)."""
-    cube = B.dast_cube()
+    cube = P.dast_cube()
     Th = 1.0 / (cube.tau0 * W**2)
     tr = simulate(cube, model, (0.0, W, W), t_end=10.0 * Th, samples=201, euler_zxz0=(0.0, 0.5 * math.pi, 0.0))
     assert tr.stats["method"] == "secular"
@@ -99,7 +101,7 @@ def test_secular_needs_a_symmetric_top():
 
 
 def test_auto_picks_secular_radau_or_lie_and_says_why():
-    cube = B.dast_cube()
+    cube = P.dast_cube()
     m, why = choose_method(cube, "reduced", (0.0, W, W), 10.0 / (cube.tau0 * W**2))
     assert m == "secular" and "turns of a symmetric top" in why and "beyond float64" in why
     thin = B.custom((1.0, 1.0, 1e-6), (math.sin(0.5), 0.0, math.cos(0.5)), units="dimensionless")
@@ -112,7 +114,7 @@ def test_auto_picks_secular_radau_or_lie_and_says_why():
 def test_driver_switches_to_radau_when_the_explicit_method_detects_stiffness(monkeypatch):
     """If the up-front estimate misses stiffness, lie-dop853's stiffness test (Hairer's) fires
     and the driver reruns with radau, saying so."""
-    import spinviz.simulate as S
+    import spinviz.driver as S
 
     monkeypatch.setattr(S, "choose_method", lambda *a, **k: ("lie-dop853", "forced for the test"))
     thin = B.custom((1.0, 1.0, 1e-5), (math.sin(0.5), 0.0, math.cos(0.5)), units="dimensionless")

@@ -8,7 +8,7 @@ import pytest
 from spinviz import rotations as R
 from spinviz.physics import bodies as B
 from spinviz.physics import closed_forms as CF
-from spinviz.simulate import SimulationError, simulate
+from spinviz.driver import SimulationError, simulate
 
 SPHERE = B.symmetric_top(0.0, 0.0)
 

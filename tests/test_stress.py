@@ -4,7 +4,7 @@
 
 import pytest
 
-from spinviz import stress
+from spinviz.validation import stress
 
 FAST = [
     stress.case_thin_longitudinal,

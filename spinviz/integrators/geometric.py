@@ -11,18 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import kernels as KN
+from . import status as ST
 from . import tableaus as T
 from .base import Integrator, Problem, Solution, register
-
-_STATUS = {
-    KN.TOO_MANY_STEPS: "exceeded the step limit",
-    KN.STEP_UNDERFLOW: "step size fell below round-off (the problem is too stiff for an explicit method)",
-    KN.NOT_FINITE: "the solution left the finite numbers (overflow)",
-    KN.STIFF: "stiffness detected (Hairer's test: 15 steps in a row limited by stability)",
-    KN.TURN_TOO_LARGE: "a step turns the body by more than half a turn (exponential coordinates are singular "
-                       "at a full turn); use a smaller step",
-}
 
 MAX_STEPS = 200_000_000
 
@@ -34,18 +25,18 @@ def _args(problem: Problem):
     w0 = np.asarray(problem.omega0, dtype=float)
     q0 = np.asarray(problem.q0 if problem.q0 is not None else (1.0, 0.0, 0.0, 0.0), dtype=float)
     t = np.asarray(problem.t_eval, dtype=float)
-    return KN.MODEL_ID[s.model], J, g, w0, q0, t, problem.kinematics == "quaternion"
+    return ST.MODEL_ID[s.model], J, g, w0, q0, t, problem.kinematics == "quaternion"
 
 
 def _solution(problem, w, q, status, stats):
-    ok = status == KN.OK
+    ok = status == ST.OK
     with_q = problem.kinematics == "quaternion"
     return Solution(
         t=np.asarray(problem.t_eval, dtype=float),
         omega=w if ok else np.full_like(w, np.nan),
         q=(q if ok else np.full_like(q, np.nan)) if with_q else None,
         success=ok,
-        message="" if ok else _STATUS.get(status, f"status {status}"),
+        message="" if ok else ST.MESSAGES.get(status, f"status {status}"),
         stats=stats,
     )
 
@@ -54,6 +45,8 @@ def solve_lie_dop853(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12,
                      max_steps: int = MAX_STEPS, stop_on_stiffness: bool = False) -> Solution:
     """Adaptive Lie-group DOP853; ``step`` caps the step size; with ``stop_on_stiffness``
     it gives up as soon as it detects stiffness (the driver then switches to radau)."""
+    from . import kernels as KN          # numba compiles (or loads from cache) on first use only
+
     model, J, g, w0, q0, t, with_q = _args(problem)
     h_max = float(step) if step else np.inf
     w, q, nfev, nsteps, nrej, status, stiff_at = KN.lie_dop853(
@@ -71,6 +64,8 @@ def _fixed(tableau: T.Tableau):
               max_steps: int = MAX_STEPS) -> Solution:
         if step is None or not step > 0:
             raise ValueError(f"method lie-{tableau.name} is fixed-step: give step > 0")
+        from . import kernels as KN
+
         model, J, g, w0, q0, t, with_q = _args(problem)
         w, q, nfev, nsteps, status = KN.lie_fixed(
             model, J, g, w0, q0, t, float(step), tableau.A, tableau.b, with_q, int(max_steps)

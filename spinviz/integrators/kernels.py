@@ -37,7 +37,7 @@ from . import tableaus as T
 
 _jit = nb.njit(cache=True)
 
-MODEL_ID = {"free": 0, "reduced": 1, "truncated": 2}
+from .status import MODEL_ID, NOT_FINITE, OK, STEP_UNDERFLOW, STIFF, TOO_MANY_STEPS, TURN_TOO_LARGE  # noqa: F401
 
 _free = _jit(E.free_rate)
 _reduced = _jit(E.reduced_terms)
@@ -152,9 +152,6 @@ def substeps(dt, h):
     return m, dt / m
 
 
-# status codes shared with the Python wrappers
-OK, TOO_MANY_STEPS, STEP_UNDERFLOW, NOT_FINITE, STIFF, TURN_TOO_LARGE = 0, 1, 2, 3, 4, 5
-
 # Exponential coordinates are singular where |u| = 2 pi (dexp^-1 blows up there unless u is
 # parallel to Omega), so no step may turn the body by more than half a turn.
 U_MAX = math.pi
@@ -213,6 +210,105 @@ def lie_fixed(model, J, g, w0, q0, t_eval, h, A, b, with_q, max_steps):
 
 
 @_jit
+def initial_step(model, J, g, y, K, ys, n, rtol, atol, span, h_max, with_q):
+    """First step size by Hairer, Norsett & Wanner (II.4), from f(y0) in K[0]; uses K[1] as
+    scratch (one extra evaluation).  Returns the step."""
+    sc = np.empty(6)
+    for k in range(n):
+        sc[k] = atol + abs(y[k]) * rtol
+    d0 = 0.0
+    d1 = 0.0
+    for k in range(n):
+        d0 += (y[k] / sc[k]) ** 2
+        d1 += (K[0, k] / sc[k]) ** 2
+    d0 = math.sqrt(d0 / n)
+    d1 = math.sqrt(d1 / n)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, span)
+    for k in range(n):
+        ys[k] = y[k] + h0 * K[0, k]
+    lie_rhs(model, J, g, ys, K[1], with_q)
+    d2 = 0.0
+    for k in range(n):
+        d2 += ((K[1, k] - K[0, k]) / sc[k]) ** 2
+    d2 = math.sqrt(d2 / n) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, h_max)
+
+
+@_jit
+def error_norm(K, y, y_new, h, n, rtol, atol, E3, E5):
+    """DOP853's scaled error of the step (5th- and 3rd-order embedded estimates, SciPy's norm),
+    and whether y_new is finite."""
+    e5 = 0.0
+    e3 = 0.0
+    finite = True
+    for k in range(n):
+        s5 = 0.0
+        s3 = 0.0
+        for l in range(13):
+            s5 += E5[l] * K[l, k]
+            s3 += E3[l] * K[l, k]
+        scale = atol + max(abs(y[k]), abs(y_new[k])) * rtol
+        e5 += (s5 / scale) ** 2
+        e3 += (s3 / scale) ** 2
+        if not math.isfinite(y_new[k]):
+            finite = False
+    if e5 == 0.0 and e3 == 0.0:
+        return 0.0, finite
+    return h * e5 / math.sqrt((e5 + 0.01 * e3) * n), finite
+
+
+@_jit
+def stiff_step(K, y_new, ys, n, h):
+    """Hairer's stiffness test for one accepted step: h |lambda| > 6.1, with |lambda|
+    estimated from the last two stages."""
+    num = 0.0
+    den = 0.0
+    for k in range(n):
+        num += (K[12, k] - K[11, k]) ** 2
+        den += (y_new[k] - ys[k]) ** 2
+    return den > 0.0 and h * math.sqrt(num / den) > 6.1
+
+
+@_jit
+def dense_coefficients(model, J, g, A, D, K, y, y_new, h, n, ys, F, with_q):
+    """DOP853's 7th-order dense output over the step just taken: three extra stages, then the
+    coefficients F (7, n).  Returns the number of evaluations (3)."""
+    for s in range(13, 16):
+        stage_point(A, K, y, h, s, n, ys)
+        lie_rhs(model, J, g, ys, K[s], with_q)
+    for k in range(n):
+        dy = y_new[k] - y[k]
+        F[0, k] = dy
+        F[1, k] = h * K[0, k] - dy
+        F[2, k] = 2.0 * dy - h * (K[12, k] + K[0, k])
+        for r in range(4):
+            acc = 0.0
+            for l in range(16):
+                acc += D[r, l] * K[l, k]
+            F[3 + r, k] = h * acc
+    return 3
+
+
+@_jit
+def dense_eval(F, y, x, n, out):
+    """out = the dense-output state at the fraction x in [0, 1] of the step."""
+    for k in range(n):
+        v = 0.0
+        for r in range(7):
+            v += F[6 - r, k]
+            if r % 2 == 0:
+                v *= x
+            else:
+                v *= 1.0 - x
+        out[k] = y[k] + v
+
+
+@_jit
 def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps, stop_on_stiff,
                A, B, E3, E5, D):
     """Adaptive Lie-group DOP853 (error control and 7th-order dense output as in
@@ -240,33 +336,8 @@ def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps
     out_q[0, :] = q
     j_out = 1
     lie_rhs(model, J, g, y, K[0], with_q)
-    nfev = 1
-    # --- initial step (Hairer, Norsett & Wanner, II.4) ---
-    sc = np.empty(6)
-    for k in range(n):
-        sc[k] = atol + abs(y[k]) * rtol
-    d0 = 0.0
-    d1 = 0.0
-    for k in range(n):
-        d0 += (y[k] / sc[k]) ** 2
-        d1 += (K[0, k] / sc[k]) ** 2
-    d0 = math.sqrt(d0 / n)
-    d1 = math.sqrt(d1 / n)
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    h0 = min(h0, t_end - t)
-    for k in range(n):
-        ys[k] = y[k] + h0 * K[0, k]
-    lie_rhs(model, J, g, ys, K[1], with_q)
-    nfev += 1
-    d2 = 0.0
-    for k in range(n):
-        d2 += ((K[1, k] - K[0, k]) / sc[k]) ** 2
-    d2 = math.sqrt(d2 / n) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
-    h = min(100.0 * h0, h1, h_max)
+    h = initial_step(model, J, g, y, K, ys, n, rtol, atol, t_end - t, h_max, with_q)
+    nfev = 2
     nsteps = 0
     nrej = 0
     rejected = False
@@ -277,8 +348,7 @@ def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps
     while t < t_end:
         if nsteps >= max_steps:
             return out_w, out_q, nfev, nsteps, nrej, TOO_MANY_STEPS, stiff_at
-        min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
-        if h < min_step:
+        if h < 10.0 * abs(np.nextafter(t, np.inf) - t):
             return out_w, out_q, nfev, nsteps, nrej, STEP_UNDERFLOW, stiff_at
         if t + h > t_end:
             h = t_end - t
@@ -296,27 +366,9 @@ def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps
                 y_new[k] = y[k] + h * acc
         lie_rhs(model, J, g, y_new, K[12], with_q)
         nfev += 12
-        # error estimate (5th and 3rd order embedded), SciPy's norm
-        e5 = 0.0
-        e3 = 0.0
-        finite = True
-        for k in range(n):
-            s5 = 0.0
-            s3 = 0.0
-            for l in range(13):
-                s5 += E5[l] * K[l, k]
-                s3 += E3[l] * K[l, k]
-            scale = atol + max(abs(y[k]), abs(y_new[k])) * rtol
-            e5 += (s5 / scale) ** 2
-            e3 += (s3 / scale) ** 2
-            if not math.isfinite(y_new[k]):
-                finite = False
+        err, finite = error_norm(K, y, y_new, h, n, rtol, atol, E3, E5)
         if not finite:
             return out_w, out_q, nfev, nsteps, nrej, NOT_FINITE, stiff_at
-        if e5 == 0.0 and e3 == 0.0:
-            err = 0.0
-        else:
-            err = h * e5 / math.sqrt((e5 + 0.01 * e3) * n)
         if with_q:
             un = math.sqrt(y_new[3] * y_new[3] + y_new[4] * y_new[4] + y_new[5] * y_new[5])
             if un > U_MAX:
@@ -325,92 +377,60 @@ def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps
                 nrej += 1
                 rejected = True
                 continue
-        if err <= 1.0:
-            # Hairer's stiffness test: h |lambda| estimated from the last two stages
-            num = 0.0
-            den = 0.0
-            for k in range(n):
-                num += (K[12, k] - K[11, k]) ** 2
-                den += (y_new[k] - ys[k]) ** 2
-            if den > 0.0:
-                if h * math.sqrt(num / den) > 6.1:
-                    n_nonstiff = 0
-                    n_stiff += 1
-                    if n_stiff == 15 and stiff_at < 0.0:
-                        stiff_at = t
-                        if stop_on_stiff:
-                            return out_w, out_q, nfev, nsteps, nrej, STIFF, stiff_at
-                else:
-                    n_nonstiff += 1
-                    if n_nonstiff == 6:
-                        n_stiff = 0
-            t_old = t
-            et_old = et
-            if t_old + et_old + h < t_end:
-                t, et = compensated(t_old, h, et)
-            else:
-                t = t_end
-                et = 0.0
-            # dense output for every requested time in (t_old, t]
-            if j_out < N and t_eval[j_out] <= t:
-                for s in range(13, 16):
-                    stage_point(A, K, y, h, s, n, ys)
-                    lie_rhs(model, J, g, ys, K[s], with_q)
-                nfev += 3
-                for k in range(n):
-                    dy = y_new[k] - y[k]
-                    F[0, k] = dy
-                    F[1, k] = h * K[0, k] - dy
-                    F[2, k] = 2.0 * dy - h * (K[12, k] + K[0, k])
-                    for r in range(4):
-                        acc = 0.0
-                        for l in range(16):
-                            acc += D[r, l] * K[l, k]
-                        F[3 + r, k] = h * acc
-                while j_out < N and t_eval[j_out] <= t:
-                    x = ((t_eval[j_out] - t_old) - et_old) / h
-                    for k in range(n):
-                        v = 0.0
-                        for r in range(7):
-                            v += F[6 - r, k]
-                            if r % 2 == 0:
-                                v *= x
-                            else:
-                                v *= 1.0 - x
-                        ys[k] = y[k] + v
-                    out_w[j_out, 0] = ys[0]
-                    out_w[j_out, 1] = ys[1]
-                    out_w[j_out, 2] = ys[2]
-                    out_q[j_out, :] = q
-                    if with_q:
-                        apply_u(out_q[j_out], ys[3], ys[4], ys[5])
-                    j_out += 1
-            # accept: advance, move the orientation, restart the chart at u = 0
-            for k in range(n):
-                y[k] = y_new[k]
-            for k in range(3):
-                ec[k] = ec_new[k]
-            if with_q:
-                apply_u(q, y[3], y[4], y[5])
-                y[3] = 0.0
-                y[4] = 0.0
-                y[5] = 0.0
-            K[0, 0], K[0, 1], K[0, 2] = K[12, 0], K[12, 1], K[12, 2]   # FSAL for Omega
-            if with_q:
-                K[0, 3], K[0, 4], K[0, 5] = y[0], y[1], y[2]          # dexp^-1_0 = identity
-            nsteps += 1
-            if err == 0.0:
-                factor = 10.0
-            else:
-                factor = min(10.0, 0.9 * err ** err_exp)
-            if rejected:
-                factor = min(1.0, factor)
-            h = min(h * factor, h_max)
-            rejected = False
-        else:
+        if not err <= 1.0:                 # (a NaN error is a rejection too)
             h = h * max(0.2, 0.9 * err ** err_exp)
             nrej += 1
             rejected = True
+            continue
+        if stiff_step(K, y_new, ys, n, h):
+            n_nonstiff = 0
+            n_stiff += 1
+            if n_stiff == 15 and stiff_at < 0.0:
+                stiff_at = t
+                if stop_on_stiff:
+                    return out_w, out_q, nfev, nsteps, nrej, STIFF, stiff_at
+        else:
+            n_nonstiff += 1
+            if n_nonstiff == 6:
+                n_stiff = 0
+        t_old = t
+        et_old = et
+        if t_old + et_old + h < t_end:
+            t, et = compensated(t_old, h, et)
+        else:
+            t = t_end
+            et = 0.0
+        # dense output for every requested time in (t_old, t]
+        if j_out < N and t_eval[j_out] <= t:
+            nfev += dense_coefficients(model, J, g, A, D, K, y, y_new, h, n, ys, F, with_q)
+            while j_out < N and t_eval[j_out] <= t:
+                dense_eval(F, y, ((t_eval[j_out] - t_old) - et_old) / h, n, ys)
+                out_w[j_out, 0] = ys[0]
+                out_w[j_out, 1] = ys[1]
+                out_w[j_out, 2] = ys[2]
+                out_q[j_out, :] = q
+                if with_q:
+                    apply_u(out_q[j_out], ys[3], ys[4], ys[5])
+                j_out += 1
+        # accept: advance, move the orientation, restart the chart at u = 0
+        for k in range(n):
+            y[k] = y_new[k]
+        for k in range(3):
+            ec[k] = ec_new[k]
+        if with_q:
+            apply_u(q, y[3], y[4], y[5])
+            y[3] = 0.0
+            y[4] = 0.0
+            y[5] = 0.0
+        K[0, 0], K[0, 1], K[0, 2] = K[12, 0], K[12, 1], K[12, 2]   # FSAL for Omega
+        if with_q:
+            K[0, 3], K[0, 4], K[0, 5] = y[0], y[1], y[2]          # dexp^-1_0 = identity
+        nsteps += 1
+        factor = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** err_exp)
+        if rejected:
+            factor = min(1.0, factor)
+        h = min(h * factor, h_max)
+        rejected = False
     return out_w, out_q, nfev, nsteps, nrej, OK, stiff_at
 
 

@@ -8,7 +8,6 @@ per-call overhead on 3-vectors); the implicit methods get the exact Jacobian
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from ..physics.equations import euler_zxz_rate
 from .base import Integrator, Problem, Solution, register
@@ -69,6 +68,8 @@ def _make_solver(method: str, implicit: bool):
             kw["jac"] = jac
         if step is not None:
             kw["max_step"] = step
+        from scipy.integrate import solve_ivp
+
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             res = solve_ivp(f, (t[0], t[-1]), y0, method=method, t_eval=t, **kw)
         ok = res.status == 0 and res.y.shape[1] == t.size and bool(np.all(np.isfinite(res.y)))

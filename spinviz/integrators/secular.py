@@ -34,10 +34,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from .. import rotations as R
 from ..physics.equations import System
+from ..physics.free_top import pose_about_L
 from .base import Integrator, Problem, Solution, register
 
 M_PHASES = 32          # phase-average nodes: exact for trigonometric polynomials of degree < 32
@@ -119,21 +119,6 @@ def prepare(problem: Problem):
     return flow, (q_frame if rotated else None), np.array([wp0, float(w0[2]), 0.0, 0.0]), q_L, ang0, eps_rad
 
 
-def pose_about_L(q_L, phi, theta_L, psi, wp, w3, q_frame, with_q=True):
-    """(Omega_body, q) of a symmetric top from its ZXZ angles about L (arrays over time).
-
-    q = q_L (x) ZXZ(phi, theta_L, psi) (x) q_frame and Omega = (wp sin psi, wp cos psi, w3)
-    -- the free top's p = pi/2 - psi -- taken back from the frame q_frame (e3 along d for a
-    sphere; identity otherwise) to the body.  q is None unless ``with_q``.
-    """
-    q_frame = np.asarray(q_frame, dtype=float)
-    omega = R.body_from_world(q_frame, np.stack([wp * np.sin(psi), wp * np.cos(psi), w3], axis=-1))
-    if not with_q:
-        return omega, None
-    q = R.multiply(np.asarray(q_L, dtype=float), R.quat_from_euler_zxz(np.stack([phi, theta_L, psi], axis=-1)))
-    return omega, R.multiply(q, q_frame[None, :])
-
-
 def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, step: float | None = None) -> Solution:
     t = np.asarray(problem.t_eval, dtype=float)
     try:
@@ -143,6 +128,8 @@ def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, st
     kw = {"rtol": rtol, "atol": atol}
     if step:
         kw["max_step"] = step
+    from scipy.integrate import solve_ivp
+
     res = solve_ivp(flow.rhs, (t[0], t[-1]), y0, method="DOP853", t_eval=t, **kw)
     if res.status != 0 or not np.all(np.isfinite(res.y)):
         return Solution(t=t, omega=np.full((t.size, 3), np.nan), success=False,

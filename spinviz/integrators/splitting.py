@@ -17,7 +17,6 @@ the 8th-order DOP853 formula in substeps of at most 1/50 of the local decay time
 
 from __future__ import annotations
 
-from . import kernels as KN
 from . import tableaus as T
 from .base import Integrator, Problem, Solution, register
 from .geometric import MAX_STEPS, _args, _solution
@@ -33,6 +32,8 @@ def _solver(order: int):
             raise ValueError(f"method split{order} is fixed-step: give step > 0")
         if not problem.system.is_symmetric:
             raise ValueError(f"method split{order} needs a symmetric top (I1 = I2)")
+        from . import kernels as KN
+
         model, J, g, w0, q0, t, with_q = _args(problem)
         w, q, nfev, nsteps, status = KN.split_symmetric(model, J, g, w0, q0, t, float(step), gammas, with_q,
                                                         int(max_steps), RH_MAX, T.DOP853.A, T.DOP853.b)

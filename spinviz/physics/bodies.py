@@ -1,4 +1,4 @@
-"""Bodies and materials: inertia, dipole, shape, and the presets of section 6.
+"""Bodies: inertia, dipole and shape of a rigid body; the shapes that make one.
 
 A ``Body`` holds principal moments along body axes e1, e2, e3 and the body-frame
 dipole, in one of two unit systems (see ``spinviz.units``):
@@ -7,19 +7,18 @@ dipole, in one of two unit systems (see ``spinviz.units``):
 * ``"dimensionless"``: inertia relative (only ratios matter), dipole a direction; the
   dipole's size is implied by tau0 = 2|d|^2 / (3 I1 c^3) = 1.
 
-Each preset states where its numbers come from, and keeps the figures the paper
-prints, so ``spinviz info`` can show both (DESIGN.md, section 2).
+The presets of section 6 (cellulose rod, DAST crystals) are in ``presets``.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .. import units as U
-from ..rotations import quat_from_axis_angle, world_from_body
+from ..rotations import world_from_body
 from .equations import System, is_symmetric
 
 
@@ -92,6 +91,26 @@ class Body:
             raise BodyError("dipole", "is zero: tau0 (3.8) is undefined; give a dipole and use model = \"free\" for torque-free motion")
         if self.units not in U.UNIT_SYSTEMS:
             raise BodyError("units", f"unknown unit system {self.units!r}; valid: {', '.join(U.UNIT_SYSTEMS)}")
+
+    # -- plain data (saved trajectories carry their body) ---------------------------------
+    def to_dict(self) -> dict:
+        """JSON-ready description from which ``Body.from_dict`` rebuilds this body exactly."""
+        shape = None if self.shape is None else {
+            "kind": self.shape.kind, "dims": list(self.shape.dims),
+            "q_body_from_shape": list(self.shape.q_body_from_shape), "label": self.shape.label}
+        return {"name": self.name, "units": self.units, "inertia": [float(x) for x in self.inertia],
+                "dipole": [float(x) for x in self.dipole], "shape": shape, "source": self.source,
+                "printed": [dict(vars(p)) for p in self.printed], "reference_omega": self.reference_omega,
+                "extra": {k: float(v) for k, v in self.extra.items()}}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Body":
+        sh = d.get("shape")
+        shape = None if sh is None else Shape(sh["kind"], tuple(sh["dims"]), tuple(sh["q_body_from_shape"]), sh["label"])
+        return cls(name=d["name"], units=d["units"], inertia=tuple(d["inertia"]), dipole=tuple(d["dipole"]),
+                   shape=shape, source=d.get("source", ""),
+                   printed=tuple(PrintedFigure(**p) for p in d.get("printed", ())),
+                   reference_omega=d.get("reference_omega"), extra=dict(d.get("extra", {})))
 
     # -- derived quantities --------------------------------------------------------------
     @property
@@ -295,140 +314,3 @@ def symmetric_top(delta: float, chi: float, name="symmetric top", **kw) -> Body:
     if not math.isfinite(chi):
         raise BodyError("chi", f"must be finite, got {chi!r}")
     return custom((1.0, 1.0, 1.0 - delta), (math.sin(chi), 0.0, math.cos(chi)), units="dimensionless", name=name, **kw)
-
-
-# --- materials ---------------------------------------------------------------------------
-@dataclass(frozen=True)
-class DastCrystal:
-    """DAST (4-dimethylamino-N-methyl-4-stilbazolium tosylate) crystal data, section 6.2.
-
-    Source: the paper, section 6.2, after Ref. [MNS03]: cell 1.04 x 1.13 x 1.79 nm,
-    molecular weight 410.5, Z = 4 molecules per cell, 30 D per ion pair in the e1-e3
-    plane at 35 deg to e1; dipoles add up over the crystal.
-    """
-
-    cell_nm: tuple[float, float, float] = (1.04, 1.13, 1.79)
-    molar_mass: float = 410.5
-    z_per_cell: int = 4
-    pair_dipole_debye: float = 30.0
-    dipole_angle_from_e1_deg: float = 35.0
-
-    @property
-    def cell_volume_cm3(self) -> float:
-        a, b, c = self.cell_nm
-        return a * b * c * U.NM**3
-
-    @property
-    def density(self) -> float:
-        """rho = Z mu m_u / V_cell, g/cm^3 (1.30 from these data; the paper prints 1.37)."""
-        return self.z_per_cell * self.molar_mass * U.AMU / self.cell_volume_cm3
-
-    @property
-    def dipole_density(self) -> float:
-        """Dipole per volume, statC cm / cm^3 (about 57 D/nm^3)."""
-        return self.z_per_cell * self.pair_dipole_debye * U.DEBYE / self.cell_volume_cm3
-
-    @property
-    def dipole_direction_crystal(self) -> np.ndarray:
-        """Unit dipole in the crystal frame (a, b, c axes): 35 deg from a, in the a-c plane."""
-        t = math.radians(self.dipole_angle_from_e1_deg)
-        return np.array([math.cos(t), 0.0, math.sin(t)])
-
-
-DAST = DastCrystal()
-OMEGA_PAPER = math.pi * 1e10   # rad/s, the spin of Ref. [JYRLYZ21] used throughout section 6
-
-_DAST_SOURCE = (
-    "DAST crystal data of section 6.2 (cell 1.04 x 1.13 x 1.79 nm, mu = 410.5, Z = 4, "
-    "30 D per ion pair at 35 deg to e1 in the e1-e3 plane); density and dipole computed from them"
-)
-
-
-def dast_box(a_nm: float, b_nm: float, c_nm: float, density: float | None = None, name=None, crystal: DastCrystal = DAST, **kw) -> Body:
-    """A DAST a x b x c (nm) parallelepiped from the crystal data; edges along e1, e2, e3.
-
-    density : g/cm^3, default from the crystal data (1.30); pass 1.37 for the paper's value.
-    The dipole is the dipole density times the volume, along the crystal direction.
-    """
-    a, b, c = (_positive(k, v) * U.NM for k, v in (("a_nm", a_nm), ("b_nm", b_nm), ("c_nm", c_nm)))
-    rho = crystal.density if density is None else _positive("density", density)
-    d = crystal.dipole_density * a * b * c * crystal.dipole_direction_crystal
-    kw.setdefault("source", _DAST_SOURCE)
-    kw.setdefault("reference_omega", OMEGA_PAPER)
-    return box(a, b, c, rho, d, name=name or f"DAST {a_nm:g} x {b_nm:g} x {c_nm:g} nm", **kw)
-
-
-# --- presets of section 6 ------------------------------------------------------------------
-def cellulose_rod(density: float | None = None) -> Body:
-    """Cellulose nanocrystal, section 6.1 (Ref. [F-PBL14]): L = 315 nm, L/D = 10,
-    rho = 1.6 g/cm^3 (or ``density``), 4400 D along the axis (chi = 0)."""
-    L = 315.0 * U.NM
-    return rod(
-        L, L / 10.0, 1.6 if density is None else density, 4400.0 * U.DEBYE, 0.0,
-        name="cellulose nanocrystal",
-        source="section 6.1 after Ref. [F-PBL14]: L = 315 nm, L/D = 10, rho = 1.6 g/cm^3, 4400 D along the axis",
-        reference_omega=OMEGA_PAPER,
-        printed=(
-            PrintedFigure("I1", 3.3e-26, "section 6.1"),
-            PrintedFigure("I3", 4.11e-28, "section 6.1 (its epsilon = 0.015 fits 4.87e-28)"),
-            PrintedFigure("epsilon", 0.015, "section 6.1"),
-            PrintedFigure("tau0", 1.4e-35, "section 6.1"),
-            PrintedFigure("T", 3e6 * U.YEAR, "section 6.1, after (6.1)", approx=True),
-            PrintedFigure("Theta", 1e10 * U.YEAR, "section 6.1, before (6.1)", approx=True),
-        ),
-    )
-
-
-def dast_cube(a_nm: float = 100.0, density: float | None = None) -> Body:
-    """Cubic DAST nanocrystal, section 6.2: a = 100 nm, a spherical top (delta = 0).
-
-    Any axes are principal for a cube; as the paper does, the body frame has e3 along d
-    (chi = 0), reached from the crystal axes by a rotation about b.  The drawn cube keeps
-    its crystal faces through ``Shape.q_body_from_shape``.
-    """
-    base = dast_box(a_nm, a_nm, a_nm, density)
-    n_c = DAST.dipole_direction_crystal
-    beta = -math.atan2(n_c[0], n_c[2])                     # rotation about b taking d to e3
-    q = tuple(float(x) for x in quat_from_axis_angle((0.0, 1.0, 0.0), beta))
-    s = base.shape
-    return Body(
-        name=f"DAST cube {a_nm:g} nm",
-        units="cgs",
-        inertia=base.inertia,
-        dipole=(0.0, 0.0, base.dipole_magnitude),
-        shape=Shape("box", s.dims, q, label="cube (crystal faces)"),
-        source=_DAST_SOURCE + "; body axes with e3 along d, as in section 6.2",
-        reference_omega=OMEGA_PAPER,
-        extra=dict(base.extra),
-        printed=(
-            PrintedFigure("density", 1.37, "section 6.2"),
-            PrintedFigure("I1", 2.3e-26, "section 6.2, after (6.10)"),
-            PrintedFigure("d_debye", 5.6e7, "section 6.2, after (6.10)"),
-            PrintedFigure("tau0", 3.4e-27, "section 6.2, after (6.10)"),
-            PrintedFigure("Theta", 4.0 * U.DAY, "section 6.2, after (6.10)", approx=True),
-        ) if a_nm == 100.0 else (),
-    )
-
-
-def dast_family1(a_nm: float = 100.0, c_nm: float = 50.0, density: float | None = None) -> Body:
-    """DAST family-1 box a = b = 100 nm, c = 50 nm (section 6.2): delta = -0.6, chi = 55 deg."""
-    body = dast_box(a_nm, a_nm, c_nm, density, name=f"DAST family-1 box {a_nm:g} x {a_nm:g} x {c_nm:g} nm")
-    if (a_nm, c_nm) != (100.0, 50.0):
-        return body
-    return replace(
-        body,
-        printed=(
-            PrintedFigure("density", 1.37, "section 6.2"),
-            PrintedFigure("I1", 7.14e-27, "section 6.2, family 1"),
-            PrintedFigure("delta", -0.6, "section 6.2, family 1"),
-            PrintedFigure("chi_deg", 55.0, "section 6.2, family 1"),
-            PrintedFigure("d_debye", 2.8e7, "section 6.2, family 1"),
-        ),
-    )
-
-
-PRESETS = {
-    "cellulose_rod": cellulose_rod,
-    "dast_cube": dast_cube,
-    "dast_family1": dast_family1,
-}

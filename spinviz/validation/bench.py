@@ -27,12 +27,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import rotations as R
-from .integrators import get
-from .physics import closed_forms as CF
-from .physics.bodies import symmetric_top
-from .physics.equations import System
-from .simulate import spin_problem
+from .. import rotations as R
+from ..integrators import get
+from ..integrators.scaling import spin_problem
+from ..physics import closed_forms as CF
+from ..physics.bodies import symmetric_top
+from ..physics.equations import System
 
 TARGET_ERROR = 1e-8
 N_OUT = 41
@@ -369,7 +369,7 @@ def format_table(rows: list[Row], summ: list[dict], notes) -> str:
 
 def plot(rows: list[Row], path: str) -> None:
     """Error against time, log-log, one line per method; one panel per problem and horizon."""
-    from .plotting import pyplot, save
+    from ..plotting import pyplot, save
 
     plt = pyplot()
 

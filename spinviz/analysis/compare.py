@@ -17,10 +17,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import rotations as R
-from .plotting import pyplot, save
-from .timeline import format_time
-from .trajectory import Trajectory
+from .. import rotations as R
+from ..plotting import pyplot, save
+from ..trajectory import Trajectory
+from ..units import format_time
 
 THRESHOLDS_DEG = (1.0, 10.0)
 

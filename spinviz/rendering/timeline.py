@@ -28,11 +28,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import rotations as R
-from . import units as U
-from .integrators.secular import pose_about_L
-from .scene import RenderSpec
-from .trajectory import Trajectory
+from .. import rotations as R
+from ..physics.free_top import pose_about_L
+from ..trajectory import Trajectory
+from ..units import format_omega, format_time
+from .spec import RenderSpec
 
 MAX_TRUE_DEG_PER_FRAME = 30.0
 
@@ -61,15 +61,6 @@ def time_map_label(spec: RenderSpec, t_end: float, units: str) -> str:
         return "time: linear"
     k = spec.log_knee or t_end / 1000.0
     return f"time: logarithmic after {format_time(k, units)}"
-
-
-def format_time(t: float, units: str) -> str:
-    """Physical time in the best human unit (CGS), or in tau0 (dimensionless)."""
-    return U.human_time(t) if units == "cgs" else f"{t:.4g} \u03c40"
-
-
-def format_omega(w: float, units: str) -> str:
-    return f"|\u03a9| = {w:.3g} rad/s" if units == "cgs" else f"|\u03c9| = {w:.3g} /\u03c40"
 
 
 @dataclass

@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 
-from . import units as U
-from .physics.bodies import Body
+from .. import units as U
+from ..physics.bodies import Body
 
 FLAG_THRESHOLD = 0.05
 

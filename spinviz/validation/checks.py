@@ -22,10 +22,10 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from . import rotations as R
-from .physics import bodies as B
-from .physics import closed_forms as CF
-from .simulate import simulate
+from .. import rotations as R
+from ..driver import simulate
+from ..physics import bodies as B
+from ..physics import closed_forms as CF
 
 RTOL, ATOL = 1e-12, 1e-14      # tight: exact checks must sit at the integrator's tolerance
 

@@ -12,10 +12,13 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from . import rotations as R
-from .physics import bodies as B
-from .physics import closed_forms as CF
-from .simulate import SimulationError, simulate, stiffness_ratio
+from .. import rotations as R
+from ..driver import simulate
+from ..errors import SimulationError
+from ..integrators.auto import stiffness_ratio
+from ..physics import bodies as B
+from ..physics import closed_forms as CF
+from ..physics import presets as P
 
 
 @dataclass
@@ -150,7 +153,7 @@ def case_truncated_singularity() -> StressResult:
     Omega_dot ~ 300) the run must move away from the surface and agree with Radau; started
     just beyond it (denominator -1e-3) it must stop with an error that names the singularity,
     not integrate into it or return NaNs."""
-    from .physics.equations import truncated_singularity
+    from ..physics.equations import truncated_singularity
 
     body = B.custom((1.0, 1.0, 0.3), (0.6, 0.0, 0.8), units="dimensionless")
     s = body.system("truncated")
@@ -178,7 +181,7 @@ def case_truncated_singularity() -> StressResult:
 def case_real_cgs_rod() -> StressResult:
     """Cellulose rod with real parameters (tau0 = 1.46e-35 s, Omega = pi 1e10 /s) over 3 T in
     CGS: no overflow or underflow; the truncated spin-down matches (6.2)'s |Omega_perp|, Omega3."""
-    rod = B.cellulose_rod()
+    rod = P.cellulose_rod()
     W = math.pi * 1e10
     T = rod.braking_time_T(W)                  # the paper's T = 1/(tau0 Omega20^2), 2.2e6 years
     tr, dt = _timed(lambda: simulate(rod, "truncated", (0.0, W, W), t_end=3.0 * T, samples=61))
@@ -197,7 +200,7 @@ def case_real_cgs_rod() -> StressResult:
 def case_real_dast_cube() -> StressResult:
     """The DAST cube with real parameters over 10 Theta (~1e16 turns): |Omega_perp|, Omega3 and
     theta (d from the rotation axis) against (6.7) and (6.8), to 1e-6 relative, in < 1 s."""
-    cube = B.dast_cube()
+    cube = P.dast_cube()
     W = math.pi * 1e10
     Th = 1.0 / (cube.tau0 * W**2)
     tr, dt = _timed(lambda: simulate(cube, "reduced", (0.0, W, W), t_end=10.0 * Th, samples=201,

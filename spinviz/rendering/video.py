@@ -1,4 +1,4 @@
-"""Off-screen rendering to video: the only part of spinviz that imports pyvista/imageio.
+"""The render-and-encode pipeline: a ``timeline.FramePlan`` to an MP4 or GIF and a PNG poster.
 
 ``render_video(plan, out)`` draws every frame of a ``timeline.FramePlan`` and encodes it;
 ``render_frames`` draws chosen frames in this process (tests, stills).  The renderer
@@ -21,19 +21,15 @@ import sys
 import tempfile
 import time
 import traceback
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..atomic import AtomicPath
+from ..errors import RenderError
 from .encode import Mp4Writer, open_writer, save_png
 
 __all__ = ["render_video", "render_frames", "RenderResult", "RenderError"]
-
-
-class RenderError(RuntimeError):
-    """Rendering failed; the message says where (a worker's last traceback line included)."""
-
 
 @dataclass
 class RenderResult:
@@ -44,6 +40,7 @@ class RenderResult:
     seconds: float
     startup_seconds: float
     workers: int
+    notes: list = field(default_factory=list)        # what the plan chose and why (spin mode)
 
     @property
     def fps(self) -> float:
@@ -164,7 +161,7 @@ def render_video(plan, out: str, size=None, workers: int | None = None, supersam
         raise
     seconds = time.perf_counter() - start
     return RenderResult(path=out, poster=poster_path, frames=F, size=size, seconds=seconds,
-                        startup_seconds=startup, workers=workers)
+                        startup_seconds=startup, workers=workers, notes=list(plan.notes))
 
 
 def _render_in_process(plan, path, size, supersample, F, poster_f, bar):

@@ -1,0 +1,195 @@
+"""Scene or trajectories -> frame plan -> video or frames: ``spinviz.render``, ``render_frame``.
+
+A scene is simulated once per model, with the frame times as output instants and with the
+orientation only when something shown needs it; trajectories are used as they are (the
+renderer never steps physics).  Rendering (the heavy optional stack) is imported only
+when a picture is asked for.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Sequence, Union
+
+import numpy as np
+
+from .driver import simulate
+from .errors import UsageError
+from .rendering.spec import RenderSpec
+from .rendering.timeline import FramePlan, frame_times, plan_frames
+from .scene import Scene, load_scene
+from .trajectory import Trajectory
+
+__all__ = ["render", "render_frame", "Renderer", "plan", "require_render_stack", "default_output"]
+
+OPTIONAL_RENDER_MODULES = {"pyvista", "vtk", "vtkmodules", "imageio", "imageio_ffmpeg", "PIL"}
+MAX_STORED_TURN = np.pi / 2         # slerp between stored orientations needs neighbours closer than this
+
+Source = Union[Scene, str, os.PathLike, Trajectory, Sequence[Trajectory]]
+
+
+class MissingRenderStack(UsageError, ImportError):
+    """The rendering extra is not installed; str() says what to install."""
+
+
+def require_render_stack():
+    """Import ``spinviz.rendering.video``, or explain in one line which optional package is missing."""
+    try:
+        import imageio_ffmpeg  # noqa: F401
+        import PIL  # noqa: F401
+        import pyvista  # noqa: F401
+        import vtk  # noqa: F401
+
+        from .rendering import video
+    except ImportError as e:
+        name = (e.name or "").split(".")[0]
+        if name in OPTIONAL_RENDER_MODULES:
+            raise MissingRenderStack(
+                f"rendering needs the optional package {name!r}: pip install 'spinviz[render]'"
+            ) from None
+        raise
+    return video
+
+
+# --- what to draw ------------------------------------------------------------------------
+def _as_source(source: Source):
+    """(scene or None, trajectories or None) from any accepted source."""
+    if isinstance(source, (str, os.PathLike)):
+        return load_scene(source), None
+    if isinstance(source, Scene):
+        return source, None
+    trajs = [source] if isinstance(source, Trajectory) else list(source)
+    if not 1 <= len(trajs) <= 2 or not all(isinstance(t, Trajectory) for t in trajs):
+        raise UsageError("render a scene, a Trajectory or a list of one or two Trajectories")
+    return None, trajs
+
+
+def resolve_spec(source: Source, **overrides) -> tuple[Scene | None, list[Trajectory] | None, RenderSpec]:
+    """The source and its render spec with ``overrides`` (size, fps, duration, show, ...):
+    a scene's ``[render]`` table, or the defaults for trajectories."""
+    scene, trajs = _as_source(source)
+    base = scene.render if scene is not None else RenderSpec()
+    spec = base.with_(**overrides)
+    spec.check_horizon(scene.t_end if scene is not None else float(trajs[0].t[-1]))
+    return scene, trajs, spec
+
+
+def scene_trajectories(scene: Scene, spec: RenderSpec, t_end: float | None = None) -> list[Trajectory]:
+    """One trajectory per model, stored at the frame times (kinematics only if shown)."""
+    _, sim_t, _ = frame_times(spec, scene.t_end if t_end is None else t_end)
+    kw = scene.simulation_kwargs(kinematics="quaternion" if spec.needs_orientation else "none", t_eval=sim_t)
+    return [simulate(scene.body, m, **kw) for m in scene.models]
+
+
+def _check_drawable(trajs: list[Trajectory], spec: RenderSpec) -> None:
+    """Frames are interpolated between stored instants: orientations must be stored closely
+    enough for slerp (or carry the slow geometry of a ``secular`` run)."""
+    if not spec.needs_orientation:
+        return
+    for tr in trajs:
+        if tr.q is None:
+            raise UsageError(f"this {tr.model} trajectory has no orientation; simulate with kinematics=\"quaternion\" "
+                             f"or show only the hodograph")
+        if tr.slow is not None:
+            continue
+        turn = float(np.max(tr.omega_magnitude[:-1] * np.diff(tr.t))) if tr.t.size > 1 else 0.0
+        if turn > MAX_STORED_TURN:
+            raise UsageError(f"the {tr.model} trajectory is stored too coarsely to draw (up to {np.degrees(turn):.0f} deg "
+                             f"between samples); simulate it at more instants")
+
+
+def plan(source: Source, t: float | None = None, frames: int | None = None, **overrides) -> FramePlan:
+    """The frame plan of a video of ``source`` from 0 to ``t`` (default: the whole run)."""
+    scene, trajs, spec = resolve_spec(source, **overrides)
+    return _plan(scene, trajs, spec, t, frames)
+
+
+def _plan(scene, trajs, spec: RenderSpec, t=None, frames=None) -> FramePlan:
+    if scene is not None:
+        t_end = scene.t_end if t is None else _within(t, scene.t_end)
+        trajs = scene_trajectories(scene, spec, t_end)
+    else:
+        t_end = float(trajs[0].t[-1]) if t is None else _within(t, float(trajs[0].t[-1]))
+        _check_drawable(trajs, spec)
+        if t is not None:
+            trajs = [tr.sample(frame_times(spec, t_end, frames)[1]) for tr in trajs]
+    return plan_frames(spec, trajs, frames)
+
+
+def _within(t, t_end: float) -> float:
+    t = float(t)
+    if not 0.0 < t <= t_end:
+        raise UsageError(f"t must lie in (0, {t_end:g}], got {t:g}")
+    return t
+
+
+# --- pictures ------------------------------------------------------------------------------
+class Renderer:
+    """Off-screen windows drawing the frames of one plan; use as a context manager so that
+    the windows are released::
+
+        with spinviz.Renderer("scenes/default.toml", size=(640, 360)) as r:
+            img = r.frame(r.frames - 1)        # (360, 640, 3) uint8
+
+    ``source``: a scene (object or path), a Trajectory, or a list of two (one per panel).
+    """
+
+    def __init__(self, source: Source, t: float | None = None, **overrides):
+        video = require_render_stack()
+        self.plan = plan(source, t=t, **overrides)
+        self._session = None
+        self._render_frames = video.render_frames
+
+    @property
+    def frames(self) -> int:
+        return self.plan.frames
+
+    def frame(self, f: int) -> np.ndarray:
+        """Frame ``f`` (0 .. frames - 1) as an RGB array (H, W, 3), uint8."""
+        if not 0 <= f < self.frames:
+            raise UsageError(f"frame must lie in 0..{self.frames - 1}, got {f}")
+        if self._session is None:
+            imgs, self._session = self._render_frames(self.plan, [f], self.plan.spec.size)
+            return imgs[0]
+        return self._session.frame(f)
+
+    def close(self) -> None:
+        if self._session is not None:
+            self._session.close()
+            self._session = None
+
+    def __enter__(self) -> "Renderer":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def render_frame(source: Source, t: float | None = None, *, size=(640, 360), **overrides) -> np.ndarray:
+    """The picture at time ``t`` (scene units; default the end), as an RGB array (H, W, 3).
+
+    It is the last frame of the video of [0, t] (the trail and, for a slowed spin, the shown
+    phase depend on what came before).  Shows nicely in Jupyter with
+    ``PIL.Image.fromarray(img)`` or ``matplotlib.pyplot.imshow(img)``."""
+    with Renderer(source, t=t, size=tuple(size), **overrides) as r:
+        return r.frame(r.frames - 1)
+
+
+def render(source: Source, out: str | None = None, *, size=None, fps=None, duration=None, workers=None,
+           progress: bool = False, **overrides):
+    """Render ``source`` to ``out`` (.mp4 or .gif) and a PNG poster beside it; returns a
+    ``RenderResult`` (path, poster, frames, seconds, fps).  ``out`` defaults to
+    ``renders/<scene>.mp4`` for a scene.  Other keywords override ``[render]`` settings."""
+    scene, trajs, spec = resolve_spec(source, size=size, fps=fps, duration=duration, **overrides)
+    if out is None:
+        if scene is None:
+            raise UsageError("give out=... (a .mp4 or .gif path) to render trajectories")
+        out = default_output(scene)
+    spec.check_output(out, len(scene.models) if scene is not None else len(trajs))
+    video = require_render_stack()
+    return video.render_video(_plan(scene, trajs, spec), out, workers=workers, progress=progress)
+
+
+def default_output(scene: Scene, directory: str = "renders") -> str:
+    stem = os.path.splitext(os.path.basename(scene.path))[0]
+    return os.path.join(directory, f"{stem}.mp4")

@@ -43,7 +43,8 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--duration", type=_real, help="video length in seconds")
     r.add_argument("--workers", type=_positive, help="render processes (default: one per core)")
     r.add_argument("--bench", action="store_true",
-                   help="measure frames per second at 1280x720 and 1920x1080, encoding included (writes to a temporary directory)")
+                   help="measure frames per second at 1280x720 and 1920x1080, encoding included "
+                        "(writes to a temporary directory)")
     r.add_argument("--frames", type=_positive, default=150, help="frames per benchmark size (with --bench)")
     r.add_argument("--json", metavar="PATH", help="with --bench: also write the results as JSON")
     r.add_argument("--plot", metavar="PATH", help="with --bench: also draw frames per second against the targets (PNG)")
@@ -51,7 +52,8 @@ def _parser() -> argparse.ArgumentParser:
 
     c2 = sub.add_parser("compare", help="reduced vs truncated for a two-model scene: angles, crossing times, final states, plots")
     c2.add_argument("scene")
-    c2.add_argument("--out", help="prefix of the PNG plots (default renders/<scene>): <prefix>_compare.png, <prefix>_hodograph.png")
+    c2.add_argument("--out", help="prefix of the PNG plots (default renders/<scene>): "
+                                  "<prefix>_compare.png, <prefix>_hodograph.png")
     c2.add_argument("--samples", type=_positive, default=800, help="evenly spaced plus as many log-spaced output times")
     c2.add_argument("--json", action="store_true", help="print the results as JSON")
 
@@ -263,7 +265,8 @@ def _cmd_compare(args) -> int:
 
     sc = load_scene(args.scene)
     if len(sc.models) != 2:
-        raise UsageError(f"{args.scene}: [simulation].models: compare needs two models, e.g. models = [\"reduced\", \"truncated\"]")
+        raise UsageError(f"{args.scene}: [simulation].models: compare needs two models, "
+                         f"e.g. models = [\"reduced\", \"truncated\"]")
     try:
         import matplotlib  # noqa: F401
     except ImportError:

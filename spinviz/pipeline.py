@@ -9,7 +9,7 @@ when a picture is asked for.
 from __future__ import annotations
 
 import os
-from typing import Sequence, Union
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -25,7 +25,7 @@ __all__ = ["render", "render_frame", "Renderer", "plan", "require_render_stack",
 OPTIONAL_RENDER_MODULES = {"pyvista", "vtk", "vtkmodules", "imageio", "imageio_ffmpeg", "PIL"}
 MAX_STORED_TURN = np.pi / 2         # slerp between stored orientations needs neighbours closer than this
 
-Source = Union[Scene, str, os.PathLike, Trajectory, Sequence[Trajectory]]
+Source = Scene | str | os.PathLike | Trajectory | Sequence[Trajectory]
 
 
 class MissingRenderStack(UsageError, ImportError):
@@ -149,7 +149,7 @@ class Renderer:
         if not 0 <= f < self.frames:
             raise UsageError(f"frame must lie in 0..{self.frames - 1}, got {f}")
         if self._session is None:
-            imgs, self._session = self._render_frames(self.plan, [f], self.plan.spec.size)
+            imgs, self._session = self._render_frames(self.plan, [f])
             return imgs[0]
         return self._session.frame(f)
 
@@ -158,7 +158,7 @@ class Renderer:
             self._session.close()
             self._session = None
 
-    def __enter__(self) -> "Renderer":
+    def __enter__(self) -> Renderer:
         return self
 
     def __exit__(self, *exc) -> None:

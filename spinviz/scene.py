@@ -131,7 +131,7 @@ class _Table:
             raise self.error(present[1], f"give only one of {', '.join(keys)}")
         return present[0] if present else None
 
-    def sub(self, k: str, required=False) -> "_Table | None":
+    def sub(self, k: str, required=False) -> _Table | None:
         if required and k not in self.data:
             raise SceneError(self.path, f"[{self.name}.{k}]" if self.name else f"[{k}]", "missing table")
         v = self.raw(k, None)
@@ -232,7 +232,10 @@ def _shape(t: _Table) -> B.Body:
         length = t.number("length_nm", required=True, positive=True) * U.NM
         if t.has("diameter_nm") == t.has("aspect"):
             raise t.error("diameter_nm", "give diameter_nm or aspect (L/D), exactly one")
-        diameter = t.number("diameter_nm", positive=True) * U.NM if t.has("diameter_nm") else length / t.number("aspect", positive=True)
+        if t.has("diameter_nm"):
+            diameter = t.number("diameter_nm", positive=True) * U.NM
+        else:
+            diameter = length / t.number("aspect", positive=True)
         dipole = t.number("dipole_debye", required=True, positive=True) * U.DEBYE
         return B.rod(length, diameter, density, dipole, t.angle("chi", 0.0), name=name)
     a, b, c = (t.number(k, required=True, positive=True) * U.NM for k in ("a_nm", "b_nm", "c_nm"))

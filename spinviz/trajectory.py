@@ -20,7 +20,6 @@ from .atomic import atomic_path
 from .physics.bodies import Body
 from .physics.equations import angular_momentum_world, kinetic_energy
 
-
 SLOW_SERIES = ("phi_L", "theta_L", "psi_L")       # the time series of a ``slow`` record
 
 
@@ -122,7 +121,7 @@ class Trajectory:
             raise ValueError(f"{what} needs the orientation, which this run did not integrate")
 
     # -- resampling ----------------------------------------------------------------------
-    def sample(self, times) -> "Trajectory":
+    def sample(self, times) -> Trajectory:
         """The trajectory at ``times`` (within [t0, t_end]): Omega by cubic Hermite with the
         model's Omega_dot, q by slerp between stored orientations.  No integration.
 
@@ -246,7 +245,7 @@ class Trajectory:
     save_npz = save
 
     @classmethod
-    def load(cls, path) -> "Trajectory":
+    def load(cls, path) -> Trajectory:
         """A trajectory written by ``save`` (or ``spinviz simulate --out``): arrays, body, model,
         stats and slow geometry as they were."""
         with np.load(path, allow_pickle=False) as z:

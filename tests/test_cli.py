@@ -105,8 +105,10 @@ samples = 3
      "[simulation].model: unknown value 'schott'; valid: reduced, truncated, free"),
     ("delta out of range", GOOD.replace("delta = 0.3", "delta = 1.5"), "[body].delta: must satisfy -1 <= delta < 1 (3.6)"),
     ("wrong type", GOOD.replace("samples = 40", 'samples = "many"'), "[simulation].samples: must be an integer"),
-    ("bad vector", GOOD.replace("omega = [0.0, 0.05, 0.3]", "omega = [0.0, 0.05]"), "[initial].omega: must be a list of 3 numbers"),
-    ("unknown method", GOOD.replace("samples = 40", 'samples = 40\nmethod = "euler"'), "[simulation].method: unknown method 'euler'"),
+    ("bad vector", GOOD.replace("omega = [0.0, 0.05, 0.3]", "omega = [0.0, 0.05]"),
+     "[initial].omega: must be a list of 3 numbers"),
+    ("unknown method", GOOD.replace("samples = 40", 'samples = 40\nmethod = "euler"'),
+     "[simulation].method: unknown method 'euler'"),
     ("bad TOML", "[body\n", "(file): invalid TOML"),
 ]
 

@@ -9,9 +9,9 @@ import pytest
 
 from spinviz.analysis import compare as C
 from spinviz.cli import main
+from spinviz.driver import simulate
 from spinviz.physics import bodies as B
 from spinviz.physics import presets as P
-from spinviz.driver import simulate
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 

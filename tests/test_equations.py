@@ -13,8 +13,6 @@ import pytest
 from spinviz import units as U
 from spinviz.physics import equations as E
 
-RNG = np.random.default_rng(20261121)
-
 
 def eq_3_3_to_3_5(w, I1, I3, d, chi, c_power=3):
     """(3.3)-(3.5) transcribed from the paper, CGS, with c^c_power in the prefactor."""
@@ -47,18 +45,18 @@ def eq_4_2_to_4_4(w, delta, chi):
 
 
 @pytest.mark.parametrize("trial", range(20))
-def test_reduced_equals_3_3_to_3_5_with_c_cubed(trial):
+def test_reduced_equals_3_3_to_3_5_with_c_cubed(trial, rng):
     """(2.2)+(2.3) in CGS = (3.3)-(3.5) read with c^3, for random parameters.
 
     Omega is chosen so that tau0 |Omega| ~ 0.1-1: for real particles (1e-16) the
     radiation part would sit below the round-off of the free part and compare nothing.
     """
-    I1 = 10 ** RNG.uniform(-27, -25)
-    I3 = I1 * RNG.uniform(0.05, 1.95)
-    d = 10 ** RNG.uniform(-11, -7)
-    chi = RNG.uniform(0.0, 0.5 * math.pi)
+    I1 = 10 ** rng.uniform(-27, -25)
+    I3 = I1 * rng.uniform(0.05, 1.95)
+    d = 10 ** rng.uniform(-11, -7)
+    chi = rng.uniform(0.0, 0.5 * math.pi)
     tau0 = U.tau0_cgs(d, I1)
-    w = RNG.normal(size=3) * RNG.uniform(0.1, 1.0) / tau0
+    w = rng.normal(size=3) * rng.uniform(0.1, 1.0) / tau0
     g = U.radiation_coupling((d * math.sin(chi), 0.0, d * math.cos(chi)))
     got = np.array(E.reduced_rate(*w, (I1, I1, I3), tuple(g)))
     want = eq_3_3_to_3_5(w, I1, I3, d, chi, c_power=3)
@@ -79,20 +77,20 @@ def test_c_squared_as_printed_disagrees_with_2_2():
 
 
 @pytest.mark.parametrize("trial", range(20))
-def test_reduced_equals_4_2_to_4_4(trial):
+def test_reduced_equals_4_2_to_4_4(trial, rng):
     """Dimensionless general reduced equation = (4.2)-(4.4) for random delta, chi, omega."""
-    delta = RNG.uniform(-1.0, 0.95)
-    chi = RNG.uniform(0.0, 0.5 * math.pi)
-    w = RNG.normal(size=3)
+    delta = rng.uniform(-1.0, 0.95)
+    chi = rng.uniform(0.0, 0.5 * math.pi)
+    w = rng.normal(size=3)
     got = E.reduced_rate(*w, (1.0, 1.0, 1.0 - delta), (math.sin(chi), 0.0, math.cos(chi)))
     np.testing.assert_allclose(got, eq_4_2_to_4_4(w, delta, chi), rtol=1e-12, atol=1e-13)
 
 
 @pytest.mark.parametrize("trial", range(10))
-def test_truncated_equals_5_3_at_chi_0(trial):
+def test_truncated_equals_5_3_at_chi_0(trial, rng):
     """(2.5) at chi = 0 = (5.3): omega_dot_perp = free - omega_perp^2 omega_perp, omega3_dot = -omega_perp^2 omega3."""
-    delta = RNG.uniform(-1.0, 0.95)
-    w1, w2, w3 = RNG.normal(size=3)
+    delta = rng.uniform(-1.0, 0.95)
+    w1, w2, w3 = rng.normal(size=3)
     wp2 = w1 * w1 + w2 * w2
     want = [delta * w2 * w3 - wp2 * w1, -delta * w1 * w3 - wp2 * w2, -wp2 * w3]
     got = E.truncated_rate(w1, w2, w3, (1.0, 1.0, 1.0 - delta), (0.0, 0.0, 1.0))
@@ -100,12 +98,12 @@ def test_truncated_equals_5_3_at_chi_0(trial):
 
 
 @pytest.mark.parametrize("trial", range(10))
-def test_truncated_solves_2_5_exactly_for_asymmetric_bodies(trial):
+def test_truncated_solves_2_5_exactly_for_asymmetric_bodies(trial, rng):
     """The Sherman-Morrison solution makes the residual of (2.5) vanish, any inertia and dipole."""
-    J = np.sort(RNG.uniform(0.3, 1.0, size=3))
+    J = np.sort(rng.uniform(0.3, 1.0, size=3))
     J[2] = min(J[2], J[0] + J[1])
-    g = RNG.normal(size=3) * 0.4
-    w = RNG.normal(size=3) * 0.5
+    g = rng.normal(size=3) * 0.4
+    w = rng.normal(size=3) * 0.5
     wd = np.array(E.truncated_rate(*w, tuple(J), tuple(g)))
     lhs = J * wd + np.cross(w, J * w)
     rhs = -(np.dot(np.cross(g, w), np.cross(g, w)) * w + np.dot(g, np.cross(w, wd)) * g)
@@ -141,11 +139,11 @@ def test_jacobian_matches_finite_differences(model):
     np.testing.assert_allclose(jac, fd, rtol=1e-7, atol=1e-9)
 
 
-def test_free_rate_conserves_energy_and_body_momentum_magnitude():
+def test_free_rate_conserves_energy_and_body_momentum_magnitude(rng):
     """d/dt (1/2 W.JW) = 0 and d/dt |JW|^2 = 0 along (2.3a), exactly (not just numerically)."""
     J = np.array([1.0, 0.6, 0.5])
     for _ in range(5):
-        w = RNG.normal(size=3)
+        w = rng.normal(size=3)
         wd = np.array(E.free_rate(*w, tuple(J), None))
         assert abs(np.dot(J * w, wd)) < 1e-14
         assert abs(np.dot(J * w, J * wd)) < 1e-14
@@ -177,11 +175,11 @@ def test_askew_top_gains_energy_at_some_states():
         assert 0 < np.mean(np.array(rates) > 0) < 0.05
 
 
-def test_quat_rate_matches_quaternion_product():
+def test_quat_rate_matches_quaternion_product(rng):
     from spinviz import rotations as R
 
-    q = R.normalize(RNG.normal(size=4))
-    w = RNG.normal(size=3)
+    q = R.normalize(rng.normal(size=4))
+    w = rng.normal(size=3)
     want = 0.5 * R.multiply(q, np.concatenate([[0.0], w]))
     np.testing.assert_allclose(E.quat_rate(*q, *w), want, atol=1e-15)
 

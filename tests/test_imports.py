@@ -35,5 +35,27 @@ def test_import_spinviz_is_light():
 ])
 def test_cli_commands_never_import_rendering(argv, tmp_path):
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
-    mods = loaded(f"from spinviz.cli import main\nimport contextlib, io\nwith contextlib.redirect_stdout(io.StringIO()):\n    assert main({argv!r}) == 0")
+    mods = loaded("from spinviz.cli import main\nimport contextlib, io\n"
+                  f"with contextlib.redirect_stdout(io.StringIO()):\n    assert main({argv!r}) == 0")
     assert not (mods & set(RENDERING)), mods
+
+
+def test_public_names_work_any_number_of_times():
+    """spinviz.simulate used to be replaced by its own submodule after the first call.  Every
+    public name must be the same object before and after all submodules are imported."""
+    code = """
+import importlib, pkgutil
+import spinviz
+sc = spinviz.load_scene("scenes/askew_example.toml")
+first = spinviz.simulate(sc.body, "reduced", sc.omega0, t_end=10, samples=5)
+second = spinviz.simulate(sc.body, "reduced", sc.omega0, t_end=10, samples=5)
+names = {n: getattr(spinviz, n) for n in spinviz.__all__}
+for m in pkgutil.walk_packages(spinviz.__path__, "spinviz."):
+    if not m.name.startswith("spinviz.rendering.") or m.name.endswith(("spec", "timeline")):
+        importlib.import_module(m.name)
+assert all(getattr(spinviz, n) is v for n, v in names.items()), "a public name changed"
+assert callable(spinviz.simulate) and callable(spinviz.render) and callable(spinviz.render_frame)
+third = spinviz.simulate(sc.body, "reduced", sc.omega0, t_end=10, samples=5)
+assert (first.omega == second.omega).all() and (second.omega == third.omega).all()
+"""
+    loaded(code)

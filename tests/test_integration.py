@@ -5,12 +5,13 @@ import math
 import numpy as np
 import pytest
 
-from spinviz.validation import checks
 from spinviz import rotations as R
-from spinviz.physics import bodies as B
-from spinviz.physics import presets as P
-from spinviz.physics import closed_forms as CF
 from spinviz.driver import SimulationError, simulate
+from spinviz.integrators import names
+from spinviz.physics import bodies as B
+from spinviz.physics import cases
+from spinviz.physics import presets as P
+from spinviz.validation import checks
 
 ASKEW = B.symmetric_top(-0.6, math.radians(55.0))          # DAST family-1 proportions
 
@@ -86,21 +87,54 @@ def test_askew_energy_is_not_monotonic_but_falls():
         assert np.any(np.diff(E) > 0)
 
 
+# --- every registered method against an exact solution ------------------------------------
+# (6.10) over 3 T at Omega20 = Omega30 = 0.1 (phi turns ~23 rad).  Settings and bounds per
+# method: each bound is ~3-10x the error measured with these settings, so a method that
+# breaks or loses its accuracy fails; adaptive methods run at rtol 1e-10, fixed-step ones at
+# the step given (T = 100).
+EVERY_METHOD = {
+    "lie-dop853": ({"rtol": 1e-10, "atol": 1e-12}, 1e-9),     # measured 8.1e-11
+    "dop853": ({"rtol": 1e-10, "atol": 1e-12}, 1e-9),         # 1.2e-10
+    "rk45": ({"rtol": 1e-10, "atol": 1e-12}, 1e-9),           # 7.5e-11
+    "radau": ({"rtol": 1e-10, "atol": 1e-12}, 1e-9),          # 1.5e-11
+    "bdf": ({"rtol": 1e-10, "atol": 1e-12}, 1e-7),            # 1.5e-8 (variable order <= 5, the loosest)
+    "lsoda": ({"rtol": 1e-10, "atol": 1e-12}, 3e-9),          # 3.2e-10
+    "secular": ({"rtol": 1e-10, "atol": 1e-12}, 3e-9),        # 2.5e-10 (torque along L: no averaging error)
+    "lie-rk4": ({"step": 0.5}, 3e-9),                         # 3.1e-10
+    "lie-rk8": ({"step": 0.5}, 1e-13),                        # 6.3e-15
+    "split2": ({"step": 2.5}, 3e-3),                          # 7.0e-4 (T/40, 2nd order)
+    "split4": ({"step": 2.5}, 3e-6),                          # 3.9e-7
+    "split6": ({"step": 2.5}, 1e-11),                         # 1.6e-12
+    "split8": ({"step": 2.5}, 1e-13),                         # 5.4e-15
+}
+
+
+def test_every_registered_method_is_tested():
+    assert set(EVERY_METHOD) == set(names())
+
+
+@pytest.mark.parametrize("method", sorted(EVERY_METHOD))
+def test_every_method_follows_6_10(method):
+    """Each integrator reproduces the exact Omega (6.9) and orientation (6.10)."""
+    kw, bound = EVERY_METHOD[method]
+    case = cases.eq6_10(0.1)
+    tr = simulate(case.body, case.model, method=method, **case.run_kwargs(41), **kw)
+    assert tr.stats["method"] == method
+    assert R.misorientation(tr.q, case.orientation_exact(tr.t)).max() < bound
+    assert np.max(np.abs(tr.omega - case.omega_exact(tr.t))) < 1e-9 * 0.1
+
+
 # --- fixed-step methods earn their declared order ----------------------------------------
 @pytest.mark.parametrize("method,order,substeps", [("lie-rk4", 4, (10, 20, 40, 80)), ("lie-rk8", 8, (6, 8, 12, 16))])
 def test_fixed_step_order_against_6_10(method, order, substeps):
     """Orientation error at 2 T against the exact (6.10); slope of log(error) vs log(h)
     (h = 2T/m exactly, errors between 1e-3 and 1e-11, above round-off)."""
-    w20 = w30 = 0.3
-    T = 1.0 / w20**2
-    th = math.atan(w20 / w30)
-    steps = [2.0 * T / m for m in substeps]
+    case = cases.eq6_10(0.3, periods_T=2.0)
+    steps = [case.t_end / m for m in substeps]
     errs = []
     for h in steps:
-        tr = simulate(B.symmetric_top(0.0, 0.0), "truncated", (0.0, w20, w30), t_end=2.0 * T, samples=2,
-                      euler_zxz0=(0.0, th, 0.0), method=method, step=h)
-        exact = R.quat_from_euler_zxz(CF.euler_eq6_10(tr.t, 1.0, w20, w30))
-        errs.append(R.misorientation(tr.q, exact).max())
+        tr = simulate(case.body, case.model, method=method, step=h, **case.run_kwargs(2))
+        errs.append(R.misorientation(tr.q, case.orientation_exact(tr.t)).max())
     slope = np.polyfit(np.log(steps), np.log(errs), 1)[0]
     assert abs(slope - order) < 0.4, (errs, slope)
 
@@ -153,19 +187,24 @@ def test_real_cellulose_rod_parameters_do_not_underflow():
     assert tr.stats["eps_rad"] == pytest.approx(rod.tau0 * W[1], rel=1e-12)
 
 
-def test_sample_interpolates_between_stored_states():
-    """Sampling a coarse trajectory at midpoints matches a run that stores those instants."""
-    kw = dict(t_end=60.0, rtol=1e-12, atol=1e-14)
-    coarse = simulate(ASKEW, "reduced", (0.2, 0.3, 0.5), samples=121, **kw)
-    t_mid = 0.5 * (coarse.t[:-1] + coarse.t[1:])
-    fine = simulate(ASKEW, "reduced", (0.2, 0.3, 0.5), t_eval=np.concatenate([[0.0], t_mid]), **kw)
-    s = coarse.sample(t_mid)
-    # cubic Hermite: error ~ h^4 |omega''''| / 384 with h = 0.5, |omega| ~ 0.6
-    assert np.max(np.abs(s.omega - fine.omega[1:])) < 1e-4
-    # slerp assumes constant angular velocity over a sample interval: error ~ h^2 |omega_dot| / 8
-    assert R.misorientation(s.q, fine.q[1:]).max() < 1e-2
+def test_sample_interpolation_orders():
+    """Sampling at the midpoints of stored instants h apart, against a run that stores the
+    midpoints: Omega by cubic Hermite converges as h^4, q by slerp (constant angular velocity
+    over an interval) as h^2; slopes fitted over h = 0.5, 0.25, 0.125 (errors far above the
+    rtol 1e-12 of the runs)."""
+    kw = dict(rtol=1e-12, atol=1e-14)
+    hs, ew, eq = [0.5, 0.25, 0.125], [], []
+    for h in hs:
+        coarse = simulate(ASKEW, "reduced", (0.2, 0.3, 0.5), t_eval=np.arange(0.0, 20.0 + h / 2, h), **kw)
+        t_mid = 0.5 * (coarse.t[:-1] + coarse.t[1:])
+        fine = simulate(ASKEW, "reduced", (0.2, 0.3, 0.5), t_eval=np.concatenate([[0.0], t_mid]), **kw)
+        s = coarse.sample(t_mid)
+        ew.append(np.max(np.abs(s.omega - fine.omega[1:])))
+        eq.append(R.misorientation(s.q, fine.q[1:]).max())
+    assert np.polyfit(np.log(hs), np.log(ew), 1)[0] == pytest.approx(4.0, abs=0.3), ew
+    assert np.polyfit(np.log(hs), np.log(eq), 1)[0] == pytest.approx(2.0, abs=0.2), eq
     with pytest.raises(ValueError, match="sample times must lie in"):
-        coarse.sample([61.0])
+        coarse.sample([21.0])
 
 
 def test_no_orientation_when_not_asked():

@@ -8,9 +8,9 @@ import pytest
 
 from spinviz.atomic import AtomicPath
 from spinviz.cli import main
+from spinviz.driver import simulate
 from spinviz.physics import bodies as B
 from spinviz.physics import presets as P
-from spinviz.driver import simulate
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 
@@ -123,23 +123,6 @@ def test_sample_keeps_the_slow_frame_with_four_samples():
     assert tr.stats["method"] == "secular"
     s = tr.sample(tr.t)
     np.testing.assert_array_equal(s.slow["q_L"], tr.slow["q_L"])
-
-
-def test_segments_join_in_a_directory_with_a_quote(tmp_path):
-    """Two workers' MP4 segments are joined by ffmpeg's concat list, which needs quoting."""
-    import imageio
-
-    from spinviz import pipeline
-    from spinviz.rendering.video import render_video
-    from spinviz.scene import load_scene
-
-    d = tmp_path / "it's here"
-    sc = load_scene(scene(tmp_path))
-    plan = pipeline.plan(sc, fps=8, duration=1.0)
-    render_video(plan, str(d / "v.mp4"), workers=2, progress=False, poster=False)
-    r = imageio.get_reader(str(d / "v.mp4"))
-    assert r.count_frames() == 8
-    r.close()
 
 
 def test_method_names_are_case_insensitive_and_unknown_ones_are_value_errors():

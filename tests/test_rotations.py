@@ -7,8 +7,6 @@ import pytest
 
 from spinviz import rotations as R
 
-RNG = np.random.default_rng(7)
-
 
 def Rz(a):
     c, s = math.cos(a), math.sin(a)
@@ -20,10 +18,10 @@ def Rx(a):
     return np.array([[1.0, 0, 0], [0, c, -s], [0, s, c]])
 
 
-def test_zxz_quaternion_is_Rz_Rx_Rz():
+def test_zxz_quaternion_is_Rz_Rx_Rz(rng):
     """O = Rz(phi) Rx(theta) Rz(psi) is the matrix of quat_from_euler_zxz (the convention of (6.4))."""
     for _ in range(20):
-        phi, theta, psi = RNG.uniform(-np.pi, np.pi), RNG.uniform(0, np.pi), RNG.uniform(-np.pi, np.pi)
+        phi, theta, psi = rng.uniform(-np.pi, np.pi), rng.uniform(0, np.pi), rng.uniform(-np.pi, np.pi)
         m = R.matrix_from_quat(R.quat_from_euler_zxz([phi, theta, psi]))
         np.testing.assert_allclose(m, Rz(phi) @ Rx(theta) @ Rz(psi), atol=1e-14)
 
@@ -35,8 +33,8 @@ def test_quaternion_is_scalar_first():
     np.testing.assert_allclose(R.world_from_body(q, [1.0, 0.0, 0.0]), [0.0, 1.0, 0.0], atol=1e-15)
 
 
-def test_euler_round_trip_generic():
-    a = np.stack([RNG.uniform(-np.pi, np.pi, 200), RNG.uniform(1e-3, np.pi - 1e-3, 200), RNG.uniform(-np.pi, np.pi, 200)], -1)
+def test_euler_round_trip_generic(rng):
+    a = np.stack([rng.uniform(-np.pi, np.pi, 200), rng.uniform(1e-3, np.pi - 1e-3, 200), rng.uniform(-np.pi, np.pi, 200)], -1)
     back = R.euler_zxz_from_quat(R.quat_from_euler_zxz(a))
     np.testing.assert_allclose(back, a, atol=1e-12)
 
@@ -67,8 +65,8 @@ def test_round_trip_is_sign_blind():
     np.testing.assert_allclose(R.euler_zxz_from_quat(-q), R.euler_zxz_from_quat(q), atol=1e-14)
 
 
-def test_misorientation_tiny_and_large_angles_and_sign():
-    q = R.normalize(RNG.normal(size=4))
+def test_misorientation_tiny_and_large_angles_and_sign(rng):
+    q = R.normalize(rng.normal(size=4))
     for ang in (1e-12, 1e-6, 0.5, 3.0):
         r = R.multiply(q, R.quat_from_axis_angle((0.6, 0.0, 0.8), ang))
         assert R.misorientation(q, r) == pytest.approx(ang, rel=1e-9)
@@ -83,9 +81,9 @@ def test_exp_rotvec_and_matrix_round_trip():
     assert R.allclose_up_to_sign(R.quat_from_matrix(R.matrix_from_quat(q)), q)
 
 
-def test_world_and_body_are_inverse_pairwise():
-    q = R.normalize(RNG.normal(size=(5, 4)))
-    v = RNG.normal(size=(5, 3))
+def test_world_and_body_are_inverse_pairwise(rng):
+    q = R.normalize(rng.normal(size=(5, 4)))
+    v = rng.normal(size=(5, 3))
     np.testing.assert_allclose(R.body_from_world(q, R.world_from_body(q, v)), v, atol=1e-14)
 
 

@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 
 from spinviz import rotations as R
-from spinviz.integrators.secular import SlowFlow
-from spinviz.physics import bodies as B
-from spinviz.physics import presets as P
-from spinviz.physics import closed_forms as CF
-from spinviz.physics.equations import System
 from spinviz.driver import SimulationError, simulate
 from spinviz.integrators.auto import choose_method
+from spinviz.integrators.secular import SlowFlow
+from spinviz.physics import bodies as B
+from spinviz.physics import closed_forms as CF
+from spinviz.physics import presets as P
+from spinviz.physics.equations import System
 
 W = math.pi * 1e10                      # the spin of section 6, rad/s
 

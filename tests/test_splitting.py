@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from spinviz import rotations as R
+from spinviz.driver import SimulationError, simulate
 from spinviz.physics import bodies as B
 from spinviz.physics import closed_forms as CF
-from spinviz.driver import SimulationError, simulate
 
 SPHERE = B.symmetric_top(0.0, 0.0)
 

@@ -36,6 +36,11 @@ def test_driver_says_why_it_picked_a_stiff_method():
 
 
 def test_euler_angles_struggle_at_the_pole_where_quaternions_do_not():
+    """Passing 1e-9 rad from theta = 0: the quaternion kinematics needs ~1e2 evaluations for
+    5e-15 rad; (6.4), which divides by sin(theta), needs hundreds of times more (measured
+    79,577) and still ends less accurate."""
     r = stress.case_pole_passage()
-    assert r.error < 1e-9
-    assert "(6.4)" in r.notes
+    d = r.details
+    assert d["quaternion_error"] < 1e-9
+    assert d["euler_nfev"] is None or d["euler_nfev"] > 100 * d["quaternion_nfev"]
+    assert d["euler_error"] > d["quaternion_error"]

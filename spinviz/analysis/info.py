@@ -55,7 +55,8 @@ def rows(body: Body, omega=None) -> list[dict]:
                         "human": f"{body.tau0 * w0:.3g}"})
         if w3 > 0:
             Th = body.residual_time_Theta(w3)
-            out.append({"key": "Theta_scene", "label": "Theta for this scene's Omega3", "value": Th, "unit": tu, "human": _human(Th, tu)})
+            out.append({"key": "Theta_scene", "label": "Theta for this scene's Omega3", "value": Th, "unit": tu,
+                        "human": _human(Th, tu)})
     return out
 
 

@@ -4,10 +4,12 @@ Importing this package registers the built-in methods; ``get(name)`` returns one
 ``names()`` lists them.  Never imports the scene layer or rendering.
 """
 
-from . import geometric  # noqa: F401  (registers lie-dop853, lie-rk4, lie-rk8)
-from . import scipy_ivp  # noqa: F401  (registers rk45, dop853, radau, bdf, lsoda)
-from . import secular  # noqa: F401  (registers secular)
-from . import splitting  # noqa: F401  (registers split2, split4, split6, split8)
+from . import (
+    geometric,  # noqa: F401  (registers lie-dop853, lie-rk4, lie-rk8)
+    scipy_ivp,  # noqa: F401  (registers rk45, dop853, radau, bdf, lsoda)
+    secular,  # noqa: F401  (registers secular)
+    splitting,  # noqa: F401  (registers split2, split4, split6, split8)
+)
 from .base import KINEMATICS, Integrator, Problem, Solution, get, names, register
 
 __all__ = ["Integrator", "Problem", "Solution", "KINEMATICS", "get", "names", "register"]

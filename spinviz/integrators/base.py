@@ -9,8 +9,8 @@ particles), folded into the coupling vector: |g|^2 = eps_rad.  See ``simulate``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 

@@ -45,7 +45,7 @@ def solve_lie_dop853(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12,
                      max_steps: int = MAX_STEPS, stop_on_stiffness: bool = False) -> Solution:
     """Adaptive Lie-group DOP853; ``step`` caps the step size; with ``stop_on_stiffness``
     it gives up as soon as it detects stiffness (the driver then switches to radau)."""
-    from . import kernels as KN          # numba compiles (or loads from cache) on first use only
+    from . import kernels as KN  # numba compiles (or loads from cache) on first use only
 
     model, J, g, w0, q0, t, with_q = _args(problem)
     h_max = float(step) if step else np.inf
@@ -77,7 +77,8 @@ def _fixed(tableau: T.Tableau):
 
 register(Integrator(
     name="lie-dop853", order=8, fixed_step=False, solve=solve_lie_dop853, detects_stiffness=True,
-    description="Lie-group DOP853 (RKMK, exact SO(3) dexp^-1), adaptive with dense output; |q| = 1 by construction; compiled; the default",
+    description="Lie-group DOP853 (RKMK, exact SO(3) dexp^-1), adaptive with dense output; |q| = 1 by construction; "
+                "compiled; the default",
 ))
 register(Integrator(
     name="lie-rk4", order=4, fixed_step=True, solve=_fixed(T.RK4),

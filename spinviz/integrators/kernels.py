@@ -34,10 +34,9 @@ import numpy as np
 
 from ..physics import equations as E
 from . import tableaus as T
+from .status import MODEL_ID, NOT_FINITE, OK, STEP_UNDERFLOW, STIFF, TOO_MANY_STEPS, TURN_TOO_LARGE  # noqa: F401
 
 _jit = nb.njit(cache=True)
-
-from .status import MODEL_ID, NOT_FINITE, OK, STEP_UNDERFLOW, STIFF, TOO_MANY_STEPS, TURN_TOO_LARGE  # noqa: F401
 
 _free = _jit(E.free_rate)
 _reduced = _jit(E.reduced_terms)

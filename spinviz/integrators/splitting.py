@@ -46,5 +46,6 @@ _NAMES = {2: "Strang", 4: "Yoshida triple jump", 6: "Kahan-Li s9", 8: "Kahan-Li 
 for _p in (2, 4, 6, 8):
     register(Integrator(
         name=f"split{_p}", order=_p, fixed_step=True, solve=_solver(_p), symmetric_only=True,
-        description=f"exact free flow of the symmetric top composed with the radiation torque, {_NAMES[_p]} (order {_p}); compiled",
+        description=f"exact free flow of the symmetric top composed with the radiation torque, {_NAMES[_p]} "
+                    f"(order {_p}); compiled",
     ))

@@ -88,7 +88,8 @@ class Body:
         if d.shape != (3,) or not np.all(np.isfinite(d)):
             raise BodyError("dipole", f"must be three finite numbers, got {self.dipole!r}")
         if not np.any(d != 0.0):
-            raise BodyError("dipole", "is zero: tau0 (3.8) is undefined; give a dipole and use model = \"free\" for torque-free motion")
+            raise BodyError("dipole", "is zero: tau0 (3.8) is undefined; give a dipole and use model = \"free\" "
+                                      "for torque-free motion")
         if self.units not in U.UNIT_SYSTEMS:
             raise BodyError("units", f"unknown unit system {self.units!r}; valid: {', '.join(U.UNIT_SYSTEMS)}")
 
@@ -104,7 +105,7 @@ class Body:
                 "extra": {k: float(v) for k, v in self.extra.items()}}
 
     @classmethod
-    def from_dict(cls, d: dict) -> "Body":
+    def from_dict(cls, d: dict) -> Body:
         sh = d.get("shape")
         shape = None if sh is None else Shape(sh["kind"], tuple(sh["dims"]), tuple(sh["q_body_from_shape"]), sh["label"])
         return cls(name=d["name"], units=d["units"], inertia=tuple(d["inertia"]), dipole=tuple(d["dipole"]),

@@ -63,7 +63,8 @@ _DAST_SOURCE = (
 )
 
 
-def dast_box(a_nm: float, b_nm: float, c_nm: float, density: float | None = None, name=None, crystal: DastCrystal = DAST, **kw) -> Body:
+def dast_box(a_nm: float, b_nm: float, c_nm: float, density: float | None = None, name=None,
+             crystal: DastCrystal = DAST, **kw) -> Body:
     """A DAST a x b x c (nm) parallelepiped from the crystal data; edges along e1, e2, e3.
 
     density : g/cm^3, default from the crystal data (1.30); pass 1.37 for the paper's value.

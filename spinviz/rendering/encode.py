@@ -17,9 +17,7 @@ class Mp4Writer:
     def __init__(self, path: str, size, fps: int, crf: int = 20, preset: str = "veryfast", threads: int = 0):
         import imageio_ffmpeg
 
-        W, H = size
-        if W % 2 or H % 2:
-            raise ValueError(f"MP4 (H.264, yuv420p) needs an even width and height, got {W}x{H}")
+        W, H = size                            # even: checked by RenderSpec.check_output
         params = ["-preset", preset, "-crf", str(crf), "-movflags", "+faststart", "-f", "mp4"]
         if threads:
             params += ["-threads", str(threads)]

@@ -161,7 +161,7 @@ class Solids:
             f = m.faces.reshape(-1, 4).copy()
             f[:, 1:] += off
             faces.append(f.ravel())
-        for (name, p), lo, hi in zip(self.parts.items(), offsets[:-1], offsets[1:]):
+        for p, lo, hi in zip(self.parts.values(), offsets[:-1], offsets[1:]):
             p["slice"] = slice(int(lo), int(hi))
         self.mesh = pv.PolyData(np.vstack([p["points"] for p in self.parts.values()]), faces=np.concatenate(faces))
         self.mesh.point_data["rgb"] = np.zeros((self.mesh.n_points, 3), dtype=np.uint8)
@@ -200,16 +200,14 @@ class RenderSession:
     directly comparable.  ``project`` maps world points to output pixels (for tests).
     """
 
-    def __init__(self, plan, size, supersample: float = 2.0):
+    def __init__(self, plan, supersample: float = 2.0):
         self.plan = plan
-        self.size = (int(size[0]), int(size[1]))
-        self.ss = float(supersample)
         spec = plan.spec
+        self.size = spec.size                  # validated by the spec (RenderSpec.check_output)
+        self.ss = float(supersample)
         self.colors = COLORS[spec.background]
         n = len(plan.panels)
         W, H = self.size
-        if W % n:
-            raise ValueError(f"width {W} must be divisible by the number of panels ({n})")
         self.panel_width = W // n
         self.window = (int(round(self.panel_width * self.ss)), int(round(H * self.ss)))
         self.show = set(spec.show)

@@ -66,7 +66,7 @@ class RenderSpec:
 
     # -- construction ---------------------------------------------------------------------
     @classmethod
-    def from_mapping(cls, data, title: str = "") -> "RenderSpec":
+    def from_mapping(cls, data, title: str = "") -> RenderSpec:
         """A spec from a parsed ``[render]`` table: TOML types checked, unknown keys refused.
 
         ``size`` and ``show`` come as lists; ``title`` defaults to ``title``."""
@@ -82,7 +82,7 @@ class RenderSpec:
             kw[key] = _from_toml(key, value)
         return cls(**kw)
 
-    def with_(self, **overrides) -> "RenderSpec":
+    def with_(self, **overrides) -> RenderSpec:
         """A copy with some fields replaced (validated like the original); None keeps a field."""
         return replace(self, **{k: v for k, v in overrides.items() if v is not None})
 

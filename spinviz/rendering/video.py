@@ -60,12 +60,12 @@ def default_workers() -> int:
 SUPERSAMPLE = 2.0      # 2 x 2 supersampling: four samples per pixel (see session.py)
 
 
-def render_frames(plan, frames, size, supersample: float | None = None):
-    """Frames (list of indices) as RGB arrays, rendered in this process; also returns the
-    session so tests can project world points.  Caller closes the session."""
+def render_frames(plan, frames, supersample: float | None = None):
+    """Frames (list of indices) as RGB arrays at the plan's size, rendered in this process;
+    also returns the session so tests can project world points.  Caller closes the session."""
     from .session import RenderSession
 
-    session = RenderSession(plan, size, supersample or SUPERSAMPLE)
+    session = RenderSession(plan, supersample or SUPERSAMPLE)
     return [session.frame(f) for f in frames], session
 
 
@@ -104,7 +104,7 @@ def _segment_worker(index, plan, size, supersample, lo, hi, path, poster_f, msgs
         os.environ.setdefault("LP_NUM_THREADS", "1")
         from .session import RenderSession
 
-        session = RenderSession(plan, size, supersample)
+        session = RenderSession(plan, supersample)
         writer = Mp4Writer(path, size, plan.spec.fps, threads=1)
         msgs.put(("ready", index, None))
         done = 0
@@ -125,14 +125,15 @@ def _segment_worker(index, plan, size, supersample, lo, hi, path, poster_f, msgs
         msgs.put(("error", index, traceback.format_exc()))
 
 
-def render_video(plan, out: str, size=None, workers: int | None = None, supersample: float | None = None,
+def render_video(plan, out: str, workers: int | None = None, supersample: float | None = None,
                  progress: bool = True, poster: bool = True, max_frames: int | None = None) -> RenderResult:
     """Render ``plan`` to ``out`` (.mp4 or .gif) and a PNG poster beside it; atomically.
 
     workers : render processes for MP4 (default: one per core, at most 4); 1 renders in-process.
     max_frames : stop after this many frames (benchmarks).
     """
-    size = tuple(size or plan.spec.size)
+    plan.spec.check_output(out, len(plan.panels))          # the format's rules live in the spec
+    size = plan.spec.size
     supersample = supersample or SUPERSAMPLE
     F = plan.frames if max_frames is None else min(plan.frames, max_frames)
     fmt = os.path.splitext(out)[1].lower()
@@ -168,7 +169,7 @@ def _render_in_process(plan, path, size, supersample, F, poster_f, bar):
     from .session import RenderSession
 
     t0 = time.perf_counter()
-    session = RenderSession(plan, size, supersample)
+    session = RenderSession(plan, supersample)
     startup = time.perf_counter() - t0
     writer = open_writer(path, size, plan.spec.fps)
     poster_img = None

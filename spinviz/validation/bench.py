@@ -30,7 +30,7 @@ import numpy as np
 from .. import rotations as R
 from ..integrators import get
 from ..integrators.scaling import spin_problem
-from ..physics import closed_forms as CF
+from ..physics import cases
 from ..physics.bodies import symmetric_top
 from ..physics.equations import System
 
@@ -60,38 +60,18 @@ def _system(delta, chi, model) -> System:
 
 def make_problem(name: str, turns: float) -> BenchProblem:
     """The problem ``name`` at a spin giving ``turns`` turns over its horizon."""
-    if name == "6.10":
-        # phi(3T) = 2 (sqrt 7 - 1) / w for Omega20 = Omega30 = w / sqrt 2
-        w = 2.0 * (math.sqrt(7.0) - 1.0) / (2.0 * math.pi * turns)
-        w2 = w3 = w / math.sqrt(2.0)
-        t = np.linspace(0.0, 3.0 / w2**2, N_OUT)
-        q0 = R.quat_from_euler_zxz((0.0, math.pi / 4, 0.0))
-        return BenchProblem(name, turns, _system(0.0, 0.0, "truncated"), np.array([0.0, w2, w3]), q0, t,
-                            CF.omega_eq6_9(t, 1.0, w2, w3), R.quat_from_euler_zxz(CF.euler_eq6_10(t, 1.0, w2, w3)),
-                            commuting=True, note="truncated, DAST cube, exact (6.9)/(6.10)")
-    if name == "3.9":
-        # angle(3T) = (sqrt 7 - 1) / w
-        w = (math.sqrt(7.0) - 1.0) / (2.0 * math.pi * turns)
-        t = np.linspace(0.0, 3.0 / w**2, N_OUT)
-        q0 = np.array([1.0, 0.0, 0.0, 0.0])
-        # Not "commuting" for the splitting: (3.9) is an unstable solution of the askew top
+    if name in ("6.10", "3.9", "5.2+q"):
+        case = {"6.10": cases.eq6_10_turns, "3.9": cases.eq3_9_turns, "5.2+q": cases.eq5_2_turns}[name](turns)
+        t = np.linspace(0.0, case.t_end, N_OUT)
+        # (3.9) is not "commuting" for the splitting: it is an unstable solution of the askew top
         # (perturbations grow like exp(c tau^(1/4)), section 4.3); braking-scale steps let the
         # 1e-16 rounding of the splitting's polar form grow into an O(1) error by 1e5 turns.
-        return BenchProblem(name, turns, _system(-0.6, math.radians(55.0), "reduced"), np.array([0.0, w, 0.0]), q0, t,
-                            CF.omega_eq3_9(t, 1.0, w), R.quat_from_axis_angle((0, 1, 0), CF.rotation_angle_eq3_9(t, 1.0, w)),
-                            commuting=False, averaged=False,     # no precession about e2 to average over
-                            note="askew top about e2, exact (3.9), an unstable solution")
-    if name == "5.2+q":
-        delta = 0.3
-        eps = 1.0 - delta
-        # omega3 constant: turns ~ w3 t_end / 2 pi over t_end = 3 Theta = 3 / (eps w3)^2
-        w3 = 3.0 / (eps**2 * 2.0 * math.pi * turns)
-        w2 = w3
-        t = np.linspace(0.0, 3.0 / (eps * w3) ** 2, N_OUT)
-        q0 = R.quat_from_euler_zxz((0.0, 1.0, 0.0))
-        return BenchProblem(name, turns, _system(delta, 0.0, "reduced"), np.array([0.0, w2, w3]), q0, t,
-                            CF.omega_eq5_2(t, delta, w2, w3), None,
-                            note="reduced, chi = 0, delta = 0.3: Omega exact (5.2), orientation vs reference")
+        # It has no precession about e2 to average over either.
+        traits = {"6.10": dict(commuting=True, note="truncated, DAST cube, exact (6.9)/(6.10)"),
+                  "3.9": dict(averaged=False, note="askew top about e2, exact (3.9), an unstable solution"),
+                  "5.2+q": dict(note="reduced, chi = 0, delta = 0.3: Omega exact (5.2), orientation vs reference")}[name]
+        return BenchProblem(name, turns, case.body.system(case.model), case.omega0, case.q0, t,
+                            case.omega_exact(t), case.orientation_exact(t), **traits)
     if name == "askew":
         n = np.array([0.3, 0.4, 0.866])
         n /= np.linalg.norm(n)
@@ -344,9 +324,15 @@ def summary(rows: list[Row]) -> list[dict]:
             met = best[0] < goal
         out.append({"problem": prob, "turns": turns, "best_method": best[1], "best_seconds": best[0],
                     "baseline_seconds": base, "baseline": base_how if base else None, "speedup": speedup,
-                    "target": f"{'>=' if kind == 'speedup' else '<'} {goal:g}{'x' if kind == 'speedup' else ' s'}" if kind else None,
+                    "target": _target(kind, goal),
                     "target_met": met, "seconds_at_1e-8": per})
     return out
+
+
+def _target(kind, goal) -> str | None:
+    if not kind:
+        return None
+    return f">= {goal:g}x" if kind == "speedup" else f"< {goal:g} s"
 
 
 def format_table(rows: list[Row], summ: list[dict], notes) -> str:
@@ -360,7 +346,8 @@ def format_table(rows: list[Row], summ: list[dict], notes) -> str:
         best = f"{s['best_method']} {s['best_seconds']:.3g} s" if s["best_method"] else "not reached"
         base = f"{s['baseline_seconds']:.3g} s ({s['baseline']})" if s["baseline_seconds"] else "n/a"
         sp = f"{s['speedup']:.0f}x" if s["speedup"] else "n/a"
-        tgt = "" if s["target"] is None else f"; target {s['target']}: {'met' if s['target_met'] else 'MISSED' if s['target_met'] is False else 'n/a'}"
+        met = {True: "met", False: "MISSED", None: "n/a"}[s["target_met"]]
+        tgt = "" if s["target"] is None else f"; target {s['target']}: {met}"
         lines.append(f"  {s['problem']:<6} {s['turns']:>6.0e} turns: best {best}; baseline {base}; speed-up {sp}{tgt}")
     if notes:
         lines += [""] + [f"note: {n}" for n in notes]

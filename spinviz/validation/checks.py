@@ -25,6 +25,7 @@ import numpy as np
 from .. import rotations as R
 from ..driver import simulate
 from ..physics import bodies as B
+from ..physics import cases
 from ..physics import closed_forms as CF
 
 RTOL, ATOL = 1e-12, 1e-14      # tight: exact checks must sit at the integrator's tolerance
@@ -166,16 +167,12 @@ def check_6_10(omega20=0.1, omega30=0.1, periods_T=3.0, tol=1e-9) -> CheckResult
     Start phi = psi = 0, theta = arctan|Omega20/Omega30|, Omega(0) = (0, Omega20, Omega30).
     Errors: each Euler angle, and the misorientation angle of the whole rotation.
     """
-    T = 1.0 / omega20**2
-    theta0 = math.atan(abs(omega20 / omega30))
-    start = time.perf_counter()
-    tr = simulate(B.symmetric_top(0.0, 0.0), "truncated", (0.0, omega20, omega30), t_end=periods_T * T,
-                  samples=601, euler_zxz0=(0.0, theta0, 0.0), rtol=RTOL, atol=ATOL)
-    runtime = time.perf_counter() - start
-    exact = CF.euler_eq6_10(tr.t, 1.0, omega20, omega30)
+    case = cases.eq6_10(omega20, omega30, periods_T)
+    tr, runtime = _run(case, 601)
+    exact = case.euler_exact(tr.t)
     err = np.max(_angle_error(tr.euler_zxz, exact), axis=0)
-    mis = float(R.misorientation(tr.q, R.quat_from_euler_zxz(exact)).max())
-    w_err = float(np.max(np.abs(tr.omega - CF.omega_eq6_9(tr.t, 1.0, omega20, omega30))) / math.hypot(omega20, omega30))
+    mis = float(R.misorientation(tr.q, case.orientation_exact(tr.t)).max())
+    w_err = float(np.max(np.abs(tr.omega - case.omega_exact(tr.t))) / math.hypot(omega20, omega30))
     worst = float(max(err.max(), mis))
     return CheckResult(
         equation="6.10",
@@ -185,33 +182,28 @@ def check_6_10(omega20=0.1, omega30=0.1, periods_T=3.0, tol=1e-9) -> CheckResult
         criterion=f"<= {tol:g} rad",
         runtime_s=runtime,
         details={"error_phi": err[0], "error_theta": err[1], "error_psi": err[2], "misorientation": mis,
-                 "rel_error_omega_6_9": w_err, "turns": float(exact[-1, 0] / (2 * math.pi)), "t_end": periods_T * T},
+                 "rel_error_omega_6_9": w_err, "turns": float(exact[-1, 0] / (2 * math.pi)), "t_end": case.t_end},
     )
 
 
 # --- (3.9), (5.2), (5.4): exact angular velocities -----------------------------------------
-def check_3_9(model: str, delta=-0.6, chi=math.radians(55.0), omega20=0.1, periods_T=3.0, tol=1e-9) -> CheckResult:
+def check_3_9(model: str, delta=-0.6, chi=cases.CHI_FAMILY1, omega20=0.1, periods_T=3.0, tol=1e-9) -> CheckResult:
     """(3.9): rotation about e2 (Omega1 = Omega3 = 0) of the askew top (delta = -0.6,
     chi = 55 deg, the DAST family-1 box); exact for both models.  Error: relative error of
     Omega2 and the misorientation from the rotation about e2 by Omega20 vartheta(t)."""
-    T = 1.0 / omega20**2
-    start = time.perf_counter()
-    tr = simulate(B.symmetric_top(delta, chi), model, (0.0, omega20, 0.0), t_end=periods_T * T, samples=401,
-                  rtol=RTOL, atol=ATOL)
-    runtime = time.perf_counter() - start
-    w_exact = CF.omega_eq3_9(tr.t, 1.0, omega20)
-    w_err = float(np.max(np.abs(tr.omega - w_exact)) / abs(omega20))
-    q_exact = R.quat_from_axis_angle((0.0, 1.0, 0.0), CF.rotation_angle_eq3_9(tr.t, 1.0, omega20))
-    mis = float(R.misorientation(tr.q, q_exact).max())
+    case = cases.eq3_9(model, omega20, delta, chi, periods_T)
+    tr, runtime = _run(case, 401)
+    w_err = float(np.max(np.abs(tr.omega - case.omega_exact(tr.t))) / abs(omega20))
+    mis = float(R.misorientation(tr.q, case.orientation_exact(tr.t)).max())
     worst = max(w_err, mis)
     return CheckResult(
         equation="3.9",
-        description=f"{model}, askew top delta={delta:g} chi={math.degrees(chi):.0f}deg: rotation about e2",
+        description=case.description,
         passed=worst <= tol,
         max_error=worst,
         criterion=f"<= {tol:g} (|dOmega|/Omega20 and rad)",
         runtime_s=runtime,
-        details={"rel_error_omega": w_err, "misorientation": mis, "t_end": periods_T * T},
+        details={"rel_error_omega": w_err, "misorientation": mis, "t_end": case.t_end},
     )
 
 
@@ -219,26 +211,25 @@ def check_longitudinal(model: str, delta=0.3, omega20=0.1, omega30=0.3, tol=1e-9
     """(5.2) (reduced) or (5.4) (truncated): longitudinal dipole (chi = 0), omega10 = 0,
     exact angular velocity; error relative to |omega0|.  (5.2) is followed over 5 Theta,
     (5.4) over 5 T, long enough to see the residual rotation / the power-law spin-down."""
-    eq = "5.2" if model == "reduced" else "5.4"
-    eps = 1.0 - delta
-    t_end = 5.0 / (eps * omega30) ** 2 if model == "reduced" else 5.0 / omega20**2
-    form = CF.omega_eq5_2 if model == "reduced" else CF.omega_eq5_4
-    start = time.perf_counter()
-    tr = simulate(B.symmetric_top(delta, 0.0), model, (0.0, omega20, omega30), t_end=t_end, samples=801,
-                  rtol=RTOL, atol=ATOL)
-    runtime = time.perf_counter() - start
-    exact = form(tr.t, delta, omega20, omega30)
-    err = float(np.max(np.abs(tr.omega - exact)) / math.hypot(omega20, omega30))
-    final = "residual rotation about d" if model == "reduced" else "power-law spin-down to rest"
+    case = cases.longitudinal(model, delta, omega20, omega30)
+    tr, runtime = _run(case, 801)
+    err = float(np.max(np.abs(tr.omega - case.omega_exact(tr.t))) / math.hypot(omega20, omega30))
     return CheckResult(
-        equation=eq,
-        description=f"{model}, chi=0, delta={delta:g}: Omega(t) exact ({final})",
+        equation=case.equation,
+        description=case.description,
         passed=err <= tol,
         max_error=err,
         criterion=f"<= {tol:g} (|dOmega|/|Omega0|)",
         runtime_s=runtime,
-        details={"t_end": t_end, "omega_final": tr.omega[-1].tolist()},
+        details={"t_end": case.t_end, "omega_final": tr.omega[-1].tolist()},
     )
+
+
+def _run(case: cases.Case, samples: int):
+    """The case integrated at the checks' tight tolerances: (trajectory, seconds)."""
+    start = time.perf_counter()
+    tr = simulate(case.body, case.model, rtol=RTOL, atol=ATOL, **case.run_kwargs(samples))
+    return tr, time.perf_counter() - start
 
 
 ALL_CHECKS = (
@@ -269,12 +260,15 @@ def format_table(results: list[CheckResult]) -> str:
         if "epsilon" in d:
             lines.append(" " * 38 + f"{'eps':>8} {'err phi':>10} {'err theta':>10} {'err psi':>10}")
             for i, e in enumerate(d["epsilon"]):
-                lines.append(" " * 38 + f"{e:>8.0e} {d['error_phi'][i]:>10.2e} {d['error_theta'][i]:>10.2e} {d['error_psi'][i]:>10.2e}")
+                errs = " ".join(f"{d[k][i]:>10.2e}" for k in ("error_phi", "error_theta", "error_psi"))
+                lines.append(" " * 38 + f"{e:>8.0e} {errs}")
             for i in range(len(d["order_phi"])):
-                lines.append(" " * 38 + f"{'order':>8} {d['order_phi'][i]:>10.2f} {d['order_theta'][i]:>10.2f} {d['order_psi'][i]:>10.2f}")
+                orders = " ".join(f"{d[k][i]:>10.2f}" for k in ("order_phi", "order_theta", "order_psi"))
+                lines.append(" " * 38 + f"{'order':>8} {orders}")
         if r.equation == "6.8":
             lines.append(" " * 38 + f"theta rate {d['theta_decay_rate']:.6g} vs tau0 Omega3^2 = {d['tau0_Omega3^2']:.6g}; "
-                         f"phi_dot {d['phi_dot_limit']:.6g} vs Omega3 = {d['Omega3']:.6g}; psi_dot/Omega3 = {d['psi_dot_over_Omega3']:.1e}")
+                         f"phi_dot {d['phi_dot_limit']:.6g} vs Omega3 = {d['Omega3']:.6g}; "
+                         f"psi_dot/Omega3 = {d['psi_dot_over_Omega3']:.1e}")
     n_fail = sum(not r.passed for r in results)
     lines.append("-" * 100)
     lines.append(f"{len(results) - n_fail}/{len(results)} checks passed")

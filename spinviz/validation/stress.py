@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
@@ -17,6 +17,7 @@ from ..driver import simulate
 from ..errors import SimulationError
 from ..integrators.auto import stiffness_ratio
 from ..physics import bodies as B
+from ..physics import cases
 from ..physics import closed_forms as CF
 from ..physics import presets as P
 
@@ -37,6 +38,7 @@ class StressResult:
     reason: str = ""
     notes: str = ""
     time_limit_s: float | None = None
+    details: dict = field(default_factory=dict)       # measured numbers behind ``notes``
 
     @property
     def in_time(self) -> bool:
@@ -121,8 +123,8 @@ def case_chi_right_angle() -> StressResult:
     devs, dt_total, tr = [], 0.0, None
     for a in (1e-3, 5e-4):
         w0 = (wi, a, 2 * a)
-        tr, dt = _timed(lambda: simulate(B.symmetric_top(delta, 0.5 * math.pi), "reduced", w0, t_end=150.0, samples=61,
-                                         rtol=1e-12, atol=1e-15))
+        tr, dt = _timed(lambda w0=w0: simulate(B.symmetric_top(delta, 0.5 * math.pi), "reduced", w0, t_end=150.0,
+                                               samples=61, rtol=1e-12, atol=1e-15))
         dt_total += dt
         lin = CF.omega_eq5_7(tr.t, delta, wi, a, 2 * a)
         devs.append(float(np.max(np.abs(tr.omega[:, 1:] - lin[:, 1:]))))
@@ -237,15 +239,17 @@ def case_pole_passage() -> StressResult:
     t0 = time.perf_counter()
     try:
         te = simulate(body, "free", w_body, method="dop853", kinematics="euler_zxz", **kw)
-        ee = float(R.misorientation(R.quat_from_euler_zxz(te.euler), exact).max())
-        euler = f"(6.4) with DOP853: error {ee:.1e} rad, {te.stats['nfev']} evaluations"
+        ee, en = float(R.misorientation(R.quat_from_euler_zxz(te.euler), exact).max()), te.stats["nfev"]
+        euler = f"(6.4) with DOP853: error {ee:.1e} rad, {en} evaluations"
     except SimulationError as e:
-        ee = math.inf
+        ee, en = math.inf, None
         euler = f"(6.4) with DOP853 failed: {e}"
     de = time.perf_counter() - t0
     return StressResult("theta -> 0", "e3 passes 1e-9 rad from the pole (2 turns)", eq < 1e-9, eq,
                         "quaternion orientation error, rad", dq, tq.stats["method"], tq.stats["method_reason"],
-                        notes=f"quaternion: {tq.stats['nfev']} evaluations; {euler} in {de:.2f} s")
+                        notes=f"quaternion: {tq.stats['nfev']} evaluations; {euler} in {de:.2f} s",
+                        details={"quaternion_error": eq, "quaternion_nfev": tq.stats["nfev"],
+                                 "euler_error": ee, "euler_nfev": en})
 
 
 # --- asymmetric free top near the separatrix ----------------------------------------------
@@ -290,12 +294,10 @@ def case_million_turns_free() -> StressResult:
 
 def case_million_turns_braked() -> StressResult:
     """1e6 turns of (6.10) (truncated DAST cube, exact) with the default driver: error and time."""
-    w = 2.0 * (math.sqrt(7.0) - 1.0) / (2.0 * math.pi * 1e6)
-    w2 = w / math.sqrt(2.0)
-    T = 1.0 / w2**2
-    kw = dict(t_end=3.0 * T, samples=21, euler_zxz0=(0.0, math.pi / 4, 0.0))
-    tr, dt = _timed(lambda: simulate(B.symmetric_top(0.0, 0.0), "truncated", (0.0, w2, w2), method="split8", step=T / 40, **kw))
-    exact = R.quat_from_euler_zxz(CF.euler_eq6_10(tr.t, 1.0, w2, w2))
+    case = cases.eq6_10_turns(1e6)
+    T = case.t_end / 3.0
+    tr, dt = _timed(lambda: simulate(case.body, case.model, method="split8", step=T / 40, **case.run_kwargs(21)))
+    exact = case.orientation_exact(tr.t)
     err = float(R.misorientation(tr.q, exact).max())
     dq = float(np.max(np.abs(np.linalg.norm(tr.q, axis=1) - 1)))
     return StressResult("1e6 turns (6.10)", "truncated DAST cube over 3 T, split8 with T/40 steps", err < 1e-8 and dq <= 1e-12,

@@ -3,6 +3,12 @@
 A failed or interrupted write leaves nothing half-written at the output path and whatever
 was there before untouched.  The finished file gets the usual permissions (0666 masked by
 the umask), not mkstemp's private 0600.
+
+A command with several outputs (a video and its poster, two plots) uses ``Outputs``: every
+path is checked before any work starts (``check_outputs``: not a directory, not one of the
+command's inputs, in a writable place), all are written to temporary files, and they are
+renamed into place together -- with stop signals held back for those few renames -- or all
+discarded.
 """
 
 from __future__ import annotations
@@ -10,6 +16,9 @@ from __future__ import annotations
 import contextlib
 import os
 import tempfile
+
+from .errors import UsageError
+from .interrupt import deferred
 
 
 def _umask() -> int:
@@ -77,3 +86,77 @@ def write_json(path, data) -> None:
     import json
 
     write_text(path, json.dumps(data, indent=2, default=float) + "\n")
+
+
+def check_outputs(paths, inputs=()) -> list[str]:
+    """Refuse, before any work, an output that cannot be written or must not be: a
+    directory, one of the command's own inputs, a path named twice, a place without write
+    permission.  Returns the paths as strings."""
+    paths = [os.fspath(p) for p in paths]
+    seen = set()
+    for p in paths:
+        real = os.path.realpath(p)
+        if real in seen:
+            raise UsageError(f"{p}: named twice as an output")
+        seen.add(real)
+        if os.path.isdir(p):
+            raise UsageError(f"{p}: is a directory; an output must be a file path")
+        for i in inputs:
+            i = os.fspath(i)
+            if os.path.exists(p) and os.path.exists(i) and os.path.samefile(p, i):
+                raise UsageError(f"{p}: is an input of this command ({i}); choose another output path")
+        d = os.path.dirname(os.path.abspath(p))
+        while not os.path.exists(d):
+            d = os.path.dirname(d)
+        if not os.path.isdir(d):
+            raise UsageError(f"{p}: {d} is not a directory")
+        if not os.access(d, os.W_OK | os.X_OK):
+            raise UsageError(f"{p}: cannot write in {d} (permission denied)")
+        if os.path.exists(p) and not os.access(p, os.W_OK) and not os.access(os.path.dirname(os.path.abspath(p)), os.W_OK):
+            raise UsageError(f"{p}: cannot be replaced (permission denied)")
+    return paths
+
+
+class Outputs:
+    """Files that land together or not at all::
+
+        with Outputs([video, poster], inputs=[scene]) as (tmp_video, tmp_poster):
+            ...write the temporary files...
+        # both renamed into place here; on any exception (or signal) both discarded
+
+    The paths are checked when the group is made (``check_outputs``)."""
+
+    def __init__(self, paths, inputs=()):
+        self.paths = check_outputs(paths, inputs)
+        self.targets: list[AtomicPath] = []
+
+    def __enter__(self) -> list[str]:
+        try:
+            for p in self.paths:
+                self.targets.append(AtomicPath(p))
+        except BaseException:
+            self.discard()
+            raise
+        return [t.tmp for t in self.targets]
+
+    def __exit__(self, kind, value, tb) -> None:
+        if kind is not None:
+            self.discard()
+            return
+        try:
+            self.commit()
+        except BaseException:
+            self.discard()
+            raise
+
+    def commit(self) -> None:
+        with deferred():
+            for t in self.targets:                     # the world may have changed since the check
+                if os.path.isdir(t.path):
+                    raise UsageError(f"{t.path}: is a directory; an output must be a file path")
+            for t in self.targets:
+                t.commit()
+
+    def discard(self) -> None:
+        for t in reversed(self.targets):
+            t.discard()

@@ -9,7 +9,8 @@ import json
 import os
 import sys
 
-from .errors import RenderError, SceneError, SimulationError, SpecError, SpinvizError, UsageError
+from . import interrupt
+from .errors import RenderError, SceneError, SimulationError, SpecError, SpinvizError, UsageError, printable
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE = 0, 1, 2
 
@@ -106,25 +107,45 @@ def _size(text: str):
 # --- dispatch ---------------------------------------------------------------------------
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
+    with interrupt.handlers():
+        return _run(args)
+
+
+def _say(prefix: str, message) -> None:
+    """One line on stderr, control characters escaped and cut: nothing from a file or a key
+    name can colour, clear or split the terminal."""
+    print(f"spinviz: {prefix}{printable(message)}", file=sys.stderr)
+
+
+def _out(text: str) -> None:
+    """Print a report for people, each line escaped: titles and paths come from files."""
+    print("\n".join(printable(line, 2000) for line in str(text).splitlines()))
+
+
+def _run(args) -> int:
     try:
         return _COMMANDS[args.command](args)
     except (UsageError, SceneError, SpecError) as e:
-        print(f"spinviz: error: {e}", file=sys.stderr)
+        _say("error: ", e)
         return EXIT_USAGE
     except (SimulationError, RenderError) as e:
-        print(f"spinviz: run failed: {e}", file=sys.stderr)
+        _say("run failed: ", e)
         return EXIT_FAIL
+    except interrupt.Interrupted as e:
+        _say("interrupted by ", f"{e}; nothing was written")
+        return e.exit_status
     except KeyboardInterrupt:
-        print("spinviz: interrupted", file=sys.stderr)
+        _say("interrupted", "; nothing was written")
         return 130
-    except (SpinvizError, ValueError, OSError, ImportError, ArithmeticError, RuntimeError) as e:
+    except (SpinvizError, ValueError, OSError, ImportError, ArithmeticError, RuntimeError, RecursionError,
+            MemoryError) as e:
         # the safety net: whatever input slipped past the specific checks still gets one
         # line, not a traceback (SPINVIZ_DEBUG=1 shows the traceback)
         if os.environ.get("SPINVIZ_DEBUG"):
             raise
         what = getattr(e, "filename", None)
-        msg = f"{what}: {e.strerror}" if isinstance(e, OSError) and what and e.strerror else str(e)
-        print(f"spinviz: error: {msg}", file=sys.stderr)
+        msg = f"{what}: {e.strerror}" if isinstance(e, OSError) and what and e.strerror else str(e) or type(e).__name__
+        _say("error: ", msg)
         return EXIT_USAGE
 
 
@@ -140,7 +161,7 @@ def _cmd_check(args) -> int:
     if args.json:
         print(json.dumps([r.record() for r in results], indent=2, default=float))
     else:
-        print(checks.format_table(results))
+        _out(checks.format_table(results))
     return EXIT_OK if all(r.passed for r in results) else EXIT_FAIL
 
 
@@ -162,14 +183,18 @@ def _cmd_info(args) -> int:
     if args.json:
         print(json.dumps(info.rows(body, omega), indent=2, default=float))
     else:
-        print(info.format_info(body, title, omega))
+        _out(info.format_info(body, title, omega))
     return EXIT_OK
 
 
 def _cmd_simulate(args) -> int:
+    from .atomic import check_outputs
     from .driver import simulate
     from .scene import load_scene
 
+    if os.path.splitext(args.out)[1].lower() != ".npz":
+        raise UsageError(f"--out: {args.out}: a trajectory is written as .npz; give a path ending in .npz")
+    check_outputs([args.out], [args.scene])
     sc = load_scene(args.scene)
     model = args.model or sc.model
     if model not in sc.models:
@@ -195,7 +220,7 @@ def _cmd_simulate(args) -> int:
     except OSError as e:
         raise UsageError(f"{args.out}: cannot write: {e.strerror or e}") from None
     st = traj.stats
-    print(f"{args.out}: {traj.t.size} samples, model {model}, method {st['method']}, "
+    _out(f"{args.out}: {traj.t.size} samples, model {model}, method {st['method']}, "
           f"{st.get('nfev', '?')} rhs evaluations, {st['runtime_s']:.3f} s")
     return EXIT_OK
 
@@ -223,26 +248,22 @@ def _cmd_render(args) -> int:
     sc = load_scene(args.scene)
     if args.bench:
         return _render_bench(sc, args)
-    try:
-        _, _, spec = pipeline.resolve_spec(sc, size=args.size, fps=args.fps, duration=args.duration)
-        out = args.out or pipeline.default_output(sc)
-        spec.check_output(out, len(sc.models))
-    except SpecError as e:
-        raise _option(e, args) from None
-    pipeline.require_render_stack()
+    out = args.out or pipeline.default_output(sc)
     try:
         res = pipeline.render(sc, out, size=args.size, fps=args.fps, duration=args.duration, workers=args.workers,
                               progress=not args.quiet)
+    except SpecError as e:
+        raise _option(e, args) from None
     except OSError as e:
         raise UsageError(f"{out}: cannot write: {e.strerror or e}") from None
     except ValueError as e:
         raise UsageError(f"{args.scene}: {e}") from None
-    print(f"{res.path}: {res.frames} frames {res.size[0]}x{res.size[1]} at {spec.fps} fps, "
+    _out(f"{res.path}: {res.frames} frames {res.size[0]}x{res.size[1]}, "
           f"rendered in {res.seconds:.1f} s ({res.fps:.1f} fps, {res.workers} workers)")
     if res.poster:
-        print(f"{res.poster}: poster frame")
+        _out(f"{res.poster}: poster frame")
     for note in res.notes:
-        print(note)
+        _out(note)
     return EXIT_OK
 
 
@@ -253,13 +274,14 @@ def _render_bench(sc, args) -> int:
         rows = render_bench.run(sc, fps=args.fps, duration=args.duration, frames=args.frames, workers=args.workers)
     except SpecError as e:
         raise _option(e, args) from None
-    print(render_bench.format_table(rows, args.scene))
+    _out(render_bench.format_table(rows, args.scene))
     render_bench.write(rows, args.json, args.plot)
     return EXIT_OK
 
 
 def _cmd_compare(args) -> int:
     from .analysis import compare
+    from .atomic import Outputs
     from .driver import simulate
     from .scene import load_scene
 
@@ -271,24 +293,29 @@ def _cmd_compare(args) -> int:
         import matplotlib  # noqa: F401
     except ImportError:
         raise UsageError("compare's plots need matplotlib: pip install 'spinviz[render]'") from None
+    if args.samples > compare.MAX_SAMPLES:
+        raise UsageError(f"--samples: at most {compare.MAX_SAMPLES} (each model is stored at 2 x samples instants), "
+                         f"got {args.samples}")
+    prefix = args.out or os.path.join("renders", os.path.splitext(os.path.basename(args.scene))[0])
+    paths = [f"{prefix}_compare.png", f"{prefix}_hodograph.png"]
+    group = Outputs(paths, [args.scene])                # checked before the runs, landed together after
     kw = sc.simulation_kwargs(t_eval=compare.compare_times(sc.t_end, max(2, args.samples)))
     try:
         trajs = [simulate(sc.body, m, **kw) for m in sc.models]
     except ValueError as e:
         raise UsageError(f"{args.scene}: {e}") from None
     c = compare.compare(trajs)
-    prefix = args.out or os.path.join("renders", os.path.splitext(os.path.basename(args.scene))[0])
-    paths = (f"{prefix}_compare.png", f"{prefix}_hodograph.png")
     try:
-        compare.plot(c, paths[0], sc.title)
-        compare.plot_hodograph(c, paths[1], sc.title)
+        with group as tmps:
+            compare.plot(c, tmps[0], sc.title)
+            compare.plot_hodograph(c, tmps[1], sc.title)
     except OSError as e:
         raise UsageError(f"{prefix}: cannot write the plots: {e.strerror or e}") from None
     if args.json:
         print(json.dumps({**c.record(), "plots": list(paths)}, indent=2, default=float))
     else:
-        print(compare.format_table(c, sc.title))
-        print(f"\nplots: {paths[0]}, {paths[1]}")
+        _out(compare.format_table(c, sc.title))
+        _out(f"\nplots: {paths[0]}, {paths[1]}")
     return EXIT_OK
 
 
@@ -322,7 +349,7 @@ def _cmd_report(args) -> int:
     from .validation import report
 
     results, plot_path = report.generate(args.out, args.out_dir, args.quick, progress=_progress)
-    print(f"{args.out}: regenerated; {plot_path}")
+    _out(f"{args.out}: regenerated; {plot_path}")
     return EXIT_OK if all(r.passed for r in results) else EXIT_FAIL
 
 

@@ -12,9 +12,41 @@ without loading numba, scipy or the rendering stack (``spinviz info`` stays inst
 * ``RenderError`` -- drawing or encoding failed.
 
 The command line maps the first three to exit status 2, the last two to 1.
+
+``printable`` and ``brief`` make any echoed text safe for a terminal: control characters
+are shown escaped (``\\x1b``, ``\\n``) and long values are cut, so a message is always one
+short line whatever a file or a key name holds.
 """
 
 from __future__ import annotations
+
+import reprlib
+
+MAX_MESSAGE = 400          # characters of one error line
+_brief = reprlib.Repr()
+_brief.maxlist = _brief.maxtuple = 6
+_brief.maxdict, _brief.maxstring, _brief.maxother, _brief.maxlevel = 4, 60, 60, 2
+
+
+def printable(text, limit: int = MAX_MESSAGE) -> str:
+    """``text`` with every control character escaped (one line, no terminal commands) and cut
+    to ``limit`` characters."""
+    out = []
+    for ch in str(text):
+        o = ord(ch)
+        if o < 0x20 or 0x7F <= o < 0xA0 or o in (0x2028, 0x2029):
+            out.append({"\n": "\\n", "\r": "\\r", "\t": "\\t"}.get(ch, f"\\x{o:02x}" if o < 0x100 else f"\\u{o:04x}"))
+        else:
+            out.append(ch)
+        if len(out) > limit:
+            break
+    s = "".join(out)
+    return s if len(s) <= limit else s[: limit - 1] + "\u2026"
+
+
+def brief(value) -> str:
+    """A short, printable repr of a value from a file (long lists and strings cut)."""
+    return printable(_brief.repr(value), 120)
 
 
 class SpinvizError(Exception):

@@ -13,9 +13,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .atomic import check_outputs
 from .driver import simulate
 from .errors import UsageError
-from .rendering.spec import RenderSpec
+from .rendering.spec import RenderSpec, poster_for
 from .rendering.timeline import FramePlan, frame_times, plan_frames
 from .scene import Scene, load_scene
 from .trajectory import Trajectory
@@ -186,8 +187,10 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
             raise UsageError("give out=... (a .mp4 or .gif path) to render trajectories")
         out = default_output(scene)
     spec.check_output(out, len(scene.models) if scene is not None else len(trajs))
+    inputs = [scene.path] if scene is not None and os.path.exists(scene.path) else []
+    check_outputs([out, poster_for(out)], inputs)        # before any work: nothing to undo later
     video = require_render_stack()
-    return video.render_video(_plan(scene, trajs, spec), out, workers=workers, progress=progress)
+    return video.render_video(_plan(scene, trajs, spec), out, workers=workers, progress=progress, inputs=inputs)
 
 
 def default_output(scene: Scene, directory: str = "renders") -> str:

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 import os
+import stat
 import tomllib
 from dataclasses import dataclass, field, replace
 
@@ -355,20 +356,44 @@ def _time_scale(body: B.Body, omega0, key: str, st: _Table) -> float:
     return body.residual_time_Theta(w3)
 
 
+MAX_FILE_BYTES = 1_000_000      # a scene is a few hundred bytes; this bounds what a bad path can make us read
+
+
+def read_toml(path, kind: str = "scene") -> dict:
+    """The parsed TOML document at ``path``; ``SceneError(path, "(file)", reason)`` for anything
+    that is not a readable regular UTF-8 TOML file of sensible size (a FIFO or a device would
+    block or never end; nesting thousands deep would exhaust the parser's recursion)."""
+    path = os.fspath(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)         # never blocks on a FIFO
+    except FileNotFoundError:
+        raise SceneError(path, "(file)", "no such file") from None
+    except OSError as e:
+        raise SceneError(path, "(file)", e.strerror or str(e)) from None
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            raise SceneError(path, "(file)", f"is a directory, not a {kind} file")
+        if not stat.S_ISREG(st.st_mode):
+            raise SceneError(path, "(file)", f"not a regular file (a pipe, device or socket); a {kind} is a TOML file")
+        if st.st_size > MAX_FILE_BYTES:
+            raise SceneError(path, "(file)", f"{st.st_size} bytes is too large for a {kind} file (limit {MAX_FILE_BYTES})")
+        raw = os.read(fd, MAX_FILE_BYTES + 1)
+    except OSError as e:
+        raise SceneError(path, "(file)", e.strerror or str(e)) from None
+    finally:
+        os.close(fd)
+    try:
+        return tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise SceneError(path, "(file)", f"not a text (UTF-8) file; a {kind} is TOML") from None
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(path, "(file)", f"invalid TOML: {e}") from None
+    except RecursionError:
+        raise SceneError(path, "(file)", "values nested too deeply to be a scene") from None
+
+
 def load_scene(path) -> Scene:
     """Read and validate a scene file; SceneError (one line: file, key, reason) on any problem."""
     path = os.fspath(path)
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except FileNotFoundError:
-        raise SceneError(path, "(file)", "no such file") from None
-    except IsADirectoryError:
-        raise SceneError(path, "(file)", "is a directory, not a scene file") from None
-    except tomllib.TOMLDecodeError as e:
-        raise SceneError(path, "(file)", f"invalid TOML: {e}") from None
-    except UnicodeDecodeError:
-        raise SceneError(path, "(file)", "not a text (UTF-8) file; a scene is TOML") from None
-    except OSError as e:
-        raise SceneError(path, "(file)", e.strerror or str(e)) from None
-    return parse_scene(data, path)
+    return parse_scene(read_toml(path), path)

@@ -134,10 +134,10 @@ def test_missing_scene_file(tmp_path, capsys):
 
 
 def test_unwritable_output_is_one_line_and_exit_2(tmp_path, capsys):
-    target = tmp_path / "adir"
+    target = tmp_path / "adir.npz"
     target.mkdir()
     code, _, err = run(["simulate", write(tmp_path, GOOD), "--out", target], capsys)
-    assert code == 2 and "cannot write" in err and len(err.strip().splitlines()) == 1
+    assert code == 2 and "adir.npz: is a directory" in err and len(err.strip().splitlines()) == 1
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".spinviz-")] == []   # no temp left
 
 

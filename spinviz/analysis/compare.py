@@ -23,6 +23,7 @@ from ..trajectory import Trajectory
 from ..units import format_time
 
 THRESHOLDS_DEG = (1.0, 10.0)
+MAX_SAMPLES = 100_000          # per kind of output time: 2 x 1e5 instants x 7 floats x 2 models ~ 22 MB
 
 
 @dataclass

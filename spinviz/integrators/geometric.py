@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..interrupt import call_stoppable
 from . import status as ST
 from . import tableaus as T
 from .base import Integrator, Problem, Solution, register
@@ -49,10 +50,9 @@ def solve_lie_dop853(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12,
 
     model, J, g, w0, q0, t, with_q = _args(problem)
     h_max = float(step) if step else np.inf
-    w, q, nfev, nsteps, nrej, status, stiff_at = KN.lie_dop853(
-        model, J, g, w0, q0, t, float(rtol), float(atol), h_max, with_q, int(max_steps), bool(stop_on_stiffness),
-        *KN.DOP853_ARRAYS
-    )
+    w, q, nfev, nsteps, nrej, status, stiff_at = call_stoppable(
+        KN.lie_dop853, model, J, g, w0, q0, t, float(rtol), float(atol), h_max, with_q, int(max_steps),
+        bool(stop_on_stiffness), *KN.DOP853_ARRAYS)
     stats = {"nfev": int(nfev), "nsteps": int(nsteps), "nrejected": int(nrej)}
     if stiff_at >= 0.0:
         stats["stiff_at"] = float(stiff_at)
@@ -67,9 +67,8 @@ def _fixed(tableau: T.Tableau):
         from . import kernels as KN
 
         model, J, g, w0, q0, t, with_q = _args(problem)
-        w, q, nfev, nsteps, status = KN.lie_fixed(
-            model, J, g, w0, q0, t, float(step), tableau.A, tableau.b, with_q, int(max_steps)
-        )
+        w, q, nfev, nsteps, status = call_stoppable(
+            KN.lie_fixed, model, J, g, w0, q0, t, float(step), tableau.A, tableau.b, with_q, int(max_steps))
         return _solution(problem, w, q, status, {"nfev": int(nfev), "nsteps": int(nsteps)})
 
     return solve

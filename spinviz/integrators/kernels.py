@@ -34,9 +34,9 @@ import numpy as np
 
 from ..physics import equations as E
 from . import tableaus as T
-from .status import MODEL_ID, NOT_FINITE, OK, STEP_UNDERFLOW, STIFF, TOO_MANY_STEPS, TURN_TOO_LARGE  # noqa: F401
+from .status import INTERRUPTED, MODEL_ID, NOT_FINITE, OK, STEP_UNDERFLOW, STIFF, STOP_POLL, TOO_MANY_STEPS, TURN_TOO_LARGE  # noqa: F401
 
-_jit = nb.njit(cache=True)
+_jit = nb.njit(cache=True, nogil=True)    # nogil: interrupt.call_stoppable runs them in a thread
 
 _free = _jit(E.free_rate)
 _reduced = _jit(E.reduced_terms)
@@ -157,7 +157,7 @@ U_MAX = math.pi
 
 
 @_jit
-def lie_fixed(model, J, g, w0, q0, t_eval, h, A, b, with_q, max_steps):
+def lie_fixed(model, J, g, w0, q0, t_eval, h, A, b, with_q, max_steps, stop):
     """Fixed-step Lie-group RK with tableau (A, b, c): each output interval is cut into
     ceil(dt/h) equal steps, so the outputs are hit exactly.  Returns
     (omega (N,3), q (N,4), nfev, nsteps, status)."""
@@ -203,6 +203,8 @@ def lie_fixed(model, J, g, w0, q0, t_eval, h, A, b, with_q, max_steps):
                 return out_w, out_q, nfev, nsteps, NOT_FINITE
             if nsteps > max_steps:
                 return out_w, out_q, nfev, nsteps, TOO_MANY_STEPS
+            if nsteps % STOP_POLL == 0 and stop[0] != 0:
+                return out_w, out_q, nfev, nsteps, INTERRUPTED
         out_w[j + 1, :] = y[:3]
         out_q[j + 1, :] = q
     return out_w, out_q, nfev, nsteps, OK
@@ -309,7 +311,7 @@ def dense_eval(F, y, x, n, out):
 
 @_jit
 def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps, stop_on_stiff,
-               A, B, E3, E5, D):
+               A, B, E3, E5, D, stop):
     """Adaptive Lie-group DOP853 (error control and 7th-order dense output as in
     Hairer's DOP853 / SciPy), with Hairer's stiffness detection (15 stiff steps in a row:
     record the time, and return with status STIFF when ``stop_on_stiff``).
@@ -347,6 +349,8 @@ def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps
     while t < t_end:
         if nsteps >= max_steps:
             return out_w, out_q, nfev, nsteps, nrej, TOO_MANY_STEPS, stiff_at
+        if (nsteps + nrej) % STOP_POLL == 0 and stop[0] != 0:
+            return out_w, out_q, nfev, nsteps, nrej, INTERRUPTED, stiff_at
         if h < 10.0 * abs(np.nextafter(t, np.inf) - t):
             return out_w, out_q, nfev, nsteps, nrej, STEP_UNDERFLOW, stiff_at
         if t + h > t_end:
@@ -532,7 +536,7 @@ def radiation_flow(model, st, tau, J, g, A, b, rh_max, ec):
 
 
 @_jit
-def split_symmetric(model, J, g, w0, q0, t_eval, h, gammas, with_q, max_steps, rh_max, A, b):
+def split_symmetric(model, J, g, w0, q0, t_eval, h, gammas, with_q, max_steps, rh_max, A, b, stop):
     """Fixed-step composition of Strang steps A(h/2) B(h) A(h/2) with weights ``gammas``
     (orders 2, 4, 6, 8).  Returns (omega (N,3), q (N,4), nfev, nsteps, status)."""
     N = t_eval.shape[0]
@@ -566,6 +570,8 @@ def split_symmetric(model, J, g, w0, q0, t_eval, h, gammas, with_q, max_steps, r
                 return out_w, out_q, nfev, nsteps, NOT_FINITE
             if nsteps > max_steps:
                 return out_w, out_q, nfev, nsteps, TOO_MANY_STEPS
+            if nsteps % STOP_POLL == 0 and stop[0] != 0:
+                return out_w, out_q, nfev, nsteps, INTERRUPTED
         out_w[j + 1, 0] = st[0] * math.cos(st[1])
         out_w[j + 1, 1] = st[0] * math.sin(st[1])
         out_w[j + 1, 2] = st[2]

@@ -17,6 +17,7 @@ the 8th-order DOP853 formula in substeps of at most 1/50 of the local decay time
 
 from __future__ import annotations
 
+from ..interrupt import call_stoppable
 from . import tableaus as T
 from .base import Integrator, Problem, Solution, register
 from .geometric import MAX_STEPS, _args, _solution
@@ -35,7 +36,7 @@ def _solver(order: int):
         from . import kernels as KN
 
         model, J, g, w0, q0, t, with_q = _args(problem)
-        w, q, nfev, nsteps, status = KN.split_symmetric(model, J, g, w0, q0, t, float(step), gammas, with_q,
+        w, q, nfev, nsteps, status = call_stoppable(KN.split_symmetric, model, J, g, w0, q0, t, float(step), gammas, with_q,
                                                         int(max_steps), RH_MAX, T.DOP853.A, T.DOP853.b)
         return _solution(problem, w, q, status, {"nfev": int(nfev), "nsteps": int(nsteps), "stages": len(gammas)})
 

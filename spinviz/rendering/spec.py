@@ -118,6 +118,13 @@ class RenderSpec:
             raise SpecError("size", f"{panels} panels side by side need a width divisible by {panels}, got {w}")
 
 
+def poster_for(out: str) -> str:
+    """The PNG poster written beside a video: the same name with the extension .png."""
+    import os
+
+    return os.path.splitext(out)[0] + ".png"
+
+
 # --- per-field validation ------------------------------------------------------------------
 def _number(spec, key, v, lo=None, hi=None, lo_open=False, allow_none=False):
     if v is None and allow_none:

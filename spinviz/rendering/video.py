@@ -25,9 +25,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..atomic import AtomicPath
-from ..errors import RenderError
+from .. import interrupt
+from ..atomic import Outputs
+from ..errors import RenderError, printable
 from .encode import Mp4Writer, open_writer, save_png
+from .spec import poster_for
 
 __all__ = ["render_video", "render_frames", "RenderResult", "RenderError"]
 
@@ -97,9 +99,29 @@ class _Progress:
                 self.next_mark += 0.25
 
 
-def _segment_worker(index, plan, size, supersample, lo, hi, path, poster_f, msgs, stop):
-    """Render frames lo..hi-1 into the MP4 segment ``path``; report progress on ``msgs``."""
+def _worker_signals(parent: int) -> None:
+    """A render worker leaves stopping to its parent: the terminal's SIGINT and SIGHUP (sent to
+    the whole process group) are ignored, so no frame is torn in half on its way to ffmpeg;
+    the parent sets ``stop`` and the worker finishes its frame and closes its encoder.  A
+    SIGTERM (the parent's last resort) unwinds through the same clean-up."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGHUP, signal.SIG_IGN)
+
+    def leave(signum, frame):
+        raise SystemExit(128 + signum)
+
+    signal.signal(signal.SIGTERM, leave)
+    if os.getppid() != parent:                          # the parent died before we started
+        raise SystemExit(1)
+
+
+def _segment_worker(index, plan, size, supersample, lo, hi, path, poster_f, msgs, stop, parent):
+    """Render frames lo..hi-1 into the MP4 segment ``path``; report progress on ``msgs``.
+    Stops between frames when ``stop`` is set or the parent process has gone."""
     try:
+        _worker_signals(parent)
         # one rasterizer thread per worker: the workers already fill the cores
         os.environ.setdefault("LP_NUM_THREADS", "1")
         from .session import RenderSession
@@ -109,7 +131,7 @@ def _segment_worker(index, plan, size, supersample, lo, hi, path, poster_f, msgs
         msgs.put(("ready", index, None))
         done = 0
         for f in range(lo, hi):
-            if stop.is_set():
+            if stop.is_set() or os.getppid() != parent:
                 break
             img = session.frame(f)
             writer.write(img)
@@ -126,11 +148,14 @@ def _segment_worker(index, plan, size, supersample, lo, hi, path, poster_f, msgs
 
 
 def render_video(plan, out: str, workers: int | None = None, supersample: float | None = None,
-                 progress: bool = True, poster: bool = True, max_frames: int | None = None) -> RenderResult:
-    """Render ``plan`` to ``out`` (.mp4 or .gif) and a PNG poster beside it; atomically.
+                 progress: bool = True, poster: bool = True, max_frames: int | None = None,
+                 inputs=()) -> RenderResult:
+    """Render ``plan`` to ``out`` (.mp4 or .gif) and a PNG poster beside it; atomically, as a
+    group (``atomic.Outputs``: neither lands unless both are complete).
 
     workers : render processes for MP4 (default: one per core, at most 4); 1 renders in-process.
     max_frames : stop after this many frames (benchmarks).
+    inputs : files the outputs must not overwrite (the scene).
     """
     plan.spec.check_output(out, len(plan.panels))          # the format's rules live in the spec
     size = plan.spec.size
@@ -141,27 +166,19 @@ def render_video(plan, out: str, workers: int | None = None, supersample: float 
     if fmt != ".mp4" or F < 4 * workers:
         workers = 1
     poster_f = min(int(round(plan.spec.poster * (plan.frames - 1))), F - 1)
-    poster_path = os.path.splitext(out)[0] + ".png" if poster else None
-    targets = [AtomicPath(out)]
-    bar = _Progress(f"rendering {out}", F, progress)
+    paths = [out, poster_for(out)] if poster else [out]
+    bar = _Progress(f"rendering {printable(out, 80)}", F, progress)
     start = time.perf_counter()
-    try:
-        if poster_path:
-            targets.append(AtomicPath(poster_path))
+    with Outputs(paths, inputs) as tmps:                # video and poster land together, or neither does
         if workers == 1:
-            poster_img, startup = _render_in_process(plan, targets[0].tmp, size, supersample, F, poster_f, bar)
+            poster_img, startup = _render_in_process(plan, tmps[0], size, supersample, F, poster_f, bar)
         else:
-            poster_img, startup = _render_segments(plan, targets[0].tmp, size, supersample, F, poster_f, workers, bar)
-        if poster_path:                         # video and poster land together, or neither does
-            save_png(targets[1].tmp, poster_img)
-        for t in targets:
-            t.commit()
-    except BaseException:
-        for t in targets:
-            t.discard()
-        raise
+            poster_img, startup = _render_segments(plan, tmps[0], size, supersample, F, poster_f, workers, bar)
+        if poster:
+            save_png(tmps[1], poster_img)
+        interrupt.check()                               # a stop swallowed on the way still counts
     seconds = time.perf_counter() - start
-    return RenderResult(path=out, poster=poster_path, frames=F, size=size, seconds=seconds,
+    return RenderResult(path=out, poster=paths[1] if poster else None, frames=F, size=size, seconds=seconds,
                         startup_seconds=startup, workers=workers, notes=list(plan.notes))
 
 
@@ -175,6 +192,7 @@ def _render_in_process(plan, path, size, supersample, F, poster_f, bar):
     poster_img = None
     try:
         for f in range(F):
+            interrupt.check()                   # VTK may have swallowed the signal's exception
             img = session.frame(f)
             writer.write(img)
             if f == poster_f:
@@ -199,7 +217,8 @@ def _render_segments(plan, path, size, supersample, F, poster_f, workers, bar):
     tmpdir = tempfile.mkdtemp(prefix=".spinviz-segments-", dir=os.path.dirname(os.path.abspath(path)))
     segs = [os.path.join(tmpdir, f"part{k}.mp4") for k in range(workers)]
     procs = [ctx.Process(target=_segment_worker, daemon=True,
-                         args=(k, plan, size, supersample, int(bounds[k]), int(bounds[k + 1]), segs[k], poster_f, msgs, stop))
+                         args=(k, plan, size, supersample, int(bounds[k]), int(bounds[k + 1]), segs[k], poster_f, msgs,
+                               stop, os.getpid()))
              for k in range(workers)]
     t0 = time.perf_counter()
     startup = None
@@ -211,8 +230,9 @@ def _render_segments(plan, path, size, supersample, F, poster_f, workers, bar):
         pending = set(range(workers))
         ready = 0
         while pending:
+            interrupt.check()
             try:
-                kind, k, payload = msgs.get(timeout=1.0)
+                kind, k, payload = msgs.get(timeout=0.5)
             except _queue.Empty:
                 dead = [i for i in pending if not procs[i].is_alive()]
                 if dead:
@@ -233,11 +253,14 @@ def _render_segments(plan, path, size, supersample, F, poster_f, workers, bar):
                 pending.discard(k)
         _concat(segs, path)
     finally:
-        stop.set()
+        stop.set()                                      # workers finish their frame and close their encoder
         for p in procs:
             p.join(timeout=5)
             if p.is_alive():
                 p.terminate()
+                p.join(timeout=5)
+        msgs.close()
+        msgs.join_thread()
         shutil.rmtree(tmpdir, ignore_errors=True)
     return poster_img, startup or 0.0
 
@@ -246,12 +269,15 @@ def _concat(segments, path):
     """Join MP4 segments by stream copy (no re-encoding) with ffmpeg's concat demuxer."""
     import imageio_ffmpeg
 
-    listing = os.path.join(os.path.dirname(segments[0]), "segments.txt")
+    folder = os.path.dirname(segments[0])
+    listing = os.path.join(folder, "segments.txt")
     with open(listing, "w") as fh:
+        # names relative to the listing (the demuxer resolves them there): a folder whose name
+        # holds a quote or a newline never appears inside the list
         for s in segments:
-            fh.write("file '" + s.replace("'", "'\\''") + "'\n")     # the concat demuxer's quoting
+            fh.write(f"file '{os.path.basename(s)}'\n")
     cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-hide_banner", "-loglevel", "error", "-y", "-f", "concat", "-safe", "0",
            "-i", listing, "-c", "copy", "-movflags", "+faststart", "-f", "mp4", path]
-    r = subprocess.run(cmd, capture_output=True, text=True)
+    r = subprocess.run(cmd, capture_output=True, text=True, start_new_session=True)   # the terminal's Ctrl-C is ours
     if r.returncode != 0:
         raise RenderError(f"joining the video segments failed: {r.stderr.strip().splitlines()[-1] if r.stderr else r.returncode}")

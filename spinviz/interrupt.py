@@ -1,0 +1,129 @@
+"""Stopping cleanly: SIGINT, SIGTERM and SIGHUP become one exception, ``Interrupted``.
+
+The command line calls ``install()``; from then on the first of these signals raises
+``Interrupted`` in the main thread, so ``finally`` blocks run: temporary files are deleted,
+worker processes stopped, nothing half-written is left and existing outputs stay as they
+were.  Later signals are recorded but do not raise again, so the clean-up itself is not
+cut short.  The exit status is 128 + the signal number (130, 143, 129).
+
+Two places need more than a Python handler:
+
+* a library may catch the exception (VTK swallows exceptions raised inside its calls), so
+  long loops also call ``check()``, which raises if a signal arrived at any time;
+* compiled (numba) loops never return to the interpreter, so ``call_stoppable`` runs them
+  in a thread without the GIL and hands them a ``stop`` flag they poll; the main thread
+  waits in short slices, takes the signal, sets the flag and re-raises once the kernel
+  has returned.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+
+import numpy as np
+
+SIGNALS = tuple(s for s in (getattr(signal, n, None) for n in ("SIGINT", "SIGTERM", "SIGHUP")) if s is not None)
+
+_received: int | None = None
+
+
+class Interrupted(KeyboardInterrupt):
+    """A stop request (SIGINT, SIGTERM or SIGHUP); ``exit_status`` is 128 + the signal number."""
+
+    def __init__(self, signum: int = signal.SIGINT):
+        self.signum = int(signum)
+        super().__init__(signal.Signals(self.signum).name)
+
+    @property
+    def exit_status(self) -> int:
+        return 128 + self.signum
+
+
+def _handler(signum, frame):
+    global _received
+    first = _received is None
+    _received = signum
+    if first:
+        raise Interrupted(signum)
+
+
+def install() -> None:
+    """Turn SIGINT, SIGTERM and SIGHUP into ``Interrupted`` (main thread only)."""
+    global _received
+    _received = None
+    for s in SIGNALS:
+        signal.signal(s, _handler)
+
+
+@contextlib.contextmanager
+def handlers():
+    """``install()`` for the duration of a block, then the previous handlers again (a command
+    run in-process from Python leaves the caller's signal handling as it found it)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = {s: signal.getsignal(s) for s in SIGNALS}
+    install()
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+
+
+def received() -> int | None:
+    """The signal received since ``install()``, or None."""
+    return _received
+
+
+def check() -> None:
+    """Raise ``Interrupted`` if a stop signal arrived (even if its exception was swallowed)."""
+    if _received is not None:
+        raise Interrupted(_received)
+
+
+@contextlib.contextmanager
+def deferred():
+    """Hold stop signals back for the few lines that must not be cut in two (renaming a
+    group of outputs into place); they are delivered when the block ends."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+POLL_S = 0.05
+
+
+def call_stoppable(kernel, *args):
+    """``kernel(*args, stop)`` in a helper thread (the kernel releases the GIL and polls
+    ``stop[0]``); a stop signal sets the flag and is re-raised once the kernel returned."""
+    stop = np.zeros(1, dtype=np.int64)
+    if threading.current_thread() is not threading.main_thread():
+        return kernel(*args, stop)                 # signals only reach the main thread anyway
+    box: dict = {}
+
+    def run():
+        try:
+            box["value"] = kernel(*args, stop)
+        except BaseException as e:                 # handed to the caller below
+            box["error"] = e
+
+    t = threading.Thread(target=run, name="spinviz-kernel", daemon=True)
+    t.start()
+    try:
+        while t.is_alive():
+            t.join(POLL_S)
+    except BaseException:
+        stop[0] = 1
+        t.join()
+        raise
+    if "error" in box:
+        raise box["error"]
+    return box["value"]

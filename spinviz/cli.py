@@ -8,6 +8,7 @@ import argparse
 import json
 import os
 import sys
+import warnings
 
 from . import interrupt
 from .errors import RenderError, SceneError, SimulationError, SpecError, SpinvizError, UsageError, printable
@@ -107,7 +108,10 @@ def _size(text: str):
 # --- dispatch ---------------------------------------------------------------------------
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
-    with interrupt.handlers():
+    with interrupt.handlers(), warnings.catch_warnings():
+        # NumPy's overflow warnings are not for the user: every result is checked for finite
+        # values and a run that leaves them fails with one line (driver._check_finite)
+        warnings.simplefilter("ignore", RuntimeWarning)
         return _run(args)
 
 

@@ -17,7 +17,7 @@ from . import units as U
 from .errors import SimulationError
 from .integrators import get
 from .integrators.auto import choose_method
-from .integrators.scaling import body_spin_problem
+from .integrators.scaling import body_spin_problem, check_scale
 from .physics.bodies import Body
 from .physics.equations import truncated_singularity
 from .trajectory import Trajectory
@@ -56,8 +56,7 @@ def simulate(
     comparison; singular at theta = 0) or "none" (no orientation: Euler equation only).
     """
     omega0 = np.asarray(omega0, dtype=float)
-    if omega0.shape != (3,) or not np.all(np.isfinite(omega0)):
-        raise ValueError(f"omega0 must be three finite numbers, got {omega0!r}")
+    check_scale(body, omega0)
     t_eval = output_times(t_end, samples, t_eval)
     q_init, euler_init = initial_orientation(q0, euler_zxz0)
     problem, eps = body_spin_problem(body, model, omega0, t_eval, q_init, euler_init, kinematics)
@@ -145,4 +144,14 @@ def _solve(integrator, problem, kw, auto: bool, reason: str, time_scale: float):
         sol = integrator.solve(problem, **kw)
     if not sol.success:
         raise SimulationError(f"{integrator.name}: {sol.message}")
+    _check_finite(sol, integrator.name, time_scale)
     return sol, integrator, reason
+
+
+def _check_finite(sol, name: str, time_scale: float) -> None:
+    """Never hand on a non-finite number: the first instant where one appears fails the run."""
+    parts = [a for a in (sol.omega, sol.q, sol.euler) if a is not None]
+    ok = np.all([np.all(np.isfinite(a), axis=1) for a in parts], axis=0)
+    if not np.all(ok):
+        i = int(np.argmin(ok))
+        raise SimulationError(f"{name}: the solution left the finite numbers by t = {sol.t[i] / time_scale:.4g}")

@@ -58,8 +58,10 @@ def as_float_quat(qa) -> np.ndarray:
 
 
 def normalize(q) -> np.ndarray:
-    """Unit quaternion(s) q / |q|; q shape (..., 4), (w, x, y, z)."""
+    """Unit quaternion(s) q / |q|; q shape (..., 4), (w, x, y, z).  Scaled by its largest
+    component first, so |q| cannot overflow (1e308 components) or underflow (1e-320)."""
     q = np.asarray(q, dtype=float)
+    q = q / np.max(np.abs(q), axis=-1, keepdims=True)
     return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 

@@ -34,10 +34,11 @@ import numpy as np
 
 from . import rotations as R
 from . import units as U
-from .errors import SceneError, SpecError
+from .errors import SceneError, SpecError, brief
 from .physics import bodies as B
 from .physics import presets as P
 from .physics.equations import MODELS
+from .integrators.scaling import check_scale
 from .rendering.spec import RenderSpec
 
 __all__ = ["Scene", "SceneError", "load_scene", "parse_scene"]
@@ -73,7 +74,7 @@ class _Table:
         if v is None:
             return None
         if isinstance(v, bool) or not isinstance(v, (int, float)):
-            raise self.error(k, f"must be a number, got {v!r}")
+            raise self.error(k, f"must be a number, got {brief(v)}")
         v = float(v)
         if not math.isfinite(v):
             raise self.error(k, f"must be finite, got {v}")
@@ -88,7 +89,7 @@ class _Table:
         if v is None:
             return None
         if isinstance(v, bool) or not isinstance(v, int):
-            raise self.error(k, f"must be an integer, got {v!r}")
+            raise self.error(k, f"must be an integer, got {brief(v)}")
         if minimum is not None and v < minimum:
             raise self.error(k, f"must be at least {minimum}, got {v}")
         return v
@@ -98,13 +99,13 @@ class _Table:
         if v is None:
             return None
         if not isinstance(v, (list, tuple)) or len(v) != n:
-            raise self.error(k, f"must be a list of {n} numbers, got {v!r}")
+            raise self.error(k, f"must be a list of {n} numbers, got {brief(v)}")
         out = []
         for x in v:
             if isinstance(x, bool) or not isinstance(x, (int, float)):
-                raise self.error(k, f"must be a list of {n} numbers, got {v!r}")
+                raise self.error(k, f"must be a list of {n} numbers, got {brief(v)}")
             if not math.isfinite(float(x)):
-                raise self.error(k, f"must be finite, got {v!r}")
+                raise self.error(k, f"must be finite, got {brief(v)}")
             out.append(float(x))
         return np.array(out)
 
@@ -113,7 +114,7 @@ class _Table:
         if v is None:
             return None
         if not isinstance(v, str):
-            raise self.error(k, f"must be a string, got {v!r}")
+            raise self.error(k, f"must be a string, got {brief(v)}")
         if choices is not None and v not in choices:
             raise self.error(k, f"unknown value {v!r}; valid: {', '.join(choices)}")
         return v
@@ -262,6 +263,10 @@ def parse_scene(data: dict, path: str = "<scene>") -> Scene:
     if units_hint is not None and units_hint != body.units:
         raise st.error("units", f"{units_hint!r} does not match the body, which is given in {body.units!r} units")
     omega0, q0 = _initial(it)
+    try:
+        check_scale(body, omega0)
+    except SpecError as e:
+        raise SceneError(path, "[initial].omega" if e.key == "omega" else "[body]", e.reason) from None
     sim = _simulation(st, body, omega0)
     render = _render(top, path, title, sim["t_end"])
     top.finish()
@@ -302,6 +307,12 @@ def _models(st: _Table) -> tuple[str, ...]:
     return tuple(ms)
 
 
+MAX_SAMPLES = 1_000_000
+RTOL_RANGE = (1e-15, 1e-1)
+ATOL_RANGE = (1e-300, 1.0)
+MAX_FIXED_STEPS = 1e10
+
+
 def _simulation(st: _Table, body: B.Body, omega0) -> dict:
     """[simulation]: models, horizon, samples and the integrator settings, as Scene fields."""
     models = _models(st)
@@ -311,7 +322,12 @@ def _simulation(st: _Table, body: B.Body, omega0) -> dict:
     t_end = st.number(tkey, positive=True)
     if tkey != "t_end":
         t_end *= _time_scale(body, omega0, tkey, st)
+        if not math.isfinite(t_end):
+            raise st.error(tkey, "the horizon in seconds is beyond float64")
     samples = st.integer("samples", required=True, minimum=2)
+    if samples > MAX_SAMPLES:
+        raise st.error("samples", f"must be at most {MAX_SAMPLES} (memory: {samples} instants x 11 numbers per model), "
+                                  f"got {samples}")
     method = st.string("method", "auto")
     if method.lower() != "auto":
         from .integrators import get as method_named  # the registry only: no kernel is compiled
@@ -321,8 +337,16 @@ def _simulation(st: _Table, body: B.Body, omega0) -> dict:
         except ValueError as e:
             raise st.error("method", str(e)) from None
     rtol = st.number("rtol", 1e-10, positive=True)
+    if not RTOL_RANGE[0] <= rtol <= RTOL_RANGE[1]:
+        raise st.error("rtol", f"must lie in [{RTOL_RANGE[0]:g}, {RTOL_RANGE[1]:g}] (a few ulp of float64 at the "
+                               f"tightest), got {rtol:g}")
     atol = st.number("atol", 1e-12, positive=True)
+    if not ATOL_RANGE[0] <= atol <= ATOL_RANGE[1]:
+        raise st.error("atol", f"must lie in [{ATOL_RANGE[0]:g}, {ATOL_RANGE[1]:g}] (units where |omega(0)| = 1), "
+                               f"got {atol:g}")
     step = st.number("step", positive=True)
+    if step is not None and t_end / step > MAX_FIXED_STEPS:
+        raise st.error("step", f"t_end / step = {t_end / step:.3g} steps; at most {MAX_FIXED_STEPS:g} can finish")
     st.finish()
     return dict(models=models, t_end=t_end, samples=samples, method=method.lower(), rtol=rtol, atol=atol, step=step)
 

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import units as U
+from ..errors import brief
 from ..rotations import world_from_body
 from .equations import System, is_symmetric
 
@@ -86,7 +87,7 @@ class Body:
         validate_inertia(self.inertia)
         d = np.asarray(self.dipole, dtype=float)
         if d.shape != (3,) or not np.all(np.isfinite(d)):
-            raise BodyError("dipole", f"must be three finite numbers, got {self.dipole!r}")
+            raise BodyError("dipole", f"must be three finite numbers, got {brief(self.dipole)}")
         if not np.any(d != 0.0):
             raise BodyError("dipole", "is zero: tau0 (3.8) is undefined; give a dipole and use model = \"free\" "
                                       "for torque-free motion")
@@ -208,15 +209,21 @@ class Body:
         return out
 
 
+MIN_INERTIA_RATIO = 1e-6     # the rod has 0.015, the checks go to 1e-4; at 1e-6 an askew run of 10 T takes ~2.5 min (Radau), at 1e-7 ~2 min per T
+
+
 def validate_inertia(inertia) -> None:
     """Raise BodyError unless inertia is three finite positive moments obeying I_i <= I_j + I_k."""
     a = np.asarray(inertia, dtype=float)
     if a.shape != (3,):
-        raise BodyError("inertia", f"must be three principal moments, got {inertia!r}")
+        raise BodyError("inertia", f"must be three principal moments, got {brief(inertia)}")
     if not np.all(np.isfinite(a)):
         raise BodyError("inertia", f"must be finite, got {list(a)}")
     if np.any(a <= 0.0):
         raise BodyError("inertia", f"principal moments must be positive, got {list(a)}")
+    if a.min() < MIN_INERTIA_RATIO * a.max():
+        raise BodyError("inertia", f"smallest/largest moment = {a.min() / a.max():.2g} is below {MIN_INERTIA_RATIO:g}: "
+                                   f"a needle this thin makes (4.4) too stiff to integrate (it divides by I3/I1)")
     for i in range(3):
         j, k = (i + 1) % 3, (i + 2) % 3
         if a[i] > (a[j] + a[k]) * (1.0 + 1e-12):
@@ -229,7 +236,7 @@ def validate_inertia(inertia) -> None:
 def _positive(key: str, x: float) -> float:
     x = float(x)
     if not math.isfinite(x) or x <= 0.0:
-        raise BodyError(key, f"must be a positive finite number, got {x!r}")
+        raise BodyError(key, f"must be a positive finite number, got {brief(x)}")
     return x
 
 
@@ -310,8 +317,11 @@ def symmetric_top(delta: float, chi: float, name="symmetric top", **kw) -> Body:
     """Dimensionless symmetric top of section 3: I = (1, 1, 1 - delta), d = (sin chi, 0, cos chi)."""
     delta = float(delta)
     if not math.isfinite(delta) or not (-1.0 <= delta < 1.0):
-        raise BodyError("delta", f"must satisfy -1 <= delta < 1 (3.6), got {delta!r}")
+        raise BodyError("delta", f"must satisfy -1 <= delta < 1 (3.6), got {brief(delta)}")
+    if 1.0 - delta < MIN_INERTIA_RATIO:
+        raise BodyError("delta", f"1 - delta = I3/I1 = {1.0 - delta:.2g} is below {MIN_INERTIA_RATIO:g}: a needle this thin "
+                                 f"makes (4.4) too stiff to integrate")
     chi = float(chi)
     if not math.isfinite(chi):
-        raise BodyError("chi", f"must be finite, got {chi!r}")
+        raise BodyError("chi", f"must be finite, got {brief(chi)}")
     return custom((1.0, 1.0, 1.0 - delta), (math.sin(chi), 0.0, math.cos(chi)), units="dimensionless", name=name, **kw)

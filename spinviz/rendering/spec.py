@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields, replace
 
-from ..errors import SpecError
+from ..errors import SpecError, brief
 
 SHOW_ITEMS = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud", "hodograph")
 DEFAULT_SHOW = ("body", "dipole", "axes", "trail", "sphere", "hud")
@@ -24,6 +24,11 @@ VIDEO_FORMATS = (".mp4", ".gif")
 MIN_SIZE, MAX_SIZE = 16, 7680
 MAX_FPS = 240
 MAX_DURATION_S = 3600.0
+MAX_FRAMES = 100_000            # ~55 min at 30 fps; the frame plan holds ~300 bytes per frame and panel
+MAX_GIF_BYTES = 1_000_000_000   # a GIF's frames are kept in memory (1 byte per pixel) until it is written
+ZOOM_RANGE = (0.05, 20.0)       # outside it the body is a dot or fills the frame far beyond its edges
+MAX_KNEE_RATIO = 1e15           # t_end / log_knee: float64 must still tell neighbouring frame times apart
+MAX_TITLE = 160
 
 
 @dataclass(frozen=True)
@@ -63,6 +68,12 @@ class RenderSpec:
     def __post_init__(self):
         for f in fields(self):
             _CHECKS[f.name](self, f.name, getattr(self, f.name))
+        if self.frames > MAX_FRAMES:
+            raise SpecError("duration", f"{self.duration:g} s at {self.fps} fps is {self.frames} frames; "
+                                        f"at most {MAX_FRAMES} are allowed")
+        if self.spin_turns_per_second > self.fps / 4.0:
+            raise SpecError("spin_turns_per_second", f"must be at most fps / 4 = {self.fps / 4.0:g} (a quarter turn per "
+                                                     f"frame; faster spins alias), got {self.spin_turns_per_second:g}")
 
     # -- construction ---------------------------------------------------------------------
     @classmethod
@@ -99,9 +110,13 @@ class RenderSpec:
 
     # -- checks that need more than the spec ----------------------------------------------
     def check_horizon(self, t_end: float) -> None:
-        """The log knee must lie inside the run."""
+        """The log knee must lie inside the run, and not so far below t_end that float64
+        cannot separate the frame times."""
         if self.log_knee is not None and not self.log_knee < t_end:
             raise SpecError("log_knee", f"must be below t_end = {t_end:g}")
+        if self.log_knee is not None and t_end / self.log_knee > MAX_KNEE_RATIO:
+            raise SpecError("log_knee", f"must be at least t_end / {MAX_KNEE_RATIO:g} = {t_end / MAX_KNEE_RATIO:.3g}, "
+                                        f"got {self.log_knee:g}")
 
     def check_output(self, path: str, panels: int = 1) -> None:
         """The output format and the layout: .mp4 or .gif; MP4 (H.264, yuv420p) needs even
@@ -116,6 +131,9 @@ class RenderSpec:
             raise SpecError("size", f"MP4 (H.264, yuv420p) needs an even width and height, got {w}x{h}")
         if w % panels:
             raise SpecError("size", f"{panels} panels side by side need a width divisible by {panels}, got {w}")
+        if ext == ".gif" and self.frames * w * h > MAX_GIF_BYTES:
+            raise SpecError("duration", f"a GIF of {self.frames} frames at {w}x{h} needs {self.frames * w * h / 1e9:.1f} GB "
+                                        f"of memory (limit {MAX_GIF_BYTES / 1e9:g} GB); make it shorter or smaller, or use .mp4")
 
 
 def poster_for(out: str) -> str:
@@ -130,7 +148,7 @@ def _number(spec, key, v, lo=None, hi=None, lo_open=False, allow_none=False):
     if v is None and allow_none:
         return
     if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise SpecError(key, f"must be a number, got {v!r}")
+        raise SpecError(key, f"must be a number, got {brief(v)}")
     if not math.isfinite(v):
         raise SpecError(key, f"must be finite, got {v}")
     if lo is not None and (v <= lo if lo_open else v < lo):
@@ -142,7 +160,7 @@ def _number(spec, key, v, lo=None, hi=None, lo_open=False, allow_none=False):
 def _choice(options):
     def check(spec, key, v):
         if v not in options:
-            raise SpecError(key, f"unknown value {v!r}; valid: {', '.join(options)}")
+            raise SpecError(key, f"unknown value {brief(v)}; valid: {', '.join(options)}")
     return check
 
 
@@ -150,14 +168,14 @@ def _check_size(spec, key, v):
     ok = (isinstance(v, (tuple, list)) and len(v) == 2
           and all(isinstance(x, int) and not isinstance(x, bool) for x in v))
     if not ok or not all(MIN_SIZE <= x <= MAX_SIZE for x in v):
-        raise SpecError(key, f"must be [width, height] in pixels ({MIN_SIZE}..{MAX_SIZE}), got {v!r}")
+        raise SpecError(key, f"must be [width, height] in pixels ({MIN_SIZE}..{MAX_SIZE}), got {brief(v)}")
     if not isinstance(v, tuple):
         object.__setattr__(spec, key, tuple(v))
 
 
 def _check_fps(spec, key, v):
     if isinstance(v, bool) or not isinstance(v, int):
-        raise SpecError(key, f"must be an integer, got {v!r}")
+        raise SpecError(key, f"must be an integer, got {brief(v)}")
     if not 1 <= v <= MAX_FPS:
         raise SpecError(key, f"must be between 1 and {MAX_FPS}, got {v}")
 
@@ -173,7 +191,11 @@ def _check_show(spec, key, v):
 
 def _check_title(spec, key, v):
     if not isinstance(v, str):
-        raise SpecError(key, f"must be a string, got {v!r}")
+        raise SpecError(key, f"must be a string, got {brief(v)}")
+    if any(ord(c) < 0x20 or 0x7F <= ord(c) < 0xA0 for c in v):
+        raise SpecError(key, "must be one line of printable text (no newlines or control characters)")
+    if len(v) > MAX_TITLE:
+        raise SpecError(key, f"must be at most {MAX_TITLE} characters, got {len(v)}")
 
 
 _CHECKS = {
@@ -185,10 +207,10 @@ _CHECKS = {
     "spin": _choice(("auto", "true", "slowed")),
     "spin_turns_per_second": lambda s, k, v: _number(s, k, v, lo=0.0, lo_open=True),
     "show": _check_show,
-    "trail_seconds": lambda s, k, v: _number(s, k, v, lo=0.0),
+    "trail_seconds": lambda s, k, v: _number(s, k, v, lo=0.0, hi=MAX_DURATION_S),
     "azimuth_deg": lambda s, k, v: _number(s, k, v),
     "elevation_deg": lambda s, k, v: _number(s, k, v, lo=-89.0, hi=89.0),
-    "zoom": lambda s, k, v: _number(s, k, v, lo=0.0, lo_open=True),
+    "zoom": lambda s, k, v: _number(s, k, v, lo=ZOOM_RANGE[0], hi=ZOOM_RANGE[1]),
     "background": _choice(("white", "black")),
     "title": _check_title,
     "poster": lambda s, k, v: _number(s, k, v, lo=0.0, hi=1.0),

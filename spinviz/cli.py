@@ -18,10 +18,17 @@ EXIT_OK, EXIT_FAIL, EXIT_USAGE = 0, 1, 2
 UserError = UsageError          # the CLI's name for bad input (exit 2)
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with its errors in the house style: one escaped line, exit status 2."""
+
+    def error(self, message):
+        self.exit(EXIT_USAGE, f"spinviz: error: {printable(message)} (see '{printable(self.prog)} --help')\n")
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="spinviz", description="Rotation of a dipolar nanocrystal braked by radiation reaction "
-                                "(reduced (2.2)+(2.3) vs truncated (2.5) Euler equations).")
-    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+    p = _Parser(prog="spinviz", description="Rotation of a dipolar nanocrystal braked by radiation reaction "
+                                            "(reduced (2.2)+(2.3) vs truncated (2.5) Euler equations).")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
 
     c = sub.add_parser("check", help="validate the integrators against the paper's closed forms")

@@ -35,10 +35,10 @@ import numpy as np
 from . import rotations as R
 from . import units as U
 from .errors import SceneError, SpecError, brief
+from .integrators.scaling import check_scale
 from .physics import bodies as B
 from .physics import presets as P
 from .physics.equations import MODELS
-from .integrators.scaling import check_scale
 from .rendering.spec import RenderSpec
 
 __all__ = ["Scene", "SceneError", "load_scene", "parse_scene"]
@@ -69,7 +69,8 @@ class _Table:
         self.used.add(k)
         return self.data[k]
 
-    def number(self, k: str, default=None, required=False, positive=False, nonneg=False) -> float | None:
+    def number(self, k: str, default=None, required=False, positive=False, nonneg=False, within=None) -> float | None:
+        """A finite number; ``within=(lo, hi)`` with the reason a value outside makes no sense."""
         v = self.raw(k, default, required)
         if v is None:
             return None
@@ -82,6 +83,8 @@ class _Table:
             raise self.error(k, f"must be positive, got {v:g}")
         if nonneg and v < 0.0:
             raise self.error(k, f"must not be negative, got {v:g}")
+        if within is not None and not within[0] <= v <= within[1]:
+            raise self.error(k, f"must lie in [{within[0]:g}, {within[1]:g}] ({within[2]}), got {v:g}")
         return v
 
     def integer(self, k: str, default=None, required=False, minimum=None) -> int | None:
@@ -213,36 +216,49 @@ def _body(t: _Table, units_hint: str | None) -> B.Body:
         raise t.error(e.key, e.reason) from None
 
 
+# Physical ranges of the CGS inputs: wide enough for any nanoparticle and for a metre-sized
+# crystal, narrow enough that every derived quantity (I ~ rho L^5, tau0 ~ d^2/I) is a float64.
+LENGTH_NM = (0.1, 1e9, "from an atom to a metre")
+DENSITY = (1e-3, 1e3, "g/cm^3")
+DIPOLE_DEBYE = (1e-6, 1e30, "D")
+ASPECT = (1e-3, 1e3, "L/D")
+
+
 def _preset(t: _Table) -> B.Body:
     name = t.string("preset", choices=tuple(P.PRESETS) + ("dast_box",))
-    density = t.number("density", positive=True)
+    density = t.number("density", within=DENSITY)
     if name == "cellulose_rod":
         return P.cellulose_rod(density=density)
     if name == "dast_cube":
-        return P.dast_cube(t.number("a_nm", 100.0, positive=True), density=density)
+        return P.dast_cube(t.number("a_nm", 100.0, within=LENGTH_NM), density=density)
     if name == "dast_family1":
-        return P.dast_family1(t.number("a_nm", 100.0, positive=True), t.number("c_nm", 50.0, positive=True), density=density)
-    a, b, c = (t.number(k, required=True, positive=True) for k in ("a_nm", "b_nm", "c_nm"))
+        return P.dast_family1(t.number("a_nm", 100.0, within=LENGTH_NM), t.number("c_nm", 50.0, within=LENGTH_NM),
+                              density=density)
+    a, b, c = (t.number(k, required=True, within=LENGTH_NM) for k in ("a_nm", "b_nm", "c_nm"))
     return P.dast_box(a, b, c, density=density)
 
 
 def _shape(t: _Table) -> B.Body:
     kind = t.string("shape", choices=("rod", "box"))
-    density = t.number("density", required=True, positive=True)
+    density = t.number("density", required=True, within=DENSITY)
     name = t.string("name", kind)
     if kind == "rod":
-        length = t.number("length_nm", required=True, positive=True) * U.NM
+        length = t.number("length_nm", required=True, within=LENGTH_NM) * U.NM
         if t.has("diameter_nm") == t.has("aspect"):
             raise t.error("diameter_nm", "give diameter_nm or aspect (L/D), exactly one")
         if t.has("diameter_nm"):
-            diameter = t.number("diameter_nm", positive=True) * U.NM
+            diameter = t.number("diameter_nm", within=LENGTH_NM) * U.NM
         else:
-            diameter = length / t.number("aspect", positive=True)
-        dipole = t.number("dipole_debye", required=True, positive=True) * U.DEBYE
+            diameter = length / t.number("aspect", within=ASPECT)
+        dipole = t.number("dipole_debye", required=True, within=DIPOLE_DEBYE) * U.DEBYE
         return B.rod(length, diameter, density, dipole, t.angle("chi", 0.0), name=name)
-    a, b, c = (t.number(k, required=True, positive=True) * U.NM for k in ("a_nm", "b_nm", "c_nm"))
-    dipole = t.vector("dipole_debye", required=True) * U.DEBYE
-    return B.box(a, b, c, density, dipole, name=name)
+    a, b, c = (t.number(k, required=True, within=LENGTH_NM) * U.NM for k in ("a_nm", "b_nm", "c_nm"))
+    dipole = t.vector("dipole_debye", required=True)
+    size = float(np.max(np.abs(dipole)))
+    if not DIPOLE_DEBYE[0] <= size <= DIPOLE_DEBYE[1]:
+        raise t.error("dipole_debye", f"the largest component must lie in [{DIPOLE_DEBYE[0]:g}, {DIPOLE_DEBYE[1]:g}] D, "
+                                      f"got {size:g}")
+    return B.box(a, b, c, density, dipole * U.DEBYE, name=name)
 
 
 # --- the whole file -----------------------------------------------------------------------
@@ -328,6 +344,8 @@ def _simulation(st: _Table, body: B.Body, omega0) -> dict:
     if samples > MAX_SAMPLES:
         raise st.error("samples", f"must be at most {MAX_SAMPLES} (memory: {samples} instants x 11 numbers per model), "
                                   f"got {samples}")
+    if not np.all(np.diff(np.linspace(0.0, t_end, samples)) > 0.0) or not t_end / body.tau0 > 0.0:
+        raise st.error(tkey, f"{t_end:g} is too short to hold {samples} distinct instants")
     method = st.string("method", "auto")
     if method.lower() != "auto":
         from .integrators import get as method_named  # the registry only: no kernel is compiled
@@ -380,7 +398,7 @@ def _time_scale(body: B.Body, omega0, key: str, st: _Table) -> float:
     return body.residual_time_Theta(w3)
 
 
-MAX_FILE_BYTES = 1_000_000      # a scene is a few hundred bytes; this bounds what a bad path can make us read
+MAX_FILE_BYTES = 16_000_000     # a scene is a few hundred bytes; this bounds what a bad path can make us read
 
 
 def read_toml(path, kind: str = "scene") -> dict:

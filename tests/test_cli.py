@@ -95,7 +95,7 @@ omega = [0.0, 3e10, 0.0]
 model = "reduced"
 t_end = 1e-9
 samples = 3
-""", "[body].length_nm: must be positive, got -315"),
+""", "[body].length_nm: must lie in [0.1, 1e+09] (from an atom to a metre), got -315"),
     ("I3 > I1 + I2", GOOD.replace("delta = 0.3\nchi = 0.7", "inertia = [1.0, 1.0, 2.5]\ndipole = [0.0, 0.0, 1.0]"),
      "[body].inertia: I3 = 2.5 exceeds I1 + I2 = 2"),
     ("NaN", GOOD.replace("delta = 0.3", "delta = nan"), "[body].delta: must be finite, got nan"),

@@ -4,10 +4,15 @@ nothing half-written ever sits at the output path."""
 
 from __future__ import annotations
 
+import logging
 import os
 
 import numpy as np
 from PIL import Image
+
+# imageio-ffmpeg warns when a writer closes before its first frame: a worker told to stop
+# early does exactly that, and its segment is discarded anyway.
+logging.getLogger("imageio_ffmpeg").setLevel(logging.ERROR)
 
 
 class Mp4Writer:

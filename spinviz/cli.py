@@ -148,6 +148,8 @@ def _run(args) -> int:
     except KeyboardInterrupt:
         _say("interrupted", "; nothing was written")
         return 130
+    except BrokenPipeError:
+        raise                                           # the reader left: entry() ends quietly
     except (SpinvizError, ValueError, OSError, ImportError, ArithmeticError, RuntimeError, RecursionError,
             MemoryError) as e:
         # the safety net: whatever input slipped past the specific checks still gets one
@@ -371,4 +373,11 @@ _COMMANDS = {"check": _cmd_check, "info": _cmd_info, "simulate": _cmd_simulate, 
 
 def entry() -> None:
     """Console-script entry point."""
-    sys.exit(main())
+    try:
+        code = main()
+        sys.stdout.flush()
+    except BrokenPipeError:
+        # the reader went away (spinviz methods | head -1): end quietly, as a Unix tool does
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        code = 128 + 13
+    sys.exit(code)

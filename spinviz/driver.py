@@ -16,7 +16,7 @@ from . import rotations as R
 from . import units as U
 from .errors import SimulationError
 from .integrators import get
-from .integrators.auto import choose_method
+from .integrators.auto import check_cost, choose_method
 from .integrators.scaling import body_spin_problem, check_scale
 from .physics.bodies import Body
 from .physics.equations import truncated_singularity
@@ -65,6 +65,7 @@ def simulate(
     time_scale = eps / body.tau0                   # spin-unit time per unit of t
     method = str(method).lower()
     auto = method == "auto"
+    check_cost(body, model, omega0, float(t_eval[-1]), method, step, spin=(problem, eps))
     if auto:
         method, reason = choose_method(body, model, omega0, float(t_eval[-1]), kinematics, spin=(problem, eps))
     else:

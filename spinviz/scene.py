@@ -35,6 +35,7 @@ import numpy as np
 from . import rotations as R
 from . import units as U
 from .errors import SceneError, SpecError, brief
+from .integrators.auto import check_cost
 from .integrators.scaling import check_scale
 from .physics import bodies as B
 from .physics import presets as P
@@ -326,8 +327,6 @@ def _models(st: _Table) -> tuple[str, ...]:
 MAX_SAMPLES = 1_000_000
 RTOL_RANGE = (1e-15, 1e-1)
 ATOL_RANGE = (1e-300, 1.0)
-MAX_FIXED_STEPS = 1e10
-
 
 def _simulation(st: _Table, body: B.Body, omega0) -> dict:
     """[simulation]: models, horizon, samples and the integrator settings, as Scene fields."""
@@ -363,8 +362,12 @@ def _simulation(st: _Table, body: B.Body, omega0) -> dict:
         raise st.error("atol", f"must lie in [{ATOL_RANGE[0]:g}, {ATOL_RANGE[1]:g}] (units where |omega(0)| = 1), "
                                f"got {atol:g}")
     step = st.number("step", positive=True)
-    if step is not None and t_end / step > MAX_FIXED_STEPS:
-        raise st.error("step", f"t_end / step = {t_end / step:.3g} steps; at most {MAX_FIXED_STEPS:g} can finish")
+    try:
+        check_cost(body, models[0], omega0, t_end, method, step)
+        for m in models[1:]:
+            check_cost(body, m, omega0, t_end, method, step)
+    except SpecError as e:
+        raise st.error(tkey if e.key == "t_end" else e.key, e.reason) from None
     st.finish()
     return dict(models=models, t_end=t_end, samples=samples, method=method.lower(), rtol=rtol, atol=atol, step=step)
 

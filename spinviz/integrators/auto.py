@@ -6,10 +6,69 @@ import math
 
 import numpy as np
 
+from ..errors import SpecError
+from .base import get
 from .scaling import body_spin_problem
 
 MAX_RESOLVED_TURNS = 1e6     # beyond this, resolving every turn costs more than ~10 s
+HARD_MAX_TURNS = 3e8         # a resolving method takes ~3 us per turn (lie-dop853): beyond this ~15 min
 STIFF_RATIO = 10.0           # radiation decay rate / spin rate above which explicit steps are stability-bound
+
+
+def braking_coefficient(problem) -> float:
+    """kappa: the initial relative decay rate of |omega| in units of eps_rad |omega|^2 (spin
+    units), from the model's own radiation torque -- averaged over the free precession phase
+    for a symmetric top, whose braking depends on where omega_perp points in the body.
+    1 for rotation about a principal axis perpendicular to d ((3.7)), 0 where nothing brakes."""
+    s = problem.system
+    w = np.asarray(problem.omega0, dtype=float)
+    rad = s.radiation()
+    if s.is_symmetric:
+        wp, p0 = math.hypot(w[0], w[1]), math.atan2(w[1], w[0])
+        p = p0 + 2.0 * math.pi * np.arange(32) / 32
+        a = np.array(rad(wp * np.cos(p), wp * np.sin(p), np.full(p.shape, w[2])))
+        ws = np.stack([wp * np.cos(p), wp * np.sin(p), np.full(p.shape, w[2])])
+        decay = -float(np.mean(np.sum(ws * a, axis=0)))
+    else:
+        decay = -float(np.dot(w, rad(*w)))
+    eps = float(np.dot(s.coupling, s.coupling))
+    w2 = float(w @ w)
+    return max(0.0, decay / (eps * w2 * w2)) if eps > 0 and w2 > 0 else 0.0
+
+
+MAX_FIXED_STEPS = 1e10
+
+
+def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", step: float | None = None,
+               spin=None) -> None:
+    """Refuse, before any work, a run that cannot finish: more than 1e10 fixed steps, or more
+    than ``HARD_MAX_TURNS`` turns (estimated with braking) for a method that resolves every
+    turn.  ``secular`` (and ``auto`` on a symmetric top, which uses it) follows the slow
+    variables instead and has no such limit.  ``SpecError`` names "step" or "t_end"."""
+    method = str(method).lower()
+    if method != "auto" and get(method).fixed_step:
+        if step is not None and t_end / step > MAX_FIXED_STEPS:
+            raise SpecError("step", f"t_end / step = {t_end / step:.3g} steps; at most {MAX_FIXED_STEPS:g} can finish")
+        return
+    if method == "secular" or (method == "auto" and body.is_symmetric):
+        return
+    turns = estimated_turns(body, model, omega0, t_end, spin)
+    if turns > HARD_MAX_TURNS:
+        who = "every method for an asymmetric body" if method == "auto" else method
+        raise SpecError("t_end", f"the body turns ~{turns:.3g} times (estimated with braking) and {who} resolves each "
+                                 f"turn: at most {HARD_MAX_TURNS:g} can finish")
+
+
+def estimated_turns(body, model: str, omega0, t_end: float, spin=None) -> float:
+    """Turns of the body over [0, t_end] with braking: |omega| following the law of (3.7),
+    d|omega|/ds = -kappa eps |omega|^3, with kappa measured at the start
+    (``braking_coefficient``); without braking (kappa = 0) |omega0| t_end / 2 pi."""
+    problem, eps = spin if spin is not None else body_spin_problem(body, model, omega0)
+    S = float(t_end) * eps / body.tau0                  # the horizon in spin units (|omega(0)| = 1)
+    k = braking_coefficient(problem) * eps
+    if k * S < 1e-8:
+        return S / (2.0 * math.pi)
+    return (math.sqrt(1.0 + 2.0 * k * S) - 1.0) / (2.0 * math.pi * k)
 
 
 def stiffness_ratio(body, model: str, omega0, problem=None) -> float:

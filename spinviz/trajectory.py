@@ -171,6 +171,23 @@ class Trajectory:
         L_body = np.asarray(self.body.inertia, dtype=float) * self.omega
         return R.angle_between(np.broadcast_to(self.body.dipole_direction, L_body.shape), L_body)
 
+    def angle_d_L_range(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lowest, highest) angle between d and L over one free precession turn, rad, (N,) each.
+
+        For a symmetric top L_body = (w1, w2, J3 w3) turns about e3 at the fixed nutation
+        theta_L = atan2(|w_perp|, J3 w3) while d sits at chi from e3, so the angle sweeps
+        [|theta_L - chi|, theta_L + chi] (folded into [0, pi]) whatever the precession phase:
+        it needs only the slow variables, so it is exact also where the phase is averaged
+        (``secular``).  For an asymmetric body it is the instantaneous angle twice."""
+        if not self.body.is_symmetric:
+            a = self.angle_d_L()
+            return a, a.copy()
+        J3 = self.body.I3 / self.body.I1
+        theta_L = np.arctan2(np.hypot(self.omega[:, 0], self.omega[:, 1]), J3 * self.omega[:, 2])
+        chi = self.body.chi
+        hi = theta_L + chi
+        return np.abs(theta_L - chi), np.where(hi > np.pi, 2.0 * np.pi - hi, hi)
+
     def plot(self, path: str | None = None):
         """|Omega|(t), the angle between d and L, and the hodograph of Omega (body frame), as a
         matplotlib figure; also written to ``path`` (PNG) when given."""

@@ -74,3 +74,18 @@ def test_angle_d_L_needs_no_orientation_and_matches_the_world_frame():
     np.testing.assert_allclose(a.angle_d_L(), world, atol=1e-7)
     b = spinviz.simulate(body, "reduced", (0.1, 0.2, 0.3), t_end=30.0, samples=20, kinematics="none")
     np.testing.assert_allclose(b.angle_d_L(), a.angle_d_L(), atol=1e-9)
+
+
+def test_angle_d_L_range_brackets_the_swing_over_a_precession_turn():
+    """Askew symmetric top (delta = 0.3, chi = 1.0), free motion over several precession turns:
+    the instantaneous angle(d, L) sweeps exactly the interval angle_d_L_range gives."""
+    body = B.symmetric_top(0.3, 1.0)
+    w = (0.2, 0.0, 0.5)                     # precession rate delta w3 = 0.15: period ~42
+    tr = spinviz.simulate(body, "free", w, t_end=200.0, samples=4001, rtol=1e-12, atol=1e-14)
+    lo, hi = tr.angle_d_L_range()
+    a = tr.angle_d_L()
+    np.testing.assert_allclose(lo, lo[0], atol=1e-10)          # free motion: theta_L is constant
+    assert np.all(a >= lo - 1e-9) and np.all(a <= hi + 1e-9)
+    assert a.min() == pytest.approx(lo[0], abs=1e-4) and a.max() == pytest.approx(hi[0], abs=1e-4)
+    theta_L = math.atan2(0.2, 0.7 * 0.5)
+    assert lo[0] == pytest.approx(abs(theta_L - 1.0)) and hi[0] == pytest.approx(theta_L + 1.0)

@@ -65,7 +65,7 @@ def simulate(
     time_scale = eps / body.tau0                   # spin-unit time per unit of t
     method = str(method).lower()
     auto = method == "auto"
-    check_cost(body, model, omega0, float(t_eval[-1]), method, step, spin=(problem, eps))
+    check_cost(body, model, omega0, float(t_eval[-1]), method, step, spin=(problem, eps), kinematics=kinematics)
     if auto:
         method, reason = choose_method(body, model, omega0, float(t_eval[-1]), kinematics, spin=(problem, eps))
     else:

@@ -19,6 +19,7 @@ Two places need more than a Python handler:
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
 import threading
 
@@ -41,11 +42,26 @@ class Interrupted(KeyboardInterrupt):
         return 128 + self.signum
 
 
+# Libraries that call back into Python and swallow what the callback raises (VTK prints an
+# error block and carries on): a signal arriving there is only recorded, and the caller's
+# loop raises it at its next ``check()`` -- between two frames.
+_SWALLOWING = (f"{os.sep}vtkmodules{os.sep}",
+               f"{os.sep}pyvista{os.sep}")
+
+
+def _inside_swallowing_library(frame) -> bool:
+    while frame is not None:
+        if any(s in frame.f_code.co_filename for s in _SWALLOWING):
+            return True
+        frame = frame.f_back
+    return False
+
+
 def _handler(signum, frame):
     global _received
     first = _received is None
     _received = signum
-    if first:
+    if first and not _inside_swallowing_library(frame):
         raise Interrupted(signum)
 
 

@@ -40,21 +40,27 @@ MAX_FIXED_STEPS = 1e10
 
 
 def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", step: float | None = None,
-               spin=None) -> None:
+               spin=None, kinematics: str = "quaternion") -> None:
     """Refuse, before any work, a run that cannot finish: more than 1e10 fixed steps, or more
     than ``HARD_MAX_TURNS`` turns (estimated with braking) for a method that resolves every
-    turn.  ``secular`` (and ``auto`` on a symmetric top, which uses it) follows the slow
-    variables instead and has no such limit.  ``SpecError`` names "step" or "t_end"."""
+    turn.  ``secular`` follows the slow variables instead and has no such limit; ``auto`` is
+    judged by the method it picks.  ``SpecError`` names "step" or "t_end"."""
     method = str(method).lower()
-    if method != "auto" and get(method).fixed_step:
+    auto = method == "auto"
+    if auto:
+        method = choose_method(body, model, omega0, t_end, kinematics, spin=spin)[0]
+    if get(method).fixed_step:
         if step is not None and t_end / step > MAX_FIXED_STEPS:
             raise SpecError("step", f"t_end / step = {t_end / step:.3g} steps; at most {MAX_FIXED_STEPS:g} can finish")
         return
-    if method == "secular" or (method == "auto" and body.is_symmetric):
+    if method == "secular":
         return
     turns = estimated_turns(body, model, omega0, t_end, spin)
     if turns > HARD_MAX_TURNS:
-        who = "every method for an asymmetric body" if method == "auto" else method
+        who = method
+        if auto:
+            who = ("every method for an asymmetric body" if not body.is_symmetric else
+                   f"{method} (averaging does not apply: tau0 |Omega0| is not small)")
         raise SpecError("t_end", f"the body turns ~{turns:.3g} times (estimated with braking) and {who} resolves each "
                                  f"turn: at most {HARD_MAX_TURNS:g} can finish")
 

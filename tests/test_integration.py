@@ -51,8 +51,10 @@ def test_check_3_9_askew_rotation_about_e2(model):
 
 @pytest.mark.parametrize("model", ["reduced", "truncated"])
 def test_check_5_2_and_5_4_longitudinal(model):
+    """Omega against (5.2)/(5.4) and the orientation against the one the exact Omega implies."""
     r = checks.check_longitudinal(model)
     assert r.passed and r.max_error <= 1e-9, r.details
+    assert r.details["misorientation"] < 1e-9 and r.details["turns"] > 5
 
 
 # --- invariants ---------------------------------------------------------------------------

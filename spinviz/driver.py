@@ -75,7 +75,8 @@ def simulate(
     if step is not None:
         kw["step"] = step * time_scale
     start = time.perf_counter()
-    sol, integrator, reason = _solve(integrator, problem, kw, auto, reason, time_scale)
+    sol, integrator, reason = _solve(integrator, problem, kw, auto, reason, time_scale,
+                                     resolvable=auto and _resolvable(body, model, omega0, float(t_eval[-1]), kinematics))
     runtime = time.perf_counter() - start
     stats = dict(sol.stats)
     stats.update(method=integrator.name, method_reason=reason, runtime_s=runtime, eps_rad=eps, rtol=rtol, atol=atol)
@@ -108,6 +109,15 @@ def initial_orientation(q0=None, euler_zxz0=None):
     return R.quat_from_euler_zxz(euler), euler
 
 
+def _resolvable(body, model, omega0, t_end, kinematics) -> bool:
+    """Whether lie-dop853 could take over this run (the cost check passes)."""
+    try:
+        check_cost(body, model, omega0, t_end, "lie-dop853", kinematics=kinematics)
+        return True
+    except ValueError:
+        return False
+
+
 def check_truncated_solvable(body: Body, omega0) -> None:
     """(2.5) is linear in Omega_dot with the factor J + g (g x Omega)^T, whose determinant is
     det J (1 + (g x Omega) . J^-1 g) (tau0 = 1).  It is 1 at rest and 1 + O(tau0 |Omega|) for
@@ -132,21 +142,43 @@ def _integrator(method: str, body: Body, kinematics: str):
     return integrator
 
 
-def _solve(integrator, problem, kw, auto: bool, reason: str, time_scale: float):
+def _solve(integrator, problem, kw, auto: bool, reason: str, time_scale: float, resolvable: bool = True):
     """Run the method; under ``auto`` an explicit method that meets stiffness the estimate
-    from the initial state missed is replaced by radau.  Returns (solution, integrator, reason)."""
+    from the initial state missed is replaced by radau, and a ``secular`` run that declines
+    (a resonance, the oscillating regime) by lie-dop853 when ``resolvable`` (affordable).
+    Returns (solution, integrator, reason)."""
     extra = {"stop_on_stiffness": True} if auto and integrator.detects_stiffness else {}
     sol = integrator.solve(problem, **kw, **extra)
+    if auto and not sol.success and integrator.name == "secular" and resolvable:
+        reason = f"{reason}; but {sol.message} -- so resolved in full by lie-dop853"
+        integrator = get("lie-dop853")
+        sol = integrator.solve(problem, **kw, stop_on_stiffness=True)
     if auto and not sol.success and not integrator.stiff and integrator.name != "secular":
         stiff_at = sol.stats.get("stiff_at")
         why = f"stiffness detected at t = {stiff_at / time_scale:.3g}" if stiff_at is not None else sol.message
         reason = f"{integrator.name} gave up ({why}); switched to radau (implicit, exact Jacobian)"
         integrator = get("radau")
         sol = integrator.solve(problem, **kw)
+    if "runaway_at" in sol.stats:
+        raise SimulationError(_runaway_message(problem, sol.stats, time_scale))
     if not sol.success:
         raise SimulationError(f"{integrator.name}: {sol.message}")
     _check_finite(sol, integrator.name, time_scale)
     return sol, integrator, reason
+
+
+def _runaway_message(problem, stats, time_scale: float) -> str:
+    """One line: what ran away, when, and when it would blow up (|omega| ~ 1/(t* - t) extrapolated
+    from the rate at detection)."""
+    s = problem.system
+    eps = float(np.dot(s.coupling, s.coupling))
+    w = np.asarray(stats["runaway_omega"], dtype=float)
+    a = np.asarray(s.rate()(*w))
+    growth = float(w @ a) / float(w @ w)            # d ln|omega| / dt
+    t = stats["runaway_at"] / time_scale
+    blow = f"; blow-up extrapolated at t = {(stats['runaway_at'] + 1.0 / growth) / time_scale:.4g}" if growth > 0 else ""
+    return (f"the {s.model} solution runs away: tau0 |Omega| grew from {eps:.3g} to {eps * float(np.linalg.norm(w)):.3g} "
+            f"by t = {t:.4g} (the reduction (2.3) assumes tau0 |Omega| << 1){blow}")
 
 
 def _check_finite(sol, name: str, time_scale: float) -> None:

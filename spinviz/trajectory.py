@@ -74,9 +74,13 @@ class Trajectory:
     # -- derived series ------------------------------------------------------------------
     @property
     def phase_resolved(self) -> bool:
-        """False when the spin phase is below float64 resolution (> 1e-3 rad per ulp), as after
-        1e16 turns of a real DAST cube: then q's spin phase is not physical."""
-        return float(self.stats.get("phase_resolution_rad", 0.0)) <= 1e-3
+        """Whether the orientation's phases are physical: False when the run (``secular``)
+        estimates them wrong by more than 1e-3 rad, when they went through the oscillating
+        regime "5", or when float64 cannot hold them (> 1e-3 rad per ulp, as after 1e16 turns
+        of a real DAST cube).  Then only the slow geometry -- L, theta_L, |Omega| and the range
+        of angle(d, L) -- is physical."""
+        return (bool(self.stats.get("phases_resolved", True))
+                and float(self.stats.get("phase_resolution_rad", 0.0)) <= 1e-3)
 
     @property
     def euler_zxz(self) -> np.ndarray:

@@ -94,16 +94,16 @@ def choose_method(body, model: str, omega0, t_end: float, kinematics: str = "qua
                   spin=None) -> tuple[str, str]:
     """The method ``method = "auto"`` picks, and why.
 
-    * more than 1e6 turns of a symmetric top: ``secular`` (slow flow averaged over the
-      precession; resolving each turn is neither affordable nor, past 1e16 turns,
-      representable in float64);
+    * more than 1e6 turns (estimated with braking) of a symmetric top with tau0 |Omega0| <=
+      1e-3: ``secular`` (the hybrid slow flow; resolving each turn is neither affordable nor,
+      past 1e16 turns, representable in float64);
     * stiff (decay rate > 10 x spin rate): ``radau`` with the exact Jacobian;
     * otherwise ``lie-dop853``; if it then detects stiffness, the driver switches to radau.
 
     ``spin``: (problem, eps_rad) from ``spin_problem`` if the caller already has them.
     """
     problem, eps = spin if spin is not None else body_spin_problem(body, model, omega0)
-    turns = t_end * eps / body.tau0 / (2.0 * math.pi)
+    turns = estimated_turns(body, model, omega0, t_end, (problem, eps))
     if kinematics == "euler_zxz":
         return "dop853", "Euler-angle kinematics (6.4) is integrated by scipy methods only"
     if turns > MAX_RESOLVED_TURNS and body.is_symmetric:
@@ -113,11 +113,12 @@ def choose_method(body, model: str, omega0, t_end: float, kinematics: str = "qua
             prepare(problem)
             ulp = float(np.spacing(2.0 * math.pi * turns))
             phase = f"; the spin phase is beyond float64 (1 ulp = {ulp:.2g} rad)" if ulp > 1e-3 else ""
-            return "secular", (f"{turns:.3g} turns of a symmetric top: averaged slow flow "
-                               f"(relative error O(tau0 Omega) = {eps:.2g}){phase}")
+            return "secular", (f"~{turns:.3g} turns of a symmetric top (estimated with braking): the slow flow, in "
+                               f"full where the precession is slow, averaged where it is fast (tau0 |Omega0| = "
+                               f"{eps:.2g}){phase}")
         except NotApplicable:
-            pass                                        # precession too slow to average (mu > MU_MAX)
+            pass                                        # tau0 |Omega0| too large for a fast spin
     ratio = stiffness_ratio(body, model, omega0, problem)
     if ratio > STIFF_RATIO:
         return "radau", f"stiff: decay rate {ratio:.3g} x the spin rate; implicit Radau with the exact Jacobian"
-    return "lie-dop853", f"non-stiff (decay/spin = {ratio:.2g}), {turns:.3g} turns resolved; |q| = 1 by construction"
+    return "lie-dop853", f"non-stiff (decay/spin = {ratio:.2g}), ~{turns:.3g} turns resolved; |q| = 1 by construction"

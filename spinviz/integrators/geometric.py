@@ -50,12 +50,15 @@ def solve_lie_dop853(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12,
 
     model, J, g, w0, q0, t, with_q = _args(problem)
     h_max = float(step) if step else np.inf
-    w, q, nfev, nsteps, nrej, status, stiff_at = call_stoppable(
+    w_max = ST.runaway_bound(float(np.dot(g, g)))
+    w, q, nfev, nsteps, nrej, status, t_event = call_stoppable(
         KN.lie_dop853, model, J, g, w0, q0, t, float(rtol), float(atol), h_max, with_q, int(max_steps),
-        bool(stop_on_stiffness), *KN.DOP853_ARRAYS)
+        bool(stop_on_stiffness), w_max, *KN.DOP853_ARRAYS)
     stats = {"nfev": int(nfev), "nsteps": int(nsteps), "nrejected": int(nrej)}
-    if stiff_at >= 0.0:
-        stats["stiff_at"] = float(stiff_at)
+    if status == ST.RUNAWAY:
+        stats.update(runaway_at=float(t_event), runaway_omega=w[-1].tolist())
+    elif t_event >= 0.0:
+        stats["stiff_at"] = float(t_event)
     return _solution(problem, w, q, status, stats)
 
 

@@ -34,7 +34,18 @@ import numpy as np
 
 from ..physics import equations as E
 from . import tableaus as T
-from .status import INTERRUPTED, MODEL_ID, NOT_FINITE, OK, STEP_UNDERFLOW, STIFF, STOP_POLL, TOO_MANY_STEPS, TURN_TOO_LARGE  # noqa: F401
+from .status import (  # noqa: F401
+    INTERRUPTED,
+    MODEL_ID,
+    NOT_FINITE,
+    OK,
+    RUNAWAY,
+    STEP_UNDERFLOW,
+    STIFF,
+    STOP_POLL,
+    TOO_MANY_STEPS,
+    TURN_TOO_LARGE,
+)
 
 _jit = nb.njit(cache=True, nogil=True)    # nogil: interrupt.call_stoppable runs them in a thread
 
@@ -310,13 +321,15 @@ def dense_eval(F, y, x, n, out):
 
 
 @_jit
-def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps, stop_on_stiff,
+def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps, stop_on_stiff, w_max,
                A, B, E3, E5, D, stop):
     """Adaptive Lie-group DOP853 (error control and 7th-order dense output as in
     Hairer's DOP853 / SciPy), with Hairer's stiffness detection (15 stiff steps in a row:
     record the time, and return with status STIFF when ``stop_on_stiff``).
 
-    Returns (omega (N,3), q (N,4), nfev, nsteps, nrejected, status, stiff_at)."""
+    Returns (omega (N,3), q (N,4), nfev, nsteps, nrejected, status, t_event): t_event is where
+    stiffness was detected, or where |Omega| passed ``w_max`` (status RUNAWAY, the state kept in
+    omega[-1])."""
     N = t_eval.shape[0]
     n = 6 if with_q else 3
     out_w = np.empty((N, 3))
@@ -415,6 +428,9 @@ def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps
                 if with_q:
                     apply_u(out_q[j_out], ys[3], ys[4], ys[5])
                 j_out += 1
+        if y_new[0] * y_new[0] + y_new[1] * y_new[1] + y_new[2] * y_new[2] > w_max * w_max:
+            out_w[N - 1, 0], out_w[N - 1, 1], out_w[N - 1, 2] = y_new[0], y_new[1], y_new[2]
+            return out_w, out_q, nfev, nsteps, nrej, RUNAWAY, t
         # accept: advance, move the orientation, restart the chart at u = 0
         for k in range(n):
             y[k] = y_new[k]

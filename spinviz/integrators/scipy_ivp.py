@@ -11,6 +11,7 @@ import numpy as np
 
 from ..physics.equations import euler_zxz_rate
 from .base import Integrator, Problem, Solution, register
+from .status import runaway_bound
 
 
 def _euler_rhs(system):
@@ -70,8 +71,14 @@ def _make_solver(method: str, implicit: bool):
             kw["max_step"] = step
         from scipy.integrate import solve_ivp
 
+        w_max = runaway_bound(float(np.dot(problem.system.coupling, problem.system.coupling)))
+
+        def runaway(s, y):
+            return float(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]) - w_max * w_max
+
+        runaway.terminal = True
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            res = solve_ivp(f, (t[0], t[-1]), y0, method=method, t_eval=t, **kw)
+            res = solve_ivp(f, (t[0], t[-1]), y0, method=method, t_eval=t, events=runaway, **kw)
         ok = res.status == 0 and res.y.shape[1] == t.size and bool(np.all(np.isfinite(res.y)))
         y = res.y.T if ok else np.full((t.size, y0.size), np.nan)
         if ok:
@@ -79,6 +86,9 @@ def _make_solver(method: str, implicit: bool):
         parts = split_state(problem, y)
         stats = {"method": method.lower(), "nfev": int(res.nfev), "njev": int(res.njev), "nlu": int(res.nlu)}
         message = "" if ok else f"solve_ivp({method}) failed: {res.message}"
+        if res.status == 1 and res.t_events[0].size:
+            stats.update(runaway_at=float(res.t_events[0][0]), runaway_omega=res.y_events[0][0][:3].tolist())
+            message = "the solution runs away"
         return Solution(t=t, success=ok, message=message, stats=stats, **parts)
 
     return solve

@@ -1,6 +1,6 @@
 """Status codes shared by the compiled kernels and their Python wrappers, and what they mean."""
 
-OK, TOO_MANY_STEPS, STEP_UNDERFLOW, NOT_FINITE, STIFF, TURN_TOO_LARGE, INTERRUPTED = 0, 1, 2, 3, 4, 5, 6
+OK, TOO_MANY_STEPS, STEP_UNDERFLOW, NOT_FINITE, STIFF, TURN_TOO_LARGE, INTERRUPTED, RUNAWAY = 0, 1, 2, 3, 4, 5, 6, 7
 
 STOP_POLL = 256          # the compiled loops look at their stop flag every this many steps
 
@@ -12,6 +12,18 @@ MESSAGES = {
     TURN_TOO_LARGE: "a step turns the body by more than half a turn (exponential coordinates are singular "
                     "at a full turn); use a smaller step",
     INTERRUPTED: "interrupted",
+    RUNAWAY: "the solution runs away",
 }
+
+# A run stops as a runaway when tau0 |Omega| exceeds RUNAWAY_FACTOR x max(tau0 |Omega0|, 1): the
+# reduction (2.3) that defines the model assumes tau0 |Omega| << 1, and past that point its
+# solutions grow without bound (measured: |omega| ~ 1/(t* - t), a finite-time blow-up).
+RUNAWAY_FACTOR = 10.0
+
+
+def runaway_bound(eps: float) -> float:
+    """The largest |omega| in spin units (|omega(0)| = 1, coupling |g|^2 = eps) before a run is
+    called a runaway."""
+    return RUNAWAY_FACTOR * max(1.0, 1.0 / eps) if eps > 0 else float("inf")
 
 MODEL_ID = {"free": 0, "reduced": 1, "truncated": 2}

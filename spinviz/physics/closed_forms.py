@@ -191,3 +191,15 @@ def averaged_rate_eq4_12(omega_perp, omega3, delta: float, chi: float):
     dwp = -(n3**2 * (wp2 + (1.0 - delta) ** 2 * w32) + 0.5 * n1**2 * (wp2 + (1.0 + delta + delta**2) * w32)) * omega_perp
     dw3 = -0.5 * n1**2 * ((2.0 + delta) * wp2 + 2.0 * w32) * omega3 / (1.0 - delta)
     return dwp, dw3, -delta * omega3
+
+
+def spiral4_amplitude_sq_eq4_18(chi: float) -> float:
+    """A^2 of the spiral solution "4" (4.18): omega_perp^2 tau -> A^2 as tau -> oo, corrected.
+
+    The paper prints A^2 = 1/(2 - xi), xi = tan^2 chi, which is negative for xi > 2 and cannot be
+    right.  With omega3 -> 0 faster than omega_perp, (4.12) reduces to d omega_perp / d tau =
+    -(n3^2 + n1^2/2) omega_perp^3, so omega_perp^2 tau -> 1/(2 n3^2 + n1^2) = 1/(1 + n3^2)
+    = (1 + xi)/(2 + xi) -- 1/(2 - n1^2): the printed xi was probably meant for n1^2.
+    (DESIGN.md, section 2; checked against the averaged and the full equations in the tests.)"""
+    xi = math.tan(chi) ** 2
+    return (1.0 + xi) / (2.0 + xi)

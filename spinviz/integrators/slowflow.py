@@ -1,0 +1,461 @@
+"""The compiled hybrid slow flow behind ``secular``: the body-frame Euler equation of a
+symmetric top, in full where its precession is slow, averaged over the precession where it
+is fast, with the spin about the fixed L_world integrated as a phase.
+
+The body-frame equation does not involve the orientation.  Its only fast motion is the
+precession of omega_perp about e3 at the rate delta w3; its slow motion is the braking, at
+the rate eps |w|^2 (spin units, eps = tau0 |Omega0|).  Two modes, one DOP853 loop:
+
+* FULL: y = (w1, w2, w3, Sigma), the equation itself -- cheap wherever the precession is
+  slow, exact wherever it stops (the domain "?" of (4.20), where w3 changes sign again and
+  again, the oscillating solution "5");
+* AVG: y = (w_perp, w3, p, Sigma), the flow averaged over the precession phase p ((4.12)
+  for the reduced model; here the model's own radiation rate averaged on M phase nodes).
+
+The hand-over follows mu_ad = eps |w|^3 / (|delta| w3^2) -- how much the precession rate
+itself changes over one radian of precession (the plain ratio eps |w|^2 / |delta w3| misses
+the slowing of w3; measured: 100x larger errors): FULL above ``mu_star``, AVG below half of
+it.  At the start, at each switch and at each output the first-order near-identity
+transform x = xbar + U(xbar, p) maps averaged and true variables into each other; without
+it first-order averaging is off by O(eps) in the slow variables and by O(1) in the phases
+after O(1/eps) of time (measured), with it by O(eps^2) and O(eps) respectively.
+
+Sigma = phi + sign(w3) psi, the ZXZ angles about L (psi = pi/2 - p), is what is integrated
+for the orientation: regular where e3 lines up with +-L, unlike phi and psi separately.
+Its rate includes the radiation part of the precession (``sigma_rate``).
+
+Units: spin units of spinviz (|omega(0)| = 1, coupling g with |g|^2 = eps).  J = (1, 1, J3).
+Ported from a research prototype; the measurements are in the README ("secular").
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from . import kernels as KN
+from .status import INTERRUPTED, NOT_FINITE, OK, STEP_UNDERFLOW, STOP_POLL, TOO_MANY_STEPS
+
+_jit = nb.njit(cache=True, nogil=True, error_model="numpy")
+
+FULL, AVG = 0, 1
+M_PHASES = 32          # phase-average nodes: exact for trigonometric polynomials of degree < 32
+HYST = 0.5             # AVG again only below HYST * mu_star: no chattering
+NIT_MAX = 0.1          # the transform is applied only where it is a small correction
+MAX_SWITCHES = 100_000
+
+
+@_jit
+def avg_rates(model, J, g, wp, w3, cM, sM, equiv):
+    """The radiation part of (d w_perp, d w3, d p) averaged over the precession phase p, and
+    the mean of N = w1 a2 - w2 a1 (w_perp^2 x the radiation part of p_dot); exact, with no
+    average, where the torque commutes with rotations about e3 (``equiv``)."""
+    if equiv or wp == 0.0:
+        a = KN.radiation(model, wp, 0.0, w3, J, g)
+        return a[0], a[2], (a[1] / wp if wp != 0.0 else 0.0), wp * a[1]
+    M = cM.shape[0]
+    s1 = 0.0
+    s2 = 0.0
+    s3 = 0.0
+    # the p-independent part a(0, 0, w3) averages out of s1 and s3 exactly; taking it out first
+    # keeps its round-off out of s3 / w_perp^2 as w_perp -> 0 (types "1" and "2")
+    a0 = KN.radiation(model, 0.0, 0.0, w3, J, g)
+    for k in range(M):
+        w1 = wp * cM[k]
+        w2 = wp * sM[k]
+        a = KN.radiation(model, w1, w2, w3, J, g)
+        b1 = a[0] - a0[0]
+        b2 = a[1] - a0[1]
+        s1 += w1 * b1 + w2 * b2
+        s2 += a[2]
+        s3 += w1 * b2 - w2 * b1
+    return s1 / (M * wp), s2 / M, s3 / (M * wp * wp), s3 / M
+
+
+@_jit
+def sigma_rate(wp2, w3, J3, sgn, N):
+    """d/dt (phi + sgn psi), sgn = sign(w3), ZXZ angles about a fixed L (J1 = 1):
+    phi_dot = |L| - r cos(theta), psi_dot = delta w3 + r with r = -N / w_perp^2 the radiation
+    part of psi_dot and cos(theta) = J3 w3 / |L|; the sum is regular where w_perp -> 0."""
+    L = math.sqrt(wp2 + J3 * J3 * w3 * w3)
+    return L + sgn * (1.0 - J3) * w3 - sgn * N / (L * (L + J3 * abs(w3)))
+
+
+@_jit
+def rhs(mode, sgn, model, J, g, cM, sM, equiv, y, out):
+    J3 = J[2]
+    if mode == FULL:
+        w1, w2, w3 = y[0], y[1], y[2]
+        a = KN.radiation(model, w1, w2, w3, J, g)
+        d = 1.0 - J3
+        # the free part of a symmetric top (J1 = J2 = 1): (delta w2 w3, -delta w1 w3, 0)
+        out[0] = a[0] + d * w2 * w3
+        out[1] = a[1] - d * w1 * w3
+        out[2] = a[2]
+        out[3] = sigma_rate(w1 * w1 + w2 * w2, w3, J3, sgn, w1 * a[1] - w2 * a[0])
+    else:
+        dwp, dw3, dp, N = avg_rates(model, J, g, y[0], y[1], cM, sM, equiv)
+        out[0] = dwp
+        out[1] = dw3
+        out[2] = dp - (1.0 - J3) * y[1]
+        out[3] = sigma_rate(y[0] * y[0], y[1], J3, sgn, N)
+
+
+@_jit
+def mu_ad(mode, y, eps, delta):
+    """eps |w|^3 / (|delta| w3^2) (for |w3| < |w|; eps |w|^2 / |delta w3| otherwise): the
+    relative change of the precession rate over one radian of precession.  inf where it stops."""
+    if mode == FULL:
+        w2 = y[0] * y[0] + y[1] * y[1] + y[2] * y[2]
+        w3 = y[2]
+    else:
+        w2 = y[0] * y[0] + y[1] * y[1]
+        w3 = y[1]
+    den = abs(delta * w3)
+    if den == 0.0:
+        return np.inf
+    mu = eps * w2 / den
+    r = math.sqrt(w2) / abs(w3)
+    return mu * r if r > 1.0 else mu
+
+
+@_jit
+def nit(model, J, g, cM, sM, wp, w3, p):
+    """First-order near-identity transform at (w_perp, w3, p): (U_wp, U_w3, V_p, V_phi) with
+    x = xbar + U(xbar, p), p = pbar + V_p, phi = phibar + V_phi.  U = int F~ dp / p0dot with F~
+    the zero-mean part of the radiation rates along the precession; V_p and V_phi from the
+    phase rates likewise.  Zero where it would not be a small correction."""
+    M = cM.shape[0]
+    delta = 1.0 - J[2]
+    p0dot = -delta * w3
+    Fwp = np.empty(M)
+    Fw3 = np.empty(M)
+    G = np.empty(M)
+    for k in range(M):
+        w1 = wp * cM[k]
+        w2 = wp * sM[k]
+        a = KN.radiation(model, w1, w2, w3, J, g)
+        Fwp[k] = (w1 * a[0] + w2 * a[1]) / wp
+        Fw3[k] = a[2]
+        G[k] = (w1 * a[1] - w2 * a[0]) / (wp * wp)
+    Uwp = 0.0
+    Uw3 = 0.0
+    Vp = 0.0
+    A2wp = 0.0
+    A2w3 = 0.0
+    AG = 0.0
+    for j in range(1, M // 2):
+        # c_j = (1/M) sum_k f_k e^{-i j p_k}; the antiderivative term is 2 Re(c_j e^{ijp} / (ij))
+        cr_wp = ci_wp = cr_w3 = ci_w3 = cr_g = ci_g = 0.0
+        for k in range(M):
+            ck, sk = math.cos(j * 2.0 * math.pi * k / M), math.sin(j * 2.0 * math.pi * k / M)
+            cr_wp += Fwp[k] * ck
+            ci_wp -= Fwp[k] * sk
+            cr_w3 += Fw3[k] * ck
+            ci_w3 -= Fw3[k] * sk
+            cr_g += G[k] * ck
+            ci_g -= G[k] * sk
+        cj, sj = math.cos(j * p), math.sin(j * p)
+        im_wp = (cr_wp * sj + ci_wp * cj) / M
+        im_w3 = (cr_w3 * sj + ci_w3 * cj) / M
+        im_g = (cr_g * sj + ci_g * cj) / M
+        re_w3 = (cr_w3 * cj - ci_w3 * sj) / M
+        re_wp = (cr_wp * cj - ci_wp * sj) / M
+        A2wp += -2.0 * re_wp / (j * j)
+        A2w3 += -2.0 * re_w3 / (j * j)
+        AG += 2.0 * im_g / j
+        Uwp += 2.0 * im_wp / j
+        Uw3 += 2.0 * im_w3 / j
+        Vp += 2.0 * im_g / j + delta / p0dot * 2.0 * re_w3 / (j * j)
+    Uwp, Uw3, Vp = Uwp / p0dot, Uw3 / p0dot, Vp / p0dot
+    J3 = J[2]
+    L = math.sqrt(wp * wp + J3 * J3 * w3 * w3)
+    Vphi = ((wp / L) * A2wp / p0dot + (J3 * J3 * w3 / L) * A2w3 / p0dot + (J3 * w3 / L) * AG) / p0dot
+    if not (abs(Uwp) <= NIT_MAX * wp and abs(Uw3) <= NIT_MAX * abs(w3) and abs(Vp) <= NIT_MAX
+            and abs(Vphi) <= NIT_MAX):
+        return 0.0, 0.0, 0.0, 0.0
+    return Uwp, Uw3, Vp, Vphi
+
+
+@_jit
+def error_norm(K, y, y_new, h, n, rtol, atol, E3, E5):
+    """DOP853's scaled error; the phase Sigma (index 3), which grows to 2 pi x the turns, is
+    held to rtol x its increment instead of rtol x its size."""
+    e5 = 0.0
+    e3 = 0.0
+    for k in range(n):
+        s5 = 0.0
+        s3 = 0.0
+        for l in range(13):
+            s5 += E5[l] * K[l, k]
+            s3 += E3[l] * K[l, k]
+        if k == 3:
+            scale = atol + abs(y_new[k] - y[k]) * rtol
+        else:
+            scale = atol + max(abs(y[k]), abs(y_new[k])) * rtol
+        e5 += (s5 / scale) ** 2
+        e3 += (s3 / scale) ** 2
+    if e5 == 0.0 and e3 == 0.0:
+        return 0.0
+    return h * e5 / math.sqrt((e5 + 0.01 * e3) * n)
+
+
+@_jit
+def initial_step(mode, sgn, model, J, g, cM, sM, equiv, y, f0, rtol, atol, n, h_max):
+    sc = np.empty(n)
+    for k in range(n):
+        sc[k] = atol + abs(y[k]) * rtol
+    d0 = 0.0
+    d1 = 0.0
+    for k in range(n):
+        d0 += (y[k] / sc[k]) ** 2
+        d1 += (f0[k] / sc[k]) ** 2
+    d0 = math.sqrt(d0 / n)
+    d1 = math.sqrt(d1 / n)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, h_max)
+    ys = np.empty(n)
+    f1 = np.empty(n)
+    for k in range(n):
+        ys[k] = y[k] + h0 * f0[k]
+    rhs(mode, sgn, model, J, g, cM, sM, equiv, ys, f1)
+    d2 = 0.0
+    for k in range(n):
+        d2 += ((f1[k] - f0[k]) / sc[k]) ** 2
+    d2 = math.sqrt(d2 / n) / h0
+    h1 = max(1e-6, h0 * 1e-3) if (d1 <= 1e-15 and d2 <= 1e-15) else (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, h_max)
+
+
+@_jit
+def to_avg(model, J, g, cM, sM, y, p_unw, use_nit):
+    """FULL state -> AVG state in place (transform inverted to first order); returns the shift of phi."""
+    wp = math.hypot(y[0], y[1])
+    w3 = y[2]
+    p = p_unw
+    dphi = 0.0
+    if use_nit:
+        u = nit(model, J, g, cM, sM, wp, w3, p)
+        wp, w3, p = wp - u[0], w3 - u[1], p - u[2]
+        dphi = -u[3]
+    y[0], y[1], y[2] = wp, w3, p
+    return dphi
+
+
+@_jit
+def to_full(model, J, g, cM, sM, y, use_nit):
+    """AVG state -> FULL state in place; returns (unwrapped p, shift of phi)."""
+    wp, w3, p = y[0], y[1], y[2]
+    dphi = 0.0
+    if use_nit:
+        u = nit(model, J, g, cM, sM, wp, w3, p)
+        wp, w3, p = wp + u[0], w3 + u[1], p + u[2]
+        dphi = u[3]
+    y[0], y[1], y[2] = wp * math.cos(p), wp * math.sin(p), w3
+    return p, dphi
+
+
+@_jit
+def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, max_steps, phi0, A, B, E3, E5, D,
+                  stop):
+    """Integrate from the body-frame w0 (spin units) over t_eval.
+
+    Returns (out (N, 6): w1, w2, w3, phi, p, mode at each output; counters (10,); switches
+    (K, 2): time and new mode; status).  phi: the ZXZ precession angle about the fixed L, from
+    phi0; p: the unwrapped body-frame phase of omega_perp (psi = pi/2 - p).
+    counters: steps FULL, steps AVG, evaluations FULL, evaluations AVG, rejected steps,
+    switches, the largest mu_ad met in AVG, precession turns in FULL, sign changes of w3,
+    the time of the last sign change."""
+    N = t_eval.shape[0]
+    n = 4
+    out = np.empty((N, 6))
+    cnt = np.zeros(10)
+    sw = np.zeros((MAX_SWITCHES, 2))
+    nsw = 0
+    M = M_PHASES
+    cM = np.empty(M)
+    sM = np.empty(M)
+    for k in range(M):
+        cM[k] = math.cos(2.0 * math.pi * k / M)
+        sM[k] = math.sin(2.0 * math.pi * k / M)
+    eps = g[0] * g[0] + g[1] * g[1] + g[2] * g[2]
+    delta = 1.0 - J[2]
+    K = np.zeros((16, n))
+    y = np.zeros(n)
+    y_new = np.zeros(n)
+    ys = np.zeros(n)
+    F = np.zeros((7, n))
+    y[0], y[1], y[2], y[3] = w0[0], w0[1], w0[2], 0.0
+    p_unw = math.atan2(w0[1], w0[0])
+    if equiv:
+        mode = AVG
+    else:
+        mode = FULL if mu_ad(FULL, y, eps, delta) > mu_star else AVG
+    dphi = 0.0
+    if mode == AVG:
+        dphi = to_avg(model, J, g, cM, sM, y, p_unw, use_nit and not equiv)
+    sgn = 1.0 if w0[2] >= 0.0 else -1.0
+    y[3] = phi0 + dphi + sgn * (0.5 * math.pi - (y[2] if mode == AVG else p_unw))
+    t = t_eval[0]
+    t_end = t_eval[-1]
+    out[0, 0], out[0, 1], out[0, 2] = w0[0], w0[1], w0[2]
+    out[0, 3] = phi0
+    out[0, 4] = p_unw
+    out[0, 5] = mode
+    j_out = 1
+    rhs(mode, sgn, model, J, g, cM, sM, equiv, y, K[0])
+    nf = 1
+    h = initial_step(mode, sgn, model, J, g, cM, sM, equiv, y, K[0], rtol, atol, n, t_end - t)
+    nf += 1
+    nsteps = 0
+    rejected = False
+    err_exp = -1.0 / 8.0
+    while t < t_end:
+        if nsteps >= max_steps:
+            return out, cnt, sw[:nsw], TOO_MANY_STEPS
+        if (nsteps + int(cnt[4])) % STOP_POLL == 0 and stop[0] != 0:
+            return out, cnt, sw[:nsw], INTERRUPTED
+        if h < 10.0 * abs(np.nextafter(t, np.inf) - t):
+            return out, cnt, sw[:nsw], STEP_UNDERFLOW
+        if t + h > t_end:
+            h = t_end - t
+        for i in range(1, 12):
+            KN.stage_point(A, K, y, h, i, n, ys)
+            rhs(mode, sgn, model, J, g, cM, sM, equiv, ys, K[i])
+        for k in range(n):
+            acc = 0.0
+            for l in range(12):
+                acc += B[l] * K[l, k]
+            y_new[k] = y[k] + h * acc
+        rhs(mode, sgn, model, J, g, cM, sM, equiv, y_new, K[12])
+        nf += 12
+        for k in range(n):
+            if not math.isfinite(y_new[k]):
+                return out, cnt, sw[:nsw], NOT_FINITE
+        err = error_norm(K, y, y_new, h, n, rtol, atol, E3, E5)
+        if not err <= 1.0:
+            h = h * max(0.2, 0.9 * err ** err_exp)
+            cnt[4] += 1
+            rejected = True
+            continue
+        t_old = t
+        t = t_old + h if t_old + h < t_end else t_end
+        p_old = p_unw
+        if mode == FULL:
+            p_unw = p_old + (math.atan2(y_new[1], y_new[0]) - p_old + math.pi) % (2.0 * math.pi) - math.pi
+            cnt[7] += abs(p_unw - p_old) / (2.0 * math.pi)
+        if j_out < N and t_eval[j_out] <= t:
+            for s in range(13, 16):
+                KN.stage_point(A, K, y, h, s, n, ys)
+                rhs(mode, sgn, model, J, g, cM, sM, equiv, ys, K[s])
+            nf += 3
+            for k in range(n):
+                dy = y_new[k] - y[k]
+                F[0, k] = dy
+                F[1, k] = h * K[0, k] - dy
+                F[2, k] = 2.0 * dy - h * (K[12, k] + K[0, k])
+                for r in range(4):
+                    acc = 0.0
+                    for l in range(16):
+                        acc += D[r, l] * K[l, k]
+                    F[3 + r, k] = h * acc
+            while j_out < N and t_eval[j_out] <= t:
+                KN.dense_eval(F, y, (t_eval[j_out] - t_old) / h, n, ys)
+                if mode == FULL:
+                    out[j_out, 0], out[j_out, 1], out[j_out, 2] = ys[0], ys[1], ys[2]
+                    out[j_out, 4] = p_old + (math.atan2(ys[1], ys[0]) - p_old + math.pi) % (2.0 * math.pi) - math.pi
+                    out[j_out, 3] = ys[3] - sgn * (0.5 * math.pi - out[j_out, 4])
+                else:
+                    out[j_out, 3] = ys[3] - sgn * (0.5 * math.pi - ys[2])
+                    wp_o, w3_o, p_o = ys[0], ys[1], ys[2]
+                    if use_nit and not equiv:
+                        u = nit(model, J, g, cM, sM, wp_o, w3_o, p_o)
+                        wp_o, w3_o, p_o = wp_o + u[0], w3_o + u[1], p_o + u[2]
+                        out[j_out, 3] += u[3]
+                    out[j_out, 0] = wp_o * math.cos(p_o)
+                    out[j_out, 1] = wp_o * math.sin(p_o)
+                    out[j_out, 2] = w3_o
+                    out[j_out, 4] = p_o
+                out[j_out, 5] = mode
+                j_out += 1
+        for k in range(n):
+            y[k] = y_new[k]
+            K[0, k] = K[12, k]
+        nsteps += 1
+        if mode == FULL:
+            cnt[0] += 1
+            cnt[2] += nf
+        else:
+            cnt[1] += 1
+            cnt[3] += nf
+        nf = 0
+        factor = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** err_exp)
+        if rejected:
+            factor = min(1.0, factor)
+        h = h * factor
+        rejected = False
+        # Sigma = phi + sgn psi is re-based when w3 changes sign
+        w3_now = y[2] if mode == FULL else y[1]
+        s_new = 1.0 if w3_now >= 0.0 else -1.0
+        if s_new != sgn:
+            psi_now = 0.5 * math.pi - (y[2] if mode == AVG else p_unw)
+            y[3] += (s_new - sgn) * psi_now
+            sgn = s_new
+            cnt[8] += 1
+            cnt[9] = t
+            rhs(mode, sgn, model, J, g, cM, sM, equiv, y, K[0])
+            nf += 1
+        # the hand-over
+        if not equiv:
+            mu = mu_ad(mode, y, eps, delta)
+            switch = False
+            phi_now = y[3] - sgn * (0.5 * math.pi - (y[2] if mode == AVG else p_unw))
+            if mode == FULL and mu < HYST * mu_star:
+                phi_now += to_avg(model, J, g, cM, sM, y, p_unw, use_nit)
+                mode = AVG
+                switch = True
+            elif mode == AVG:
+                if mu > cnt[6]:
+                    cnt[6] = mu
+                if mu > mu_star:
+                    p_unw, dphi = to_full(model, J, g, cM, sM, y, use_nit)
+                    phi_now += dphi
+                    mode = FULL
+                    switch = True
+            if switch:
+                y[3] = phi_now + sgn * (0.5 * math.pi - (y[2] if mode == AVG else p_unw))
+                if nsw < MAX_SWITCHES:
+                    sw[nsw, 0] = t
+                    sw[nsw, 1] = mode
+                    nsw += 1
+                cnt[5] += 1
+                rhs(mode, sgn, model, J, g, cM, sM, equiv, y, K[0])
+                h = initial_step(mode, sgn, model, J, g, cM, sM, equiv, y, K[0], rtol, atol, n, t_end - t)
+                nf = 2
+    return out, cnt, sw[:nsw], OK
+
+
+@_jit
+def torque_harmonic(model, J, g, wp, w3, m, M):
+    """|c_m|: harmonic m of the world-frame radiation torque across L in the body-frame phase
+    p (the component that does not average out over the spin where |L|/I1 = m delta w3)."""
+    delta = 1.0 - J[2]
+    theta = math.atan2(wp, (1.0 - delta) * w3)
+    ct, st = math.cos(theta), math.sin(theta)
+    re = 0.0
+    im = 0.0
+    for k in range(M):
+        p = 2.0 * math.pi * k / M
+        a = KN.radiation(model, wp * math.cos(p), wp * math.sin(p), w3, J, g)
+        n1, n2, n3 = J[0] * a[0], J[1] * a[1], J[2] * a[2]
+        psi = 0.5 * math.pi - p
+        x = math.cos(psi) * n1 - math.sin(psi) * n2
+        yy = math.sin(psi) * n1 + math.cos(psi) * n2
+        y2 = ct * yy - st * n3
+        # Z(p) = x + i y2; c_m = (1/M) sum Z e^{-i m p}
+        c, s = math.cos(m * p), math.sin(m * p)
+        re += x * c + y2 * s
+        im += y2 * c - x * s
+    return math.hypot(re, im) / M

@@ -34,13 +34,16 @@ class MissingRenderStack(UsageError, ImportError):
 
 
 def require_render_stack():
-    """Import ``spinviz.rendering.video``, or explain in one line which optional package is missing."""
-    try:
-        import imageio_ffmpeg  # noqa: F401
-        import PIL  # noqa: F401
-        import pyvista  # noqa: F401
-        import vtk  # noqa: F401
+    """Import ``spinviz.rendering.video``, or explain in one line which optional package is missing.
 
+    The drawing stack itself (pyvista, VTK) is only looked up here, not imported: with
+    worker processes the parent never draws, and importing VTK would cost it a second."""
+    import importlib.util
+
+    try:
+        for name in ("imageio_ffmpeg", "PIL", "pyvista", "vtkmodules"):
+            if importlib.util.find_spec(name) is None:
+                raise ImportError(f"No module named {name!r}", name=name)
         from .rendering import video
     except ImportError as e:
         name = (e.name or "").split(".")[0]
@@ -190,7 +193,15 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
     inputs = [scene.path] if scene is not None and os.path.exists(scene.path) else []
     check_outputs([out, poster_for(out)], inputs)        # before any work: nothing to undo later
     video = require_render_stack()
-    return video.render_video(_plan(scene, trajs, spec), out, workers=workers, progress=progress, inputs=inputs)
+    n = video.plan_workers(spec, out, workers)
+    # the render processes start now and import the drawing stack while this one simulates
+    pool = video.WorkerPool(n) if n > 1 else None
+    try:
+        return video.render_video(_plan(scene, trajs, spec), out, workers=workers, progress=progress, inputs=inputs,
+                                  pool=pool)
+    finally:
+        if pool is not None:
+            pool.close()
 
 
 def default_output(scene: Scene, directory: str = "renders") -> str:

@@ -16,7 +16,7 @@ from dataclasses import dataclass, fields, replace
 
 from ..errors import SpecError, brief
 
-SHOW_ITEMS = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud", "hodograph")
+SHOW_ITEMS = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud", "hodograph", "inset")
 DEFAULT_SHOW = ("body", "dipole", "axes", "trail", "sphere", "hud")
 ORIENTATION_ITEMS = ("body", "dipole", "omega", "L", "trail")
 VIDEO_FORMATS = (".mp4", ".gif")
@@ -29,6 +29,7 @@ MAX_GIF_BYTES = 1_000_000_000   # a GIF's frames are kept in memory (1 byte per 
 ZOOM_RANGE = (0.05, 20.0)       # outside it the body is a dot or fills the frame far beyond its edges
 MAX_KNEE_RATIO = 1e15           # t_end / log_knee: float64 must still tell neighbouring frame times apart
 MAX_TITLE = 160
+CAPTIONS = ("outreach", "physics")
 
 
 @dataclass(frozen=True)
@@ -47,6 +48,10 @@ class RenderSpec:
     azimuth_deg, elevation_deg, zoom : the camera (view direction from the origin).
     background : "white" or "black".  title : shown under the panels.
     poster : where in the video (0..1) the PNG poster frame is taken.
+    captions : "outreach" (plain words, numbers for people) or "physics" (symbols,
+        equation numbers, scientific notation).
+    subtitles : one plain-words line per panel saying what its model does in this scene
+        (default: what each model predicts in general).
     """
 
     duration: float = 12.0
@@ -64,6 +69,8 @@ class RenderSpec:
     background: str = "white"
     title: str = ""
     poster: float = 1.0
+    captions: str = "outreach"
+    subtitles: tuple[str, ...] = ()
 
     def __post_init__(self):
         for f in fields(self):
@@ -198,6 +205,15 @@ def _check_title(spec, key, v):
         raise SpecError(key, f"must be at most {MAX_TITLE} characters, got {len(v)}")
 
 
+def _check_subtitles(spec, key, v):
+    if isinstance(v, str) or not isinstance(v, (tuple, list)) or len(v) > 2:
+        raise SpecError(key, f"must be a list of one line per panel (at most 2), got {brief(v)}")
+    for line in v:
+        _check_title(spec, key, line)
+    if not isinstance(v, tuple):
+        object.__setattr__(spec, key, tuple(v))
+
+
 _CHECKS = {
     "duration": lambda s, k, v: _number(s, k, v, lo=0.0, hi=MAX_DURATION_S, lo_open=True),
     "fps": _check_fps,
@@ -214,11 +230,13 @@ _CHECKS = {
     "background": _choice(("white", "black")),
     "title": _check_title,
     "poster": lambda s, k, v: _number(s, k, v, lo=0.0, hi=1.0),
+    "captions": _choice(CAPTIONS),
+    "subtitles": _check_subtitles,
 }
 
 
 def _from_toml(key: str, value):
     """TOML value -> field value: lists become tuples; integers stay integers."""
-    if key in ("size", "show") and isinstance(value, list):
+    if key in ("size", "show", "subtitles") and isinstance(value, list):
         return tuple(value)
     return value

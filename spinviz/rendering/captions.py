@@ -25,7 +25,7 @@ SUBTITLES = {
                 "truncated": "textbook torque without the Schott-like term",
                 "free": "torque-free Euler top"},
 }
-ARROW_NAMES = {"dipole": ("d", "dipole"), "L": ("L", "angular momentum"), "omega": ("Ω", "rotation axis Ω")}
+ARROW_NAMES = {"dipole": ("d", "dipole"), "L": ("L", "angular momentum"), "omega": ("Ω", "rotation")}
 
 _SUP = str.maketrans("0123456789-", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻")
 _WORDS = ((1e12, "trillion"), (1e9, "billion"), (1e6, "million"), (1e3, "thousand"))

@@ -25,6 +25,7 @@ from PIL import Image, ImageFont
 from .captions import Captions
 
 _FONT_DIRS = ("/usr/share/fonts/truetype/dejavu",)
+MIN_VIEW_INSET = 0.36     # ... or this, to make room for a requested inset
 MIN_VIEW = 0.5           # the 3-D view keeps at least this fraction of the frame height
 BODY_TEXT = 15 / 360      # body text size per frame row (15 px at 360 rows, 30 px at 720)
 HEADING_TEXT = 18 / 360
@@ -187,10 +188,18 @@ def make_layout(plan, W: int, H: int, show) -> Layout:
     readout_lines = max(len(cap.readouts(k, 0)) for k in range(n))
     notes_n = len(cap.notes(0))
     wanted = {"headings": hud_on, "subtitle": hud_on, "readouts": hud_on, "legend": hud_on and bool(legend),
-              "timebar": hud_on, "notes": hud_on and notes_n > 0, "title": hud_on and bool(cap.footer())}
-    for drop in (None, "title", "notes", "subtitle", "legend", "timebar", "readouts", "headings"):
-        if drop:
+              "timebar": hud_on, "notes": hud_on and notes_n > 0, "title": hud_on and bool(cap.footer()),
+              "inset": "inset" in show and plan.panels[0].omega_mag is not None}
+    sub_lines = 2
+    steps = ("title", "subtitle2", "inset", "notes", "subtitle", "legend", "timebar", "readouts", "headings")
+    if not wanted["inset"]:
+        steps = tuple(x for x in steps if x != "subtitle2")
+    for drop in (None, *steps):
+        if drop == "subtitle2":
+            sub_lines = 1
+        elif drop:
             wanted[drop] = False
+        subtitles = [s[:sub_lines] for s in subtitles]
         top = pad
         if wanted["headings"]:
             top += fonts.heading_line
@@ -200,6 +209,8 @@ def make_layout(plan, W: int, H: int, show) -> Layout:
         bottom = pad
         bottom += fonts.line * readout_lines if wanted["readouts"] else 0
         rows = []
+        if wanted["inset"]:
+            rows.append(Row("inset", 3 * fonts.line + pad))
         if wanted["legend"]:
             rows.append(Row("legend", fonts.line + pad // 2, payload=legend))
         if wanted["timebar"]:
@@ -209,7 +220,8 @@ def make_layout(plan, W: int, H: int, show) -> Layout:
         if wanted["title"]:
             rows.append(Row("title", fonts.line))
         bottom += sum(r.height for r in rows) + (pad if rows else 0)
-        if H - top - bottom >= MIN_VIEW * H:
+        # a requested inset may take the view down to MIN_VIEW_INSET of the height
+        if H - top - bottom >= (MIN_VIEW_INSET if wanted["inset"] else MIN_VIEW) * H:
             break
     lay = Layout(W=W, H=H, n=n, pad=pad, fonts=fonts, text=hud_on)
     view_y1 = H - bottom
@@ -333,6 +345,7 @@ class Hud:
         self.axis_labels = list(axis_labels)
         self.chips = []                  # (key, (x0, y0, x1, y1)) of each legend entry
         self._bar = None
+        self._inset = None
         self.dirty = self._dirty_boxes()
 
     def _dirty_boxes(self):
@@ -343,7 +356,7 @@ class Hud:
         if lay.readout_lines:
             out.append((0, lay.readout_y, lay.W, min(lay.H, lay.readout_y + lay.readout_lines * fonts.line)))
         for row in lay.rows:
-            if row.kind in ("timebar", "notes"):
+            if row.kind in ("timebar", "notes", "inset"):
                 out.append((0, row.y, lay.W, min(lay.H, row.y + row.height)))
         r = fonts.size
         for _, (x, y) in self.axis_labels:
@@ -360,9 +373,10 @@ class Hud:
         for k, items in enumerate(lay.headings):
             x0 = lay.panel_x(k) + lay.pad
             right = lay.panel_x(k) + lay.panel_width - lay.pad
+            model_color = MODEL_COLORS.get(self.plan.panels[k].model, pal.fg) if pal.bg[0] > 128 else pal.fg
             for text, which, y, extra in items:
                 font = fonts.main if which == "main" else fonts.small
-                color = pal.fg if which == "main" else pal.muted
+                color = model_color if which == "main" else pal.muted
                 clip = (x0, 0, right, lay.H)
                 st.put(img, (x0, y), text, font, color, clip=clip)
                 if extra:
@@ -381,6 +395,9 @@ class Hud:
                        clip=(lay.pad, 0, lay.W - lay.pad, lay.H))
             elif row.kind == "timebar":
                 self._bar = self._make_bar(row)
+            elif row.kind == "inset":
+                self._inset = Inset(self.plan, lay, row, pal, self.stamp)
+                self._inset.draw_static(img)
         return img
 
     def _legend(self, img, row):
@@ -448,6 +465,8 @@ class Hud:
         for row in lay.rows:
             if row.kind == "timebar":
                 self._draw_bar(img, row, f)
+            elif row.kind == "inset" and self._inset is not None:
+                self._inset.draw(img, f)
             elif row.kind == "notes":
                 notes = self.cap.notes(f)
                 text = "   ·   ".join(notes)
@@ -474,3 +493,100 @@ class Hud:
         img.paste(tuple(pal.fg), (x0 + cut - 1, y, x0 + cut, y + h))
         if bar["scale"]:
             st.put(img, (x1 + fonts.size // 2, yc), bar["scale"], fonts.small, pal.muted, anchor="lm")
+
+
+# --- the live inset -------------------------------------------------------------------------
+MODEL_COLORS = {"reduced": (0, 128, 128), "truncated": (136, 60, 180), "free": (120, 120, 120)}
+
+
+class Inset:
+    """Two small plots across the frame, against video time like the time bar: the angle
+    between d and L (its swing over a turn as a band where the phases are re-timed) and
+    |Omega| / |Omega(0)|, one colour per model, with a cursor and a dot on each curve."""
+
+    def __init__(self, plan, lay, row, pal, stamp):
+        self.plan, self.lay, self.row, self.pal, self.stamp = plan, lay, row, pal, stamp
+        fonts = lay.fonts
+        gap = 2 * lay.pad
+        label_w = int(fonts.width("180°")) + lay.pad
+        w = (lay.W - 2 * lay.pad - gap) // 2
+        top = row.y + fonts.line
+        bottom = row.y + row.height - lay.pad
+        self.boxes = []
+        for i in range(2):
+            x0 = lay.pad + i * (w + gap) + label_w
+            self.boxes.append((x0, top, lay.pad + i * (w + gap) + w, bottom))
+        F = plan.frames
+        self.x = np.arange(F) / max(1, F - 1)
+        w0 = float(plan.panels[0].omega_mag[0]) or 1.0
+        self.series = []                    # per panel: (color, angle (F,), band (F, 2) or None, omega ratio (F,))
+        for p in plan.panels:
+            band = p.angle_dL_range_deg
+            ang = p.angle_dL_deg if p.angle_dL_deg is not None else (band.mean(axis=1) if band is not None else None)
+            self.series.append((MODEL_COLORS.get(p.model, pal.fg), ang, band, p.omega_mag / w0))
+        angles = [a for _, a, b, _ in self.series if a is not None] + [b[:, 1] for _, _, b, _ in self.series
+                                                                      if b is not None]
+        top_deg = max([float(np.max(a)) for a in angles] + [1.0])
+        self.deg_max = min(180.0, 15.0 * math.ceil(top_deg / 15.0))
+        self.w_max = max(1.0, float(max(np.max(s[3]) for s in self.series)))
+
+    def _xy(self, box, x, y, ymax):
+        x0, y0, x1, y1 = box
+        return x0 + x * (x1 - x0 - 1), y1 - 1 - np.clip(y / ymax, 0.0, 1.0) * (y1 - y0 - 1)
+
+    def draw_static(self, img):
+        from PIL import ImageDraw
+
+        lay, pal, fonts, st = self.lay, self.pal, self.lay.fonts, self.stamp
+        ss = 2                                             # lines drawn at twice the size, then reduced
+        y0 = self.row.y
+        H = self.row.height
+        canvas = Image.new("RGB", (lay.W * ss, H * ss), tuple(pal.bg))
+        d = ImageDraw.Draw(canvas)
+        lw = max(1, int(round(lay.H / 360 * 1.5 * ss)))
+        for j, (box, ymax) in enumerate(zip(self.boxes, (self.deg_max, self.w_max))):
+            bx0, by0, bx1, by1 = box
+            d.rectangle([bx0 * ss, (by0 - y0) * ss, bx1 * ss - 1, (by1 - y0) * ss - 1], outline=tuple(pal.divider),
+                        width=max(1, ss // 2))
+            for color, ang, band, wr in self.series:
+                if j == 0 and band is not None:
+                    xs, lo = self._xy(box, self.x, band[:, 0], ymax)
+                    _, hi = self._xy(box, self.x, band[:, 1], ymax)
+                    poly = list(zip(xs * ss, (hi - y0) * ss)) + list(zip(xs[::-1] * ss, (lo[::-1] - y0) * ss))
+                    light = tuple(int(c + 0.75 * (b - c)) for c, b in zip(color, pal.bg))
+                    d.polygon(poly, fill=light)
+                y = ang if j == 0 else wr
+                if y is None:
+                    continue
+                xs, ys = self._xy(box, self.x, y, ymax)
+                d.line(list(zip(xs * ss, (ys - y0) * ss)), fill=tuple(color), width=lw, joint="curve")
+        small = np.asarray(canvas.reduce(ss)).copy()
+        img[y0:y0 + H] = small
+        names = ("∠(d, L)", "|Ω| / |Ω₀|") if self.plan.units == "cgs" else ("∠(d, L)", "|ω| / |ω₀|")
+        tops = (f"{self.deg_max:.0f}°", f"{self.w_max:g}")
+        for box, name, top in zip(self.boxes, names, tops):
+            bx0, by0, bx1, by1 = box
+            st.put(img, (bx0, self.row.y), name, fonts.small, pal.fg)
+            st.put(img, (bx0 - lay.pad // 2, by0), top, fonts.small, pal.muted, anchor="ra")
+            st.put(img, (bx0 - lay.pad // 2, by1), "0", fonts.small, pal.muted, anchor="rd")
+        # which colour is which model, right-aligned on the title line of the second plot
+        x = lay.W - lay.pad
+        for p in reversed(self.plan.panels):
+            color = MODEL_COLORS.get(p.model, pal.fg)
+            st.put(img, (x, self.row.y), p.model, fonts.small, color, anchor="ra")
+            x -= int(fonts.width(p.model)) + fonts.size
+
+    def draw(self, img, f: int):
+        """The cursor and a dot on each curve at frame f (img: PIL RGB image, in place)."""
+        r = max(2, self.lay.H // 180)
+        for j, (box, ymax) in enumerate(zip(self.boxes, (self.deg_max, self.w_max))):
+            bx0, by0, bx1, by1 = box
+            xc = int(round(bx0 + self.x[f] * (bx1 - bx0 - 1)))
+            img.paste(tuple(self.pal.muted), (xc, by0 + 1, xc + 1, by1 - 1))
+            for color, ang, _, wr in self.series:
+                y = ang if j == 0 else wr
+                if y is None:
+                    continue
+                _, yy = self._xy(box, self.x[f:f + 1], y[f:f + 1], ymax)
+                yc = int(round(yy[0]))
+                img.paste(tuple(color), (xc - r, yc - r, xc + r + 1, yc + r + 1))

@@ -43,7 +43,7 @@ COLORS = {
               "trail": (1.0, 0.3, 0.4), "bg_rgb": (0.0, 0.0, 0.0)},
 }
 BODY_COLORS = {"DAST": (0.96, 0.52, 0.16), "cellulose": (0.93, 0.74, 0.38)}
-ROD_SECOND_COLOR = (0.36, 0.22, 0.10)      # the rod's dark half: its axial spin shows
+ROD_SECOND_COLOR = (0.28, 0.16, 0.07)      # the rod's dark half: its axial spin shows
 BODY_COLOR = (0.72, 0.66, 0.58)
 DIPOLE_COLOR = (0.86, 0.08, 0.24)
 OMEGA_COLOR = (0.12, 0.35, 0.85)
@@ -78,8 +78,9 @@ def body_part(shape, name: str) -> Part:
     if shape.kind == "rod":
         length, diameter = shape.dims
         k = BODY_RADIUS / math.hypot(0.5 * length, 0.5 * diameter)
-        # a very thin rod is drawn at least 1/14 of its length thick, so its halves can be seen
-        r = max(0.5 * diameter * k, 0.07 * length * k)
+        # a thin rod is drawn at least a sixth of its length thick, so that its painted halves
+        # -- and with them its spin about its own axis -- can be seen (the true L/D is in the title)
+        r = max(0.5 * diameter * k, 0.085 * length * k)
         part = meshes.two_tone_rod(r, 0.5 * length * k, color, np.asarray(ROD_SECOND_COLOR))
     else:
         a, b, c = shape.dims
@@ -394,10 +395,15 @@ class RenderSession:
                 pts.append(u * (ln[:, None] + 0.02))
         return np.vstack(pts) if pts else np.eye(3)
 
-    def _margins(self, vw, vh):
+    def _border(self):
+        """Pixels kept free at the sides and at top and bottom of a view (labels reach out there)."""
         px = 5.0                                              # keep drawn pixels this far from the view's edge
         label = self.layout.fonts.size * 0.9 if "axes" in self.show else 0.0
-        return (min(0.5, 0.02 + 2 * (px + 1.4 * label) / vw), min(0.5, 0.02 + 2 * (px + 0.6 * label) / vh))
+        return px + 1.4 * label, px + 0.6 * label
+
+    def _margins(self, vw, vh):
+        bx, by = self._border()
+        return (min(0.5, 0.02 + 2 * bx / vw), min(0.5, 0.02 + 2 * by / vh))
 
     def _fit_camera(self) -> Camera:
         """The camera fitted to the content of every frame, and the 3-D views narrowed to the
@@ -409,7 +415,7 @@ class RenderSession:
         view, zoom = self._view_direction(), self.plan.spec.zoom
         cam = Camera(view, vw / vh, pts, self._margins(vw, vh), zoom)
         lo, hi = cam._extent(pts, cam.distance)
-        need = (hi[0] - lo[0]) / 2.0 * vw / (1.0 - self._margins(vw, vh)[0])
+        need = ((hi[0] - lo[0]) / 2.0 * vw + 2 * self._border()[0]) / 0.98
         w2 = int(min(vw, 2 * math.ceil(need / 2.0 + 1)))
         if w2 < vw and zoom <= 1.0:
             views = []

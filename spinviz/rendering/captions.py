@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import math
 
+# one colour per model everywhere: headings and inset of the videos, ``spinviz compare``'s plots
+MODEL_COLORS = {"reduced": (0, 128, 128), "truncated": (136, 60, 180), "free": (120, 120, 120)}
 MODEL_LABELS = {"reduced": "reduced (2.2)+(2.3)", "truncated": "truncated (2.5)", "free": "free (d = 0)"}
 
 # (heading, equation numbers) per model and register

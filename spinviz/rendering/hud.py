@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from PIL import Image, ImageFont
 
-from .captions import Captions
+from .captions import MODEL_COLORS, Captions
 
 _FONT_DIRS = ("/usr/share/fonts/truetype/dejavu",)
 MIN_VIEW_INSET = 0.36     # ... or this, to make room for a requested inset
@@ -496,7 +496,6 @@ class Hud:
 
 
 # --- the live inset -------------------------------------------------------------------------
-MODEL_COLORS = {"reduced": (0, 128, 128), "truncated": (136, 60, 180), "free": (120, 120, 120)}
 
 
 class Inset:

@@ -207,3 +207,25 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
 def default_output(scene: Scene, directory: str = "renders") -> str:
     stem = os.path.splitext(os.path.basename(scene.path))[0]
     return os.path.join(directory, f"{stem}.mp4")
+
+
+def contact_sheet(sources: Sequence[Source], out: str, *, size=(640, 360), columns: int = 2, at: float = 0.5,
+                  colors: int = 96) -> str:
+    """One frame of each source (at fraction ``at`` of its video) in a grid, as a small PNG:
+    the README's gallery overview.  ``colors`` limits the palette (the sheet stays small)."""
+    from PIL import Image
+
+    from .atomic import atomic_path
+
+    W, H = size
+    frames = []
+    for src in sources:
+        with Renderer(src, size=tuple(size)) as r:
+            frames.append(r.frame(int(round(at * (r.frames - 1)))))
+    rows = -(-len(frames) // columns)
+    sheet = Image.new("RGB", (columns * W + (columns - 1) * 4, rows * H + (rows - 1) * 4), (200, 200, 205))
+    for i, img in enumerate(frames):
+        sheet.paste(Image.fromarray(img), ((i % columns) * (W + 4), (i // columns) * (H + 4)))
+    with atomic_path(out) as tmp:
+        sheet.quantize(colors=colors, method=Image.Quantize.MEDIANCUT).save(tmp, format="PNG", optimize=True)
+    return out

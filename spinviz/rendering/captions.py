@@ -176,10 +176,10 @@ class Captions:
             factor = float(plan.slowdown[f])
             if factor >= 1.0:
                 x = sci(factor, 2)
-                out.append(f"spin shown {x} times slower than real" if outreach else f"spin shown slowed {x}×")
+                out.append(f"spin shown {x} times slower" if outreach else f"spin shown slowed {x}×")
             else:                                   # a slow top shown at the set turn rate
                 x = sci(1.0 / factor, 2)
-                out.append(f"spin shown {x} times faster than real" if outreach else f"spin shown sped up {x}×")
+                out.append(f"spin shown {x} times faster" if outreach else f"spin shown sped up {x}×")
         elif plan.spin_mode == "aliased":
             out.append("spin too fast for the frame rate: shown aliased" if outreach
                        else "spin aliased (too fast for the frame rate)")
@@ -187,9 +187,10 @@ class Captions:
             out.append("spin phase not resolved: the pose is illustrative")
         if self.spec.time_map == "log":
             if outreach:
-                out.append("time speeds up as the video runs (logarithmic)")
+                out.append("log time: ticks 10× apart")
             else:
-                out.append(plan.time_label)
+                k = self.spec.log_knee or plan.t_end / 1000.0
+                out.append(f"time axis logarithmic after {sim_time(k, plan.units, 'physics')}")
         return out
 
     def footer(self) -> str:

@@ -25,6 +25,7 @@ from PIL import Image, ImageFont
 from .captions import MODEL_COLORS, Captions
 
 _FONT_DIRS = ("/usr/share/fonts/truetype/dejavu",)
+NOTE_SEP = "   ·   "
 MIN_VIEW_INSET = 0.36     # ... or this, to make room for a requested inset
 MIN_VIEW = 0.5           # the 3-D view keeps at least this fraction of the frame height
 BODY_TEXT = 15 / 360      # body text size per frame row (15 px at 360 rows, 30 px at 720)
@@ -187,16 +188,22 @@ def make_layout(plan, W: int, H: int, show) -> Layout:
     subtitles = [wrap(cap.subtitle(k), fonts.small, pw - 2 * pad) for k in range(n)]
     readout_lines = max(len(cap.readouts(k, 0)) for k in range(n))
     notes_n = len(cap.notes(0))
+    F = plan.frames
+    sample = sorted(set(np.linspace(0, F - 1, min(F, 24)).round().astype(int)))
+    joined = max(fonts.width(NOTE_SEP.join(cap.notes(f))) for f in sample) if notes_n else 0.0
+    notes_rows = 1 if joined <= W - 2 * pad else notes_n
     wanted = {"headings": hud_on, "subtitle": hud_on, "readouts": hud_on, "legend": hud_on and bool(legend),
               "timebar": hud_on, "notes": hud_on and notes_n > 0, "title": hud_on and bool(cap.footer()),
               "inset": "inset" in show and plan.panels[0].omega_mag is not None}
     sub_lines = 2
-    steps = ("title", "subtitle2", "inset", "notes", "subtitle", "legend", "timebar", "readouts", "headings")
+    steps = ("title", "subtitle2", "inset", "notes2", "subtitle", "notes", "legend", "timebar", "readouts", "headings")
     if not wanted["inset"]:
         steps = tuple(x for x in steps if x != "subtitle2")
     for drop in (None, *steps):
         if drop == "subtitle2":
             sub_lines = 1
+        elif drop == "notes2":
+            notes_rows = 1
         elif drop:
             wanted[drop] = False
         subtitles = [s[:sub_lines] for s in subtitles]
@@ -216,7 +223,7 @@ def make_layout(plan, W: int, H: int, show) -> Layout:
         if wanted["timebar"]:
             rows.append(Row("timebar", fonts.line + pad // 2))
         if wanted["notes"]:
-            rows.append(Row("notes", fonts.line))
+            rows.append(Row("notes", fonts.line * notes_rows, payload=notes_rows))
         if wanted["title"]:
             rows.append(Row("title", fonts.line))
         bottom += sum(r.height for r in rows) + (pad if rows else 0)
@@ -469,11 +476,10 @@ class Hud:
                 self._inset.draw(img, f)
             elif row.kind == "notes":
                 notes = self.cap.notes(f)
-                text = "   ·   ".join(notes)
-                if fonts.width(text) > lay.W - 2 * lay.pad:
-                    text = notes[0]
-                st.put(img, (lay.W // 2, row.y), text, fonts.small, pal.muted, anchor="ma",
-                       clip=(lay.pad, 0, lay.W - lay.pad, lay.H))
+                lines = [NOTE_SEP.join(notes)] if row.payload == 1 else notes
+                for i, text in enumerate(lines[:row.payload]):
+                    st.put(img, (lay.W // 2, row.y + i * fonts.line), text, fonts.small, pal.muted, anchor="ma",
+                           clip=(lay.pad, 0, lay.W - lay.pad, lay.H))
         return img
 
     def _draw_bar(self, img, row, f):

@@ -48,7 +48,8 @@ BODY_COLOR = (0.72, 0.66, 0.58)
 DIPOLE_COLOR = (0.86, 0.08, 0.24)
 OMEGA_COLOR = (0.12, 0.35, 0.85)
 L_COLOR = (0.10, 0.58, 0.25)
-HODO_COLOR = (0.12, 0.35, 0.85)
+HODO_COLOR = (0.12, 0.35, 0.85)            # omega's curve: the colour of the Omega arrow
+HODO_MARKER_COLOR = (0.10, 0.10, 0.12)      # "now" on the curve
 ARROW_COLORS = {"dipole": DIPOLE_COLOR, "omega": OMEGA_COLOR, "L": L_COLOR}
 # arrow geometry, in units of the dipole arrow: shaft radius, head length, head radius, and the
 # length at full magnitude; the part beyond ARROW_BASE (about the body's surface) grows with
@@ -83,7 +84,9 @@ def body_part(shape, name: str) -> Part:
         r = max(0.5 * diameter * k, 0.085 * length * k)
         part = meshes.two_tone_rod(r, 0.5 * length * k, color, np.asarray(ROD_SECOND_COLOR))
     else:
-        a, b, c = shape.dims
+        # a needle-thin box (a slender inertia-equivalent body) is drawn at least 1/8 as thick
+        # as it is long, so that it can be seen turning
+        a, b, c = np.maximum(np.asarray(shape.dims, dtype=float), 0.125 * max(shape.dims))
         k = BODY_RADIUS / (0.5 * math.sqrt(a * a + b * b + c * c))
         part = meshes.box(0.5 * k * np.array([a, b, c]), color, 0.35 * color)
     m = matrix_from_quat(np.asarray(shape.q_body_from_shape, dtype=float))
@@ -458,7 +461,7 @@ class RenderSession:
                 solids.add(key + "_head", meshes.arrow_head(head_len, head_r, color))
         if "hodograph" in show:
             lo, hi, span = self._hodo_range()
-            solids.add("hodo_marker", meshes.ball(0.022 * span, np.asarray(DIPOLE_COLOR)))
+            solids.add("hodo_marker", meshes.ball(0.022 * span, np.asarray(HODO_MARKER_COLOR)))
         self._place_arrows(solids, panel, 0)
         solids.build(p)
         if "trail" in show:
@@ -514,8 +517,17 @@ class RenderSession:
                     e[i] = hi[i] + 0.06 * span
                     out.append((names[i], tuple(self.camera.to_pixels(e, box)[0])))
                 last = {}
+                origin = self.camera.to_pixels(np.zeros(3), box)[0]
                 for i, v, p in self.ticks:
-                    xy = self.camera.to_pixels(p, box)[0] + [0.0, 0.75 * size]
+                    # beside the axis, off the curve's side: left of a steep axis, under a flat one
+                    e = np.zeros(3)
+                    e[i] = 1.0
+                    d = self.camera.to_pixels(e, box)[0] - origin
+                    d /= np.linalg.norm(d) or 1.0
+                    side = np.array([-d[1], d[0]])
+                    if (abs(d[1]) > abs(d[0]) and side[0] > 0) or (abs(d[1]) <= abs(d[0]) and side[1] < 0):
+                        side = -side
+                    xy = self.camera.to_pixels(p, box)[0] + side * 1.1 * size
                     if i in last and np.linalg.norm(xy - last[i]) < 2.2 * size:
                         continue
                     last[i] = xy

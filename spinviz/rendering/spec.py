@@ -25,7 +25,7 @@ MIN_SIZE, MAX_SIZE = 16, 7680
 MAX_FPS = 240
 MAX_DURATION_S = 3600.0
 MAX_FRAMES = 100_000            # ~55 min at 30 fps; the frame plan holds ~300 bytes per frame and panel
-MAX_GIF_BYTES = 1_000_000_000   # a GIF's frames are kept in memory (1 byte per pixel) until it is written
+MAX_GIF_BYTES = 1_000_000_000   # a GIF's frames are kept in memory (RGB, 3 bytes per pixel) until it is written
 ZOOM_RANGE = (0.05, 20.0)       # outside it the body is a dot or fills the frame far beyond its edges
 MAX_KNEE_RATIO = 1e15           # t_end / log_knee: float64 must still tell neighbouring frame times apart
 MAX_TITLE = 160
@@ -138,8 +138,8 @@ class RenderSpec:
             raise SpecError("size", f"MP4 (H.264, yuv420p) needs an even width and height, got {w}x{h}")
         if w % panels:
             raise SpecError("size", f"{panels} panels side by side need a width divisible by {panels}, got {w}")
-        if ext == ".gif" and self.frames * w * h > MAX_GIF_BYTES:
-            raise SpecError("duration", f"a GIF of {self.frames} frames at {w}x{h} needs {self.frames * w * h / 1e9:.1f} GB "
+        if ext == ".gif" and 3 * self.frames * w * h > MAX_GIF_BYTES:
+            raise SpecError("duration", f"a GIF of {self.frames} frames at {w}x{h} needs {3 * self.frames * w * h / 1e9:.1f} GB "
                                         f"of memory (limit {MAX_GIF_BYTES / 1e9:g} GB); make it shorter or smaller, or use .mp4")
 
 

@@ -179,6 +179,7 @@ class Solids:
         self.mesh.point_data["rgb"] = np.zeros((self.mesh.n_points, 3), dtype=np.uint8)
         self._rgb = self.mesh.point_data["rgb"]                  # shares memory with the VTK array
         self._vtk_rgb = self.mesh.GetPointData().GetArray("rgb")
+        self._pts = self.mesh.points                             # so do the points: updated in place
         self.commit()
         return plotter.add_mesh(self.mesh, scalars="rgb", rgb=True, lighting=False, show_scalar_bar=False)
 
@@ -202,9 +203,17 @@ class Solids:
                 k += intensity * np.clip(n @ direction, 0.0, None)
             k = np.where(part.lit, k, 1.0)
             rgb[sl] = part.color * k[:, None]
-        self.mesh.points = pts
+        self._pts[:] = pts
+        self.mesh.GetPoints().Modified()
         self._rgb[:] = np.clip(rgb * 255.0, 0, 255).astype(np.uint8)
         self._vtk_rgb.Modified()
+
+
+def _set_points(mesh, pts):
+    """Move a mesh's points in place (no new VTK array per frame)."""
+    view = mesh.points
+    view[:] = pts
+    mesh.GetPoints().Modified()
 
 
 def arrow_length(key: str, ratio: float) -> float:
@@ -560,11 +569,11 @@ class RenderSession:
             if "trail" in curves:
                 lo = max(0, f - int(round(plan.spec.trail_seconds * plan.spec.fps)))
                 idx = np.linspace(lo, f, TRAIL_POINTS).round().astype(int)
-                curves["trail"].points = panel.dipole[idx]
+                _set_points(curves["trail"], panel.dipole[idx])
             if "hodograph" in curves:
                 pts = panel.omega_body.copy()
                 pts[f + 1:] = pts[f]
-                curves["hodograph"].points = pts
+                _set_points(curves["hodograph"], pts)
 
     def render_views(self) -> list[Image.Image]:
         """Each panel's 3-D view at output resolution (PIL RGB images), without text."""

@@ -180,10 +180,13 @@ def render_frame(source: Source, t: float | None = None, *, size=(640, 360), **o
 
 
 def render(source: Source, out: str | None = None, *, size=None, fps=None, duration=None, workers=None,
-           progress: bool = False, **overrides):
+           progress: bool = False, pool=None, **overrides):
     """Render ``source`` to ``out`` (.mp4 or .gif) and a PNG poster beside it; returns a
     ``RenderResult`` (path, poster, frames, seconds, fps).  ``out`` defaults to
-    ``renders/<scene>.mp4`` for a scene.  Other keywords override ``[render]`` settings."""
+    ``renders/<scene>.mp4`` for a scene.  Other keywords override ``[render]`` settings.
+
+    pool : render processes started earlier (``rendering.video.WorkerPool``), e.g. before the
+        scene was even read; used for an MP4 and closed here in any case."""
     scene, trajs, spec = resolve_spec(source, size=size, fps=fps, duration=duration, **overrides)
     if out is None:
         if scene is None:
@@ -193,9 +196,13 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
     inputs = [scene.path] if scene is not None and os.path.exists(scene.path) else []
     check_outputs([out, poster_for(out)], inputs)        # before any work: nothing to undo later
     video = require_render_stack()
-    n = video.plan_workers(spec, out, workers)
-    # the render processes start now and import the drawing stack while this one simulates
-    pool = video.WorkerPool(n) if n > 1 else None
+    n = video.plan_workers(spec, out, workers if pool is None else pool.workers)
+    if pool is not None and n == 1:
+        pool.close()                                     # a GIF or a very short video renders in-process
+        pool = None
+    if pool is None and n > 1:
+        # the render processes start now and import the drawing stack while this one simulates
+        pool = video.WorkerPool(n)
     try:
         return video.render_video(_plan(scene, trajs, spec), out, workers=workers, progress=progress, inputs=inputs,
                                   pool=pool)

@@ -480,3 +480,27 @@ def test_render_workers_import_no_simulation_stack():
     r = subprocess.run([sys.executable, "-c", code], input=pickle.dumps(plan), capture_output=True)
     assert r.returncode == 0, r.stderr.decode()
     assert r.stdout.decode().strip() == "[]"
+
+
+def test_render_starts_its_workers_before_it_simulates(tmp_path, monkeypatch):
+    """pipeline.render opens the render processes first, so that their imports overlap the
+    simulation: when the first model is integrated, the workers are already running; and the
+    video comes out whole (frame count) through the pre-started pool."""
+    import multiprocessing
+
+    import imageio
+
+    seen = []
+    real = pipeline.simulate
+
+    def spy(*a, **k):
+        seen.append(len(multiprocessing.active_children()))
+        return real(*a, **k)
+
+    monkeypatch.setattr(pipeline, "simulate", spy)
+    sc = askew(models='models = ["reduced", "truncated"]', show='["body", "dipole", "hud"]', w=160, h=96)
+    out = tmp_path / "v.mp4"
+    res = pipeline.render(sc, str(out), fps=12, duration=1.0, workers=2)
+    assert seen and seen[0] >= 2, seen
+    assert res.workers == 2 and imageio.get_reader(str(out)).count_frames() == 12
+    assert multiprocessing.active_children() == []

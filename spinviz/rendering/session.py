@@ -350,7 +350,7 @@ class RenderSession:
         """Axis lines across the hodographs' range and tick marks at round values: (curves, ticks)
         with ticks [(axis, value, world point)]."""
         lo, hi, span = self._hodo_range()
-        step = hud._nice_step(span, 4)
+        step = hud._nice_step(span, 6)
         size = 0.025 * span
         curves, ticks = [], []
         for i in range(3):
@@ -527,7 +527,13 @@ class RenderSession:
                     out.append((names[i], tuple(self.camera.to_pixels(e, box)[0])))
                 last = {}
                 origin = self.camera.to_pixels(np.zeros(3), box)[0]
+                # values on the axis that looks longest only: short axes near the origin would
+                # crowd their labels together
+                reach = [float(np.linalg.norm(self.camera.to_pixels(np.eye(3)[i] * (hi[i] - lo[i]), box)[0] - origin))
+                         for i in range(3)]
                 for i, v, p in self.ticks:
+                    if i != int(np.argmax(reach)):
+                        continue
                     # beside the axis, off the curve's side: left of a steep axis, under a flat one
                     e = np.zeros(3)
                     e[i] = 1.0

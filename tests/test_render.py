@@ -193,7 +193,8 @@ def test_only_listed_actors_are_built():
     try:
         assert set(session.solids[0].parts) == {"dipole_shaft", "dipole_head"}
         assert session.curves[0] == {}
-        assert len(session.plotters[0].renderer.actors) == 1          # no sphere, axes, trail, body
+        assert len(session.plotters[0].actors) == 1                   # no sphere, axes, trail, body
+        assert session.plotters[0].renderer.GetActors().GetNumberOfItems() == 1
         assert plan.panels[0].omega is None and plan.panels[0].L is None   # not computed either
     finally:
         session.close()
@@ -466,7 +467,8 @@ def test_captions_key_is_validated():
 
 def test_render_workers_import_no_simulation_stack():
     """A render worker imports the drawing stack and unpickles a plan without loading numba,
-    scipy or numpy-quaternion (about 1.5 s each): start-up is the drawing stack only."""
+    scipy or numpy-quaternion (about 1.5 s), nor pyvista's plotting module and matplotlib
+    (about 0.9 s): start-up is VTK, pyvista's meshes, Pillow and imageio-ffmpeg only."""
     import pickle
     import subprocess
     import sys
@@ -476,7 +478,8 @@ def test_render_workers_import_no_simulation_stack():
             "from spinviz.rendering import encode, session\n"
             "plan = pickle.loads(sys.stdin.buffer.read())\n"
             "session.RenderSession(plan).frame(0)\n"
-            "print(sorted(m for m in ('numba', 'scipy', 'quaternion') if m in sys.modules))")
+            "print(sorted(m for m in ('numba', 'scipy', 'quaternion', 'matplotlib', 'pyvista.plotting')"
+            " if m in sys.modules))")
     r = subprocess.run([sys.executable, "-c", code], input=pickle.dumps(plan), capture_output=True)
     assert r.returncode == 0, r.stderr.decode()
     assert r.stdout.decode().strip() == "[]"

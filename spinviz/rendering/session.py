@@ -15,8 +15,9 @@ OpenGL (llvmpipe, 2 cores) decided the structure -- measured, see ``spinviz rend
 * the camera is fitted once to everything any frame draws (both panels share it, so the
   views compare directly): nothing is clipped and no band of the view stays empty.
 
-Imports only the drawing stack and NumPy (``geometry``, not ``spinviz.rotations``): a render
-worker starts in about a second.
+Imports only the drawing stack and NumPy (``geometry``, not ``spinviz.rotations``; VTK's
+render window directly, not ``pyvista.Plotter``, whose module imports matplotlib): a render
+worker is ready to draw about a second after it starts.
 """
 
 from __future__ import annotations
@@ -27,10 +28,12 @@ import os
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")   # no X server: go straight to EGL
 
 import numpy as np
-import pyvista as pv
+import pyvista as pv  # pyvista's meshes only: its plotting module imports matplotlib (~0.9 s)
+import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (registers the OpenGL render window and mappers)
 from PIL import Image
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkUnsignedCharArray
+from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper, vtkRenderer, vtkRenderWindow
 
 from . import hud, meshes
 from .geometry import matrix_from_quat, rotation_x_to
@@ -148,6 +151,56 @@ def sphere_cage(view, colors):
     return out
 
 
+class Window:
+    """One off-screen render window with one renderer, built from VTK directly (what the
+    session needs of ``pyvista.Plotter``, without importing pyvista's plotting module and
+    matplotlib in every render worker): unlit actors, per-point RGB or one colour."""
+
+    def __init__(self, size, background):
+        self.render_window = vtkRenderWindow()
+        self.render_window.SetOffScreenRendering(1)
+        self.render_window.SetMultiSamples(0)
+        self.render_window.SetSize(int(size[0]), int(size[1]))
+        self.renderer = vtkRenderer()
+        self.renderer.SetBackground(*background)
+        self.renderer.AutomaticLightCreationOff()
+        self.render_window.AddRenderer(self.renderer)
+        self.actors = []
+
+    @property
+    def camera(self):
+        return self.renderer.GetActiveCamera()
+
+    def add_mesh(self, mesh, rgb: bool = False, color=None, line_width: float = 1.0):
+        """An unlit actor: coloured by the point array "rgb" (uint8) or by one ``color``."""
+        mapper = vtkPolyDataMapper()
+        mapper.SetInputData(mesh)
+        if rgb:
+            mapper.SetScalarModeToUsePointFieldData()
+            mapper.SelectColorArray("rgb")
+            mapper.SetColorModeToDirectScalars()
+            mapper.ScalarVisibilityOn()
+        else:
+            mapper.ScalarVisibilityOff()
+        actor = vtkActor()
+        actor.SetMapper(mapper)
+        prop = actor.GetProperty()
+        prop.LightingOff()
+        prop.SetLineWidth(float(line_width))
+        if color is not None:
+            prop.SetColor(*color)
+        self.renderer.AddActor(actor)
+        self.actors.append(actor)
+        return actor
+
+    def render(self):
+        self.render_window.Render()
+
+    def close(self):
+        self.renderer.RemoveAllViewProps()
+        self.render_window.Finalize()
+
+
 class Solids:
     """The moving solids of a panel as one mesh, turned and lit on the CPU each frame.
 
@@ -181,7 +234,7 @@ class Solids:
         self._vtk_rgb = self.mesh.GetPointData().GetArray("rgb")
         self._pts = self.mesh.points                             # so do the points: updated in place
         self.commit()
-        return plotter.add_mesh(self.mesh, scalars="rgb", rgb=True, lighting=False, show_scalar_bar=False)
+        return plotter.add_mesh(self.mesh, rgb=True)
 
     def place(self, name: str, rot3=None, shift=None, lin=None):
         p = self.parts[name]
@@ -262,14 +315,14 @@ class Camera:
         ndc = self._ndc(pts, D)
         return ndc.min(axis=0), ndc.max(axis=0)
 
-    def apply(self, plotter):
-        cam = plotter.camera
-        cam.focal_point = (0.0, 0.0, 0.0)
-        cam.position = tuple(self.distance * self.view)
-        cam.up = (0.0, 0.0, 1.0)
-        cam.view_angle = VIEW_ANGLE
+    def apply(self, window):
+        cam = window.camera
+        cam.SetFocalPoint(0.0, 0.0, 0.0)
+        cam.SetPosition(*(self.distance * self.view))
+        cam.SetViewUp(0.0, 0.0, 1.0)
+        cam.SetViewAngle(VIEW_ANGLE)
         cam.SetWindowCenter(float(self.center[0]), float(self.center[1]))
-        cam.clipping_range = (max(1e-3, self.distance - 2.0 * self.rmax - 1.0), self.distance + 2.0 * self.rmax + 1.0)
+        cam.SetClippingRange(max(1e-3, self.distance - 2.0 * self.rmax - 1.0), self.distance + 2.0 * self.rmax + 1.0)
 
     def to_pixels(self, pts, box):
         """Output pixel (column, row) of world points in the viewport ``box`` (x0, y0, x1, y1)."""
@@ -304,12 +357,9 @@ class RenderSession:
         self.plotters, self.solids, self.curves = [], [], []
         self.ticks = []
         for panel in plan.panels:
-            p = pv.Plotter(off_screen=True, window_size=self.window, lighting="none")
-            p.disable_anti_aliasing()
-            p.set_background(self.colors["bg"])
+            p = Window(self.window, self.colors["bg_rgb"])
             self._build_panel(p, panel)
             self.camera.apply(p)
-            p.show(auto_close=False)
             self.plotters.append(p)
         self._pixels = [vtkUnsignedCharArray() for _ in self.plotters]    # one each: numpy views share them
         self.labels = self._axis_labels()
@@ -458,7 +508,7 @@ class RenderSession:
         if mesh is not None:
             # 1-pixel lines at the supersampled size: wider GL lines are drawn as extra
             # triangles and cost ~2.5 ms per panel on llvmpipe
-            p.add_mesh(mesh, scalars="rgb", rgb=True, line_width=1, lighting=False, show_scalar_bar=False)
+            p.add_mesh(mesh, rgb=True, line_width=1)
         solids = Solids(self._lights())
         if "body" in show:
             solids.add("body", body_part(plan.shape, plan.body_name))
@@ -481,11 +531,10 @@ class RenderSession:
             age = np.linspace(0.0, 1.0, TRAIL_POINTS) ** 1.5
             bg, tc = np.asarray(self.colors["bg_rgb"]), np.asarray(self.colors["trail"])
             curves["trail"].point_data["rgb"] = ((bg + (tc - bg) * (0.06 + 0.94 * age)[:, None]) * 255).astype(np.uint8)
-            p.add_mesh(curves["trail"], scalars="rgb", rgb=True, line_width=2 * lw, lighting=False,
-                       show_scalar_bar=False)
+            p.add_mesh(curves["trail"], rgb=True, line_width=2 * lw)
         if "hodograph" in show:
             curves["hodograph"] = pv.lines_from_points(np.zeros((plan.frames, 3)))
-            p.add_mesh(curves["hodograph"], color=HODO_COLOR, line_width=2 * lw, lighting=False)
+            p.add_mesh(curves["hodograph"], color=HODO_COLOR, line_width=2 * lw)
         self.solids.append(solids)
         self.curves.append(curves)
 

@@ -115,9 +115,10 @@ show = ["dipole", "hud"]
         assert img.shape == (200, 480, 3)
         tips = []
         for k in range(2):
-            half = np.zeros(img.shape[:2], dtype=bool)
-            half[:, k * 240:(k + 1) * 240] = True
-            mask = dipole_mask(img) & half
+            view = np.zeros(img.shape[:2], dtype=bool)           # the panel's 3-D view: not its red legend chip
+            x0, y0, x1, y1 = session.layout.views[k]
+            view[y0:y1, x0:x1] = True
+            mask = dipole_mask(img) & view
             want = np.array(session.project(k, plan.panels[k].dipole[f]))
             got = tip_pixel(mask, session.project(k, (0.0, 0.0, 0.0)))
             assert np.linalg.norm(got - want) < 2.5, (k, got, want)

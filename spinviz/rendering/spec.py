@@ -43,10 +43,11 @@ class RenderSpec:
     spin : "auto", "true" (the simulated orientation at each frame) or "slowed" (symmetric
         tops: slow geometry exact, spin and precession phases re-timed so that the shown
         spin rate is ``spin_turns_per_second`` x |Omega_L(t)| / |Omega_L(0)|; labelled).
-    show : the actors to build (others are not built, and what they need is not computed).
+    show : the actors to build (others are not built, and what they need is not computed);
+        "inset" adds live plots of angle(d, L) and |Omega| of both models.
     trail_seconds : length of the dipole trail, video seconds.
     azimuth_deg, elevation_deg, zoom : the camera (view direction from the origin).
-    background : "white" or "black".  title : shown under the panels.
+    background : "white" or "black".  title : shown under the panels when there is room.
     poster : where in the video (0..1) the PNG poster frame is taken.
     captions : "outreach" (plain words, numbers for people) or "physics" (symbols,
         equation numbers, scientific notation).

@@ -337,6 +337,11 @@ def test_every_scene_keeps_its_frame_edges_clear_and_labels_its_arrows(path):
                 px = session.camera.to_pixels(tips, session.layout.views[k])
                 assert (px[:, 0] >= x0).all() and (px[:, 0] <= x1).all(), (path.name, key)
                 assert (px[:, 1] >= y0).all() and (px[:, 1] <= y1).all(), (path.name, key)
+        font = session.layout.fonts.small
+        for text, (x, y) in session.labels:                  # axis names and values stay inside a 3-D view
+            l, t, r, b = font.getbbox(text, anchor="mm")
+            assert any(v[0] <= x + l and x + r <= v[2] and v[1] <= y + t and y + b <= v[3]
+                       for v in session.layout.views), (path.name, text, (x, y), session.layout.views)
     finally:
         session.close()
 

@@ -34,13 +34,16 @@ class MissingRenderStack(UsageError, ImportError):
 
 
 def require_render_stack():
-    """Import ``spinviz.rendering.video``, or explain in one line which optional package is missing."""
-    try:
-        import imageio_ffmpeg  # noqa: F401
-        import PIL  # noqa: F401
-        import pyvista  # noqa: F401
-        import vtk  # noqa: F401
+    """Import ``spinviz.rendering.video``, or explain in one line which optional package is missing.
 
+    The drawing stack itself (pyvista, VTK) is only looked up here, not imported: with
+    worker processes the parent never draws, and importing VTK would cost it a second."""
+    import importlib.util
+
+    try:
+        for name in ("imageio_ffmpeg", "PIL", "pyvista", "vtkmodules"):
+            if importlib.util.find_spec(name) is None:
+                raise ImportError(f"No module named {name!r}", name=name)
         from .rendering import video
     except ImportError as e:
         name = (e.name or "").split(".")[0]
@@ -177,10 +180,13 @@ def render_frame(source: Source, t: float | None = None, *, size=(640, 360), **o
 
 
 def render(source: Source, out: str | None = None, *, size=None, fps=None, duration=None, workers=None,
-           progress: bool = False, **overrides):
+           progress: bool = False, pool=None, **overrides):
     """Render ``source`` to ``out`` (.mp4 or .gif) and a PNG poster beside it; returns a
     ``RenderResult`` (path, poster, frames, seconds, fps).  ``out`` defaults to
-    ``renders/<scene>.mp4`` for a scene.  Other keywords override ``[render]`` settings."""
+    ``renders/<scene>.mp4`` for a scene.  Other keywords override ``[render]`` settings.
+
+    pool : render processes started earlier (``rendering.video.WorkerPool``), e.g. before the
+        scene was even read; used for an MP4 and closed here in any case."""
     scene, trajs, spec = resolve_spec(source, size=size, fps=fps, duration=duration, **overrides)
     if out is None:
         if scene is None:
@@ -190,9 +196,43 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
     inputs = [scene.path] if scene is not None and os.path.exists(scene.path) else []
     check_outputs([out, poster_for(out)], inputs)        # before any work: nothing to undo later
     video = require_render_stack()
-    return video.render_video(_plan(scene, trajs, spec), out, workers=workers, progress=progress, inputs=inputs)
+    n = video.plan_workers(spec, out, workers if pool is None else pool.workers)
+    if pool is not None and n == 1:
+        pool.close()                                     # a GIF or a very short video renders in-process
+        pool = None
+    if pool is None and n > 1:
+        # the render processes start now and import the drawing stack while this one simulates
+        pool = video.WorkerPool(n)
+    try:
+        return video.render_video(_plan(scene, trajs, spec), out, workers=workers, progress=progress, inputs=inputs,
+                                  pool=pool)
+    finally:
+        if pool is not None:
+            pool.close()
 
 
 def default_output(scene: Scene, directory: str = "renders") -> str:
     stem = os.path.splitext(os.path.basename(scene.path))[0]
     return os.path.join(directory, f"{stem}.mp4")
+
+
+def contact_sheet(sources: Sequence[Source], out: str, *, size=(640, 360), columns: int = 2, at: float = 0.5,
+                  colors: int = 96) -> str:
+    """One frame of each source (at fraction ``at`` of its video) in a grid, as a small PNG:
+    the README's gallery overview.  ``colors`` limits the palette (the sheet stays small)."""
+    from PIL import Image
+
+    from .atomic import atomic_path
+
+    W, H = size
+    frames = []
+    for src in sources:
+        with Renderer(src, size=tuple(size)) as r:
+            frames.append(r.frame(int(round(at * (r.frames - 1)))))
+    rows = -(-len(frames) // columns)
+    sheet = Image.new("RGB", (columns * W + (columns - 1) * 4, rows * H + (rows - 1) * 4), (200, 200, 205))
+    for i, img in enumerate(frames):
+        sheet.paste(Image.fromarray(img), ((i % columns) * (W + 4), (i // columns) * (H + 4)))
+    with atomic_path(out) as tmp:
+        sheet.quantize(colors=colors, method=Image.Quantize.MEDIANCUT).save(tmp, format="PNG", optimize=True)
+    return out

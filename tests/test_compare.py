@@ -73,3 +73,41 @@ def test_compare_command_json_and_plots(tmp_path, capsys):
 def test_compare_needs_two_models(tmp_path, capsys):
     assert main(["compare", str(SCENES / "check_6_10_cube_truncated.toml"), "--out", str(tmp_path / "x")]) == 2
     assert "compare needs two models" in capsys.readouterr().err
+
+
+def test_compare_plots_units_colours_thresholds_and_shared_hodograph_axes(monkeypatch):
+    """The plots as a reader gets them: every axis says its unit, the time axis is logarithmic
+    (no symlog "0" over "10⁻³") in τ₀ here, the 1° and 10° lines are labelled, each model has one
+    colour on every panel (the videos' colour), and the two hodographs share their axis ranges."""
+    figs = []
+    monkeypatch.setattr(C, "save", lambda fig, path: figs.append(fig))
+    body = B.symmetric_top(-0.6, math.radians(55.0))
+    t = C.compare_times(300.0, 150)
+    c = C.compare([simulate(body, m, (0.05, 0.1, 0.2), t_eval=t) for m in ("reduced", "truncated")])
+    C.plot(c, "unused.png", "askew")
+    C.plot_hodograph(c, "unused.png", "askew")
+    fig, hodo = figs
+    axes = fig.axes
+    for ax in axes:
+        assert ax.get_xscale() == "log" and ax.get_xlabel() == "time t (τ₀), log scale"
+        assert "(" in ax.get_ylabel() and ")" in ax.get_ylabel(), ax.get_ylabel()
+    assert "Ω" in axes[1].get_ylabel() or "ω" in axes[1].get_ylabel()
+    notes = {x.get_text() for x in axes[0].texts}
+    assert {"1° apart", "10° apart"} <= notes
+    for ax in axes[1:]:
+        colors = {line.get_label(): line.get_color() for line in ax.get_lines()}
+        assert colors == {"reduced": C.model_color("reduced"), "truncated": C.model_color("truncated")}
+    assert C.model_color("reduced") != C.model_color("truncated")
+    a, b = hodo.axes[:2]
+    assert a.get_xlim() == b.get_xlim() and a.get_ylim() == b.get_ylim() and a.get_zlim() == b.get_zlim()
+    assert a.get_xlabel() == "ω₁ / |ω₀|"
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+def test_time_unit_for_people():
+    year = 365.25 * 86400.0
+    assert C.time_unit(19 * 86400.0, "cgs") == (86400.0, "time t (days)")
+    assert C.time_unit(6.6e6 * year, "cgs") == (1e6 * year, "time t (million years)")
+    assert C.time_unit(1200.0, "dimensionless") == (1.0, "time t (τ₀)")

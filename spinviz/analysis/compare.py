@@ -147,64 +147,114 @@ def format_table(c: Comparison, title: str) -> str:
     return "\n".join(lines)
 
 
+_YEAR = 365.25 * 86400.0
+DIFF_STYLES = {"misorientation": ("0.6", "-."), "dipoles": ("0.35", "--"), "cone": ("0.0", "-")}
+
+
+def model_color(model: str) -> str:
+    """The model's colour in the videos (``rendering.captions.MODEL_COLORS``), as matplotlib hex."""
+    from ..rendering.captions import MODEL_COLORS
+
+    r, g, b = MODEL_COLORS.get(model, (90, 90, 90))
+    return f"#{r:02x}{g:02x}{b:02x}"
+
+
+def time_unit(t_end: float, units: str) -> tuple[float, str]:
+    """(seconds per unit, axis label) for times up to t_end: hours, days or years (10⁶ years
+    beyond a million), or τ₀ for dimensionless runs."""
+    if units != "cgs":
+        return 1.0, "time t (τ₀)"
+    if t_end >= 2e6 * _YEAR:
+        return 1e6 * _YEAR, "time t (million years)"
+    if t_end >= 2 * _YEAR:
+        return _YEAR, "time t (years)"
+    if t_end >= 2 * 86400.0:
+        return 86400.0, "time t (days)"
+    if t_end >= 2 * 3600.0:
+        return 3600.0, "time t (hours)"
+    return 1.0, "time t (s)"
+
+
 def plot(c: Comparison, path: str, title: str) -> None:
-    """Angles between the predictions, |Omega| and angle(d, L) against time (PNG, atomic)."""
+    """How far apart the models drift, |Ω| and ∠(d, L) against time (PNG, atomic).
+
+    Time on a log axis from the first output instant (both early departures and late
+    asymptotics show; t = 0 is the common start), in days, years or τ₀; thresholds labelled;
+    each model in its colour of the videos, differences between models in greys."""
     plt = pyplot()
 
-    t = c.t
-    tl = "t [s]" if c.units == "cgs" else "t [tau0]"
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4))
+    scale, tl = time_unit(float(c.t[-1]), c.units)
+    pos = c.t > 0
+    t = c.t[pos] / scale
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
     ax = axes[0]
     if c.phase_resolved:
-        ax.plot(t, c.misorientation_deg, label="misorientation")
-        ax.plot(t, c.dipole_angle_deg, label="angle between dipoles")
-    ax.plot(t, c.cone_difference_deg, label="difference of angle(d, L)")
+        col, ls = DIFF_STYLES["misorientation"]
+        ax.plot(t, c.misorientation_deg[pos], color=col, ls=ls, label="misorientation (whole rotation)")
+        col, ls = DIFF_STYLES["dipoles"]
+        ax.plot(t, c.dipole_angle_deg[pos], color=col, ls=ls, label="angle between the two dipoles")
+    col, ls = DIFF_STYLES["cone"]
+    ax.plot(t, c.cone_difference_deg[pos], color=col, ls=ls, lw=1.6,
+            label="|∠(d, L) reduced − ∠(d, L) truncated|")
+    ax.set_yscale("symlog", linthresh=1.0, linscale=0.5)
+    ax.set_ylim(0.0, 200.0)
+    ax.set_yticks([0, 1, 10, 100, 180], ["0°", "1°", "10°", "100°", "180°"])
     for x in THRESHOLDS_DEG:
-        ax.axhline(x, color="grey", lw=0.8, ls=":")
-    _time_axis(ax, t, tl, "deg", "reduced vs truncated")
+        ax.axhline(x, color="tab:red", lw=0.8, ls=":")
+        ax.annotate(f"{x:g}° apart", (0.01, x), xycoords=("axes fraction", "data"), xytext=(2, 2),
+                    textcoords="offset points", fontsize=8, color="tab:red", va="bottom")
+    _time_axis(ax, tl, "angle between the predictions (°)", "reduced vs truncated: how far apart")
     ax = axes[1]
     for m, w in c.omega.items():
-        ax.loglog(t[1:], np.linalg.norm(w[1:], axis=1), label=m)
-    ax.set_xlabel(tl)
-    ax.set_ylabel("|Omega| [rad/s]" if c.units == "cgs" else "|omega| [1/tau0]")
-    ax.set_title("spin rate")
-    ax.legend(fontsize=8)
+        ax.plot(t, np.linalg.norm(w[pos], axis=1), color=model_color(m), lw=1.6, label=m)
+    ax.set_yscale("log")
+    _time_axis(ax, tl, "|Ω| (rad/s)" if c.units == "cgs" else "|ω| (1/τ₀)", "spin rate")
     ax = axes[2]
     for m in c.models:
-        ax.plot(t, m.angle_d_L_deg, label=m.model)
-    _time_axis(ax, t, tl, "angle(d, L) [deg]", "dipole vs rotation axis")
+        ax.plot(t, m.angle_d_L_deg[pos], color=model_color(m.model), lw=1.6, label=m.model)
+    top = max(float(np.max(m.angle_d_L_deg)) for m in c.models)
+    ax.set_ylim(0.0, min(180.0, 1.15 * top + 1.0))          # headroom: a curve at its top stays visible
+    ax.yaxis.set_major_formatter(lambda v, _: f"{v:g}°")
+    _time_axis(ax, tl, "∠(d, L), dipole to angular momentum (°)", "dipole vs rotation axis")
     fig.suptitle(title)
     fig.tight_layout()
     save(fig, path)
 
 
-def _time_axis(ax, t, xlabel, ylabel, title):
-    """Time from 0, linear near 0 and logarithmic beyond (early and late both visible)."""
-    ax.set_xscale("symlog", linthresh=max(t[1], t[-1] * 1e-6))
-    ax.set_xlim(left=0.0)
-    ax.set_xlabel(xlabel)
+def _time_axis(ax, xlabel, ylabel, title):
+    """A log time axis (decades labelled once each, no tick over another) and the labels."""
+    ax.set_xscale("log")
+    ax.set_xlabel(xlabel + ", log scale")
     ax.set_ylabel(ylabel)
     ax.set_title(title)
+    ax.grid(True, which="major", color="0.9", lw=0.6)
     ax.legend(fontsize=8)
 
 
 def plot_hodograph(c: Comparison, path: str, title: str) -> None:
-    """Omega(t) in the body frame for both models, as in the paper's figures 3 and 4."""
+    """Ω(t) in the body frame for both models, as in the paper's figures 3 and 4, on the same
+    axes ranges (the two curves compare at a glance), each model in its colour."""
     plt = pyplot()
 
     fig = plt.figure(figsize=(11, 5))
     scale = max(float(np.linalg.norm(w[0])) for w in c.omega.values()) or 1.0
+    allw = np.vstack([w for w in c.omega.values()]) / scale
+    lo, hi = np.minimum(allw.min(axis=0), 0.0), np.maximum(allw.max(axis=0), 0.0)
+    pad = 0.05 * float(np.max(hi - lo) or 1.0)
+    sym = "Ω" if c.units == "cgs" else "ω"
     for k, (m, w) in enumerate(c.omega.items()):
         ax = fig.add_subplot(1, 2, k + 1, projection="3d")
         x = w / scale
-        ax.plot(x[:, 0], x[:, 1], x[:, 2], lw=1.2)
-        ax.scatter(*x[0], color="green", s=15, label="start")
-        ax.scatter(*x[-1], color="crimson", s=15, label="end")
-        ax.set_xlabel("omega1")
-        ax.set_ylabel("omega2")
-        ax.set_zlabel("omega3")
-        ax.set_title(f"{m}  (units of |omega0|)")
-        ax.legend(fontsize=8)
-    fig.suptitle(title)
+        ax.plot(x[:, 0], x[:, 1], x[:, 2], lw=1.2, color=model_color(m))
+        ax.scatter(*x[0], color="black", s=18, marker="o", label="start")
+        ax.scatter(*x[-1], color="black", s=24, marker="x", label="end")
+        ax.set_xlim(lo[0] - pad, hi[0] + pad)
+        ax.set_ylim(lo[1] - pad, hi[1] + pad)
+        ax.set_zlim(lo[2] - pad, hi[2] + pad)
+        for i, setter in enumerate((ax.set_xlabel, ax.set_ylabel, ax.set_zlabel)):
+            setter(f"{sym}{'₁₂₃'[i]} / |{sym}₀|")
+        ax.set_title(m, color=model_color(m))
+        ax.legend(fontsize=8, loc="upper left")
+    fig.suptitle(f"{title}\nbody-frame angular velocity, in units of |{sym}(0)|, same axes in both")
     fig.tight_layout()
     save(fig, path)

@@ -40,16 +40,28 @@ class Mp4Writer:
 
 
 class GifWriter:
-    """Animated GIF via Pillow (adaptive palette per frame, frames kept in memory)."""
+    """Animated GIF via Pillow, frames kept in memory.
 
-    def __init__(self, path: str, size, fps: int):
-        self.path, self.fps, self.frames = path, fps, []
+    One palette for the whole animation, from the first, middle and last frames side by side
+    (so colours that appear late, like a filled time bar, are in it): what does not move keeps
+    its palette index from frame to frame, and Pillow stores only each frame's changed box --
+    the text bands cost nothing after the first frame.  Frames are kept as RGB until then."""
+
+    def __init__(self, path: str, size, fps: int, colors: int = 128):
+        self.path, self.fps, self.frames, self.colors = path, fps, [], colors
 
     def write(self, img: np.ndarray):
-        self.frames.append(Image.fromarray(img).quantize(colors=128, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE))
+        self.frames.append(Image.fromarray(np.ascontiguousarray(img)))
 
     def close(self):
         if self.frames:
+            picks = [self.frames[0], self.frames[len(self.frames) // 2], self.frames[-1]]
+            w, h = picks[0].size
+            mosaic = Image.new("RGB", (w * len(picks), h))
+            for i, im in enumerate(picks):
+                mosaic.paste(im, (i * w, 0))
+            palette = mosaic.quantize(colors=self.colors, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
+            self.frames = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in self.frames]
             self.frames[0].save(self.path, format="GIF", save_all=True, append_images=self.frames[1:],
                                 duration=int(round(1000 / self.fps)), loop=0, optimize=True, disposal=1)
 

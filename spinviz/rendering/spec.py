@@ -16,7 +16,7 @@ from dataclasses import dataclass, fields, replace
 
 from ..errors import SpecError, brief
 
-SHOW_ITEMS = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud", "hodograph")
+SHOW_ITEMS = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud", "hodograph", "inset")
 DEFAULT_SHOW = ("body", "dipole", "axes", "trail", "sphere", "hud")
 ORIENTATION_ITEMS = ("body", "dipole", "omega", "L", "trail")
 VIDEO_FORMATS = (".mp4", ".gif")
@@ -25,10 +25,11 @@ MIN_SIZE, MAX_SIZE = 16, 7680
 MAX_FPS = 240
 MAX_DURATION_S = 3600.0
 MAX_FRAMES = 100_000            # ~55 min at 30 fps; the frame plan holds ~300 bytes per frame and panel
-MAX_GIF_BYTES = 1_000_000_000   # a GIF's frames are kept in memory (1 byte per pixel) until it is written
+MAX_GIF_BYTES = 1_000_000_000   # a GIF's frames are kept in memory (RGB, 3 bytes per pixel) until it is written
 ZOOM_RANGE = (0.05, 20.0)       # outside it the body is a dot or fills the frame far beyond its edges
 MAX_KNEE_RATIO = 1e15           # t_end / log_knee: float64 must still tell neighbouring frame times apart
 MAX_TITLE = 160
+CAPTIONS = ("outreach", "physics")
 
 
 @dataclass(frozen=True)
@@ -42,11 +43,16 @@ class RenderSpec:
     spin : "auto", "true" (the simulated orientation at each frame) or "slowed" (symmetric
         tops: slow geometry exact, spin and precession phases re-timed so that the shown
         spin rate is ``spin_turns_per_second`` x |Omega_L(t)| / |Omega_L(0)|; labelled).
-    show : the actors to build (others are not built, and what they need is not computed).
+    show : the actors to build (others are not built, and what they need is not computed);
+        "inset" adds live plots of angle(d, L) and |Omega| of both models.
     trail_seconds : length of the dipole trail, video seconds.
     azimuth_deg, elevation_deg, zoom : the camera (view direction from the origin).
-    background : "white" or "black".  title : shown under the panels.
+    background : "white" or "black".  title : shown under the panels when there is room.
     poster : where in the video (0..1) the PNG poster frame is taken.
+    captions : "outreach" (plain words, numbers for people) or "physics" (symbols,
+        equation numbers, scientific notation).
+    subtitles : one plain-words line per panel saying what its model does in this scene
+        (default: what each model predicts in general).
     """
 
     duration: float = 12.0
@@ -64,6 +70,8 @@ class RenderSpec:
     background: str = "white"
     title: str = ""
     poster: float = 1.0
+    captions: str = "outreach"
+    subtitles: tuple[str, ...] = ()
 
     def __post_init__(self):
         for f in fields(self):
@@ -131,8 +139,8 @@ class RenderSpec:
             raise SpecError("size", f"MP4 (H.264, yuv420p) needs an even width and height, got {w}x{h}")
         if w % panels:
             raise SpecError("size", f"{panels} panels side by side need a width divisible by {panels}, got {w}")
-        if ext == ".gif" and self.frames * w * h > MAX_GIF_BYTES:
-            raise SpecError("duration", f"a GIF of {self.frames} frames at {w}x{h} needs {self.frames * w * h / 1e9:.1f} GB "
+        if ext == ".gif" and 3 * self.frames * w * h > MAX_GIF_BYTES:
+            raise SpecError("duration", f"a GIF of {self.frames} frames at {w}x{h} needs {3 * self.frames * w * h / 1e9:.1f} GB "
                                         f"of memory (limit {MAX_GIF_BYTES / 1e9:g} GB); make it shorter or smaller, or use .mp4")
 
 
@@ -198,6 +206,15 @@ def _check_title(spec, key, v):
         raise SpecError(key, f"must be at most {MAX_TITLE} characters, got {len(v)}")
 
 
+def _check_subtitles(spec, key, v):
+    if isinstance(v, str) or not isinstance(v, (tuple, list)) or len(v) > 2:
+        raise SpecError(key, f"must be a list of one line per panel (at most 2), got {brief(v)}")
+    for line in v:
+        _check_title(spec, key, line)
+    if not isinstance(v, tuple):
+        object.__setattr__(spec, key, tuple(v))
+
+
 _CHECKS = {
     "duration": lambda s, k, v: _number(s, k, v, lo=0.0, hi=MAX_DURATION_S, lo_open=True),
     "fps": _check_fps,
@@ -214,11 +231,13 @@ _CHECKS = {
     "background": _choice(("white", "black")),
     "title": _check_title,
     "poster": lambda s, k, v: _number(s, k, v, lo=0.0, hi=1.0),
+    "captions": _choice(CAPTIONS),
+    "subtitles": _check_subtitles,
 }
 
 
 def _from_toml(key: str, value):
     """TOML value -> field value: lists become tuples; integers stay integers."""
-    if key in ("size", "show") and isinstance(value, list):
+    if key in ("size", "show", "subtitles") and isinstance(value, list):
         return tuple(value)
     return value

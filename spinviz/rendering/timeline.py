@@ -24,19 +24,20 @@ show them.  Two honest modes:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .. import rotations as R
-from ..physics.free_top import pose_about_L
-from ..trajectory import Trajectory
-from ..units import format_omega, format_time
+from ..units import format_time
+from .frameplan import FramePlan, Panel, ShapeInfo
 from .spec import RenderSpec
 
-MAX_TRUE_DEG_PER_FRAME = 30.0
+if TYPE_CHECKING:
+    from ..trajectory import Trajectory
 
-MODEL_LABELS = {"reduced": "reduced (2.2)+(2.3)", "truncated": "truncated (2.5)", "free": "free (d = 0)"}
+__all__ = ["FramePlan", "Panel", "frame_times", "plan_frames", "choose_spin_mode", "time_map_label", "time_scale"]
+
+MAX_TRUE_DEG_PER_FRAME = 30.0
 
 
 def frame_times(spec: RenderSpec, t_end: float, frames: int | None = None):
@@ -63,69 +64,6 @@ def time_map_label(spec: RenderSpec, t_end: float, units: str) -> str:
     return f"time: logarithmic after {format_time(k, units)}"
 
 
-@dataclass
-class Panel:
-    """What one model's panel shows at each frame (F frames).
-
-    q : (F, 4) display orientation, body -> world, (w, x, y, z); dipole : (F, 3) unit, world;
-    omega, L : (F, 3) world vectors scaled to |x(t)|/|x(0)| of the reference panel;
-    omega_body : (F, 3) body-frame angular velocity / |omega(0)| (hodograph);
-    omega_mag : (F,) |Omega| in scene units; angle_dL_deg : (F,) angle between d and L.
-    Arrays a scene does not show are None (not computed).
-    """
-
-    model: str
-    omega_mag: np.ndarray
-    q: np.ndarray | None = None
-    dipole: np.ndarray | None = None
-    omega: np.ndarray | None = None
-    L: np.ndarray | None = None
-    omega_body: np.ndarray | None = None
-    angle_dL_deg: np.ndarray | None = None
-
-    @property
-    def label(self) -> str:
-        return MODEL_LABELS.get(self.model, self.model)
-
-
-@dataclass
-class FramePlan:
-    """Everything the renderer needs: frame times, per-panel arrays, spin mode, labels."""
-
-    spec: RenderSpec
-    video_t: np.ndarray
-    sim_t: np.ndarray
-    panels: list[Panel]
-    units: str
-    body_name: str
-    shape: object            # physics.bodies.Shape
-    dipole_body: np.ndarray  # unit, body frame
-    spin_mode: str
-    slowdown: np.ndarray | None = None      # (F,) true / shown phase rate (slowed mode)
-    time_label: str = ""
-    notes: list[str] = field(default_factory=list)
-
-    @property
-    def frames(self) -> int:
-        return self.video_t.size
-
-    def hud_lines(self, panel_index: int, f: int) -> list[str]:
-        """The heads-up lines of one panel at frame f."""
-        p = self.panels[panel_index]
-        lines = [p.label, f"t = {format_time(self.sim_t[f], self.units)}", format_omega(p.omega_mag[f], self.units)]
-        if p.angle_dL_deg is not None:
-            lines.append(f"\u2220(d, L) = {p.angle_dL_deg[f]:.3g}\u00b0")
-        if self.spin_mode == "slowed":
-            lines.append(f"spin shown slowed {self.slowdown[f]:.2g}\u00d7")
-        elif self.spin_mode == "aliased":
-            lines.append("spin too fast for the frame rate (aliased)")
-        return lines
-
-    def footer(self) -> str:
-        parts = [self.spec.title or self.body_name, self.time_label]
-        return "   \u00b7   ".join(x for x in parts if x)
-
-
 def _rotation_per_frame(trajs, sim_t) -> float:
     """Upper bound of the rotation between frames in true mode, deg."""
     dt = np.diff(sim_t)
@@ -137,7 +75,13 @@ def _rotation_per_frame(trajs, sim_t) -> float:
 
 
 def choose_spin_mode(spec: RenderSpec, trajs: list[Trajectory], sim_t) -> tuple[str, str]:
-    """("true" | "slowed" | "aliased", why)."""
+    """("true" | "slowed" | "aliased", why).
+
+    A phase that is not resolved (``Trajectory.phase_resolved`` False: float64 resolution,
+    or an averaged ``secular`` run) is never shown as the true one: symmetric tops are then
+    shown slowed (slow geometry exact, phases re-timed and labelled); an asymmetric body has
+    no slow form, so it is shown as computed with an on-screen note that the pose is
+    illustrative."""
     if not spec.needs_orientation:
         return "true", "no orientation shown"
     body = trajs[0].body
@@ -146,22 +90,54 @@ def choose_spin_mode(spec: RenderSpec, trajs: list[Trajectory], sim_t) -> tuple[
         raise ValueError("spin = \"slowed\" needs a symmetric top (I1 = I2); this body is asymmetric")
     if spec.spin == "true":
         if not resolved:
-            raise ValueError("spin = \"true\" needs a resolved spin phase; this run is beyond float64 "
-                             "resolution (use spin = \"slowed\" or \"auto\")")
+            raise ValueError("spin = \"true\" needs a resolved spin phase; this run's phase is not resolved "
+                             "(use spin = \"slowed\" or \"auto\")")
         return "true", "requested"
     if spec.spin == "slowed":
         return "slowed", "requested"
-    deg = _rotation_per_frame(trajs, sim_t) if resolved else math.inf
-    if deg <= MAX_TRUE_DEG_PER_FRAME:
+    if body.is_symmetric and not resolved:
+        return "slowed", "spin phase not resolved (float64 or averaging)"
+    deg = _rotation_per_frame(trajs, sim_t)
+    if deg <= MAX_TRUE_DEG_PER_FRAME and resolved:
         return "true", f"at most {deg:.3g} deg per frame"
     if body.is_symmetric:
-        return "slowed", (f"up to {deg:.3g} deg per frame" if resolved else "spin phase beyond float64 resolution")
+        return "slowed", f"up to {deg:.3g} deg per frame"
+    if not resolved:
+        return "aliased", "asymmetric body whose spin phase is not resolved: shown as computed, labelled illustrative"
     return "aliased", f"asymmetric body turning up to {deg:.3g} deg per frame: shown as simulated, aliased"
+
+
+def time_scale(trajs: list[Trajectory], t_end: float) -> tuple[str, float] | None:
+    """The unit of the time bar: Theta = 1/(tau0 Omega3^2 eps^2) (after (5.2)) or T =
+    1/(tau0 Omega_perp^2) (after (3.9)) of the initial state -- the one the horizon is a round
+    multiple of (scenes give t_end_Theta or t_end_T), else the one that puts t_end between
+    0.5 and 50 units; None if neither does."""
+    body = trajs[0].body
+    w = np.asarray(trajs[0].omega[0], dtype=float)
+    cands = []
+    with np.errstate(all="ignore"):
+        if w[2] != 0.0:
+            cands.append(("Θ", float(body.residual_time_Theta(abs(float(w[2]))))))
+        wp = math.hypot(float(w[0]), float(w[1]))
+        if wp != 0.0:
+            cands.append(("T", float(body.braking_time_T(wp))))
+    cands = [(n, v) for n, v in cands if math.isfinite(v) and v > 0.0]
+    for n, v in cands:
+        r = t_end / v
+        if 0.25 <= r <= 100.0 and abs(2.0 * r - round(2.0 * r)) < 1e-6 * r:
+            return n, v
+    for n, v in cands:
+        if 0.5 <= t_end / v <= 50.0:
+            return n, v
+    return None
 
 
 def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = None) -> FramePlan:
     """Frame times and per-panel display data for one or two trajectories of the same body
     and initial state (one panel per trajectory)."""
+    from .. import rotations as R
+    from ..physics.free_top import pose_about_L
+
     if not 1 <= len(trajs) <= 2:
         raise ValueError("a video shows one or two models")
     body = trajs[0].body
@@ -169,6 +145,7 @@ def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = 
     video_t, sim_t, slope = frame_times(spec, t_end, frames)
     mode, why = choose_spin_mode(spec, trajs, sim_t)
     samples = [tr.sample(sim_t) for tr in trajs]
+    resolved = all(tr.phase_resolved for tr in trajs)
     ref = samples[0]
     w_ref = float(np.linalg.norm(ref.omega[0])) or 1.0
     J = np.asarray(body.inertia, dtype=float)
@@ -195,22 +172,28 @@ def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = 
                 q = s.q
                 omega_body = s.omega
             panel.q = q
-            if "dipole" in show or "trail" in show or "hud" in show:
+            if "dipole" in show or "trail" in show:
                 panel.dipole = R.world_from_body(q, body.dipole_direction)
-            L_world = R.world_from_body(q, J * omega_body) if ("L" in show or "hud" in show) else None
             if "omega" in show:
                 panel.omega = R.world_from_body(q, omega_body) / w_ref
             if "L" in show:
-                panel.L = L_world / L_ref
-            if "hud" in show:
-                panel.angle_dL_deg = np.degrees(R.angle_between(panel.dipole, L_world))
+                panel.L = R.world_from_body(q, J * omega_body) / L_ref
+        if "hud" in show or "inset" in show:
+            # body-frame quantities from the simulated Omega (no orientation needed): the true
+            # angle where the shown phase is the true one, its swing over a turn otherwise
+            if mode == "true" and resolved:
+                panel.angle_dL_deg = np.degrees(s.angle_d_L())
+            else:
+                lo, hi = s.angle_d_L_range()
+                panel.angle_dL_range_deg = np.degrees(np.stack([lo, hi], axis=-1))
         if "hodograph" in show:
             panel.omega_body = s.omega / w_ref
         panels.append(panel)
     return FramePlan(
         spec=spec, video_t=video_t, sim_t=sim_t, panels=panels, units=body.units, body_name=body.name,
-        shape=body.shape, dipole_body=body.dipole_direction, spin_mode=mode, slowdown=slowdown,
-        time_label=time_map_label(spec, t_end, body.units), notes=[f"spin: {mode} ({why})"],
+        shape=ShapeInfo.of(body.shape), dipole_body=np.asarray(body.dipole_direction, dtype=float), spin_mode=mode,
+        slowdown=slowdown, time_label=time_map_label(spec, t_end, body.units), notes=[f"spin: {mode} ({why})"],
+        time_scale=time_scale(trajs, t_end), phase_resolved=resolved,
     )
 
 
@@ -226,6 +209,8 @@ def _slow_geometry(s: Trajectory, body) -> dict:
     From the ``secular`` slow geometry when present (its phases may be unresolved: only the
     starting phases are used), otherwise from q and Omega.
     """
+    from .. import rotations as R
+
     J3 = body.I3 / body.I1
     delta = 1.0 - J3
     w = s.omega
@@ -242,7 +227,9 @@ def _slow_geometry(s: Trajectory, body) -> dict:
         return out
     L_world = s.angular_momentum_world()
     q_L = np.array([R.quat_between((0.0, 0.0, 1.0), v) for v in L_world])
-    theta_L = R.angle_between(R.world_from_body(s.q, np.array([0.0, 0.0, 1.0])), L_world)
+    # the nutation from the body-frame Omega alone (exact whatever the phase): L_body =
+    # (w1, w2, J3 w3) sits at atan2(|w_perp|, J3 w3) from e3
+    theta_L = np.arctan2(wp, J3 * w3)
     _, ang0 = R.euler_zxz_about(L_world[0], s.q[0])
     out.update(q_L=q_L, theta_L=theta_L, phi0=float(ang0[0]), psi0=float(ang0[2]))
     return out

@@ -9,6 +9,11 @@ per core); each worker renders its segment and encodes it with its own single-th
 x264 (H.264, yuv420p), and the segments are joined by ffmpeg's concat demuxer without
 re-encoding.  No frame crosses a process boundary, so the parent costs nothing per frame.
 GIFs (small by nature) are rendered in-process.
+
+Start-up overlaps the work: ``WorkerPool`` starts the render processes before the plan
+exists (``pipeline.render`` opens it before simulating), and each worker imports only the
+drawing stack -- pyvista, the VTK modules it uses, Pillow, imageio-ffmpeg -- while the
+parent integrates; the plan reaches them as one pickled message.
 """
 
 from __future__ import annotations
@@ -31,7 +36,7 @@ from ..errors import RenderError, printable
 from .encode import Mp4Writer, open_writer, save_png
 from .spec import poster_for
 
-__all__ = ["render_video", "render_frames", "RenderResult", "RenderError"]
+__all__ = ["render_video", "render_frames", "RenderResult", "RenderError", "WorkerPool", "plan_workers"]
 
 @dataclass
 class RenderResult:
@@ -117,53 +122,137 @@ def _worker_signals(parent: int) -> None:
         raise SystemExit(1)
 
 
-def _segment_worker(index, plan, size, supersample, lo, hi, path, poster_f, msgs, stop, parent):
-    """Render frames lo..hi-1 into the MP4 segment ``path``; report progress on ``msgs``.
-    Stops between frames when ``stop`` is set or the parent process has gone."""
+def _pool_worker(index, tasks, msgs, stop, parent):
+    """A render process: import the drawing stack at once (while the parent simulates),
+    then wait for one segment to render (``_render_segment``), or for the pool to close."""
     try:
         _worker_signals(parent)
         # one rasterizer thread per worker: the workers already fill the cores
         os.environ.setdefault("LP_NUM_THREADS", "1")
-        from .session import RenderSession
+        from . import encode, session  # noqa: F401  (the import is the point: it overlaps the simulation)
 
-        session = RenderSession(plan, supersample)
-        writer = Mp4Writer(path, size, plan.spec.fps, threads=1)
-        msgs.put(("ready", index, None))
-        done = 0
-        for f in range(lo, hi):
+        msgs.put(("imported", index, None))
+        while True:
             if stop.is_set() or os.getppid() != parent:
-                break
-            img = session.frame(f)
-            writer.write(img)
-            if f == poster_f:
-                msgs.put(("poster", index, img.tobytes()))
-            done += 1
-            if done % 4 == 0 or f == hi - 1:
-                msgs.put(("progress", index, done))
-        writer.close()
-        session.close()
-        msgs.put(("done", index, None))
+                return
+            try:
+                task = tasks.get(timeout=0.2)
+            except _queue.Empty:
+                continue
+            if task is None:
+                return
+            _render_segment(index, *task, msgs, stop, parent)
+            return
     except BaseException:
         msgs.put(("error", index, traceback.format_exc()))
 
 
+def _render_segment(index, plan, size, supersample, lo, hi, path, poster_f, msgs, stop, parent):
+    """Render frames lo..hi-1 into the MP4 segment ``path``; report progress on ``msgs``.
+    Stops between frames when ``stop`` is set or the parent process has gone."""
+    from .session import RenderSession
+
+    session = RenderSession(plan, supersample)
+    writer = Mp4Writer(path, size, plan.spec.fps, threads=1)
+    msgs.put(("ready", index, None))
+    done = 0
+    for f in range(lo, hi):
+        if stop.is_set() or os.getppid() != parent:
+            break
+        img = session.frame(f)
+        writer.write(img)
+        if f == poster_f:
+            msgs.put(("poster", index, img.tobytes()))
+        done += 1
+        if done % 4 == 0 or f == hi - 1:
+            msgs.put(("progress", index, done))
+    writer.close()
+    session.close()
+    msgs.put(("done", index, None))
+
+
+class WorkerPool:
+    """Render processes started ahead of the plan; a context manager (closing stops them).
+
+    ``WorkerPool(n)`` spawns n fresh interpreters that import the drawing stack and wait;
+    ``render_video(plan, out, pool=pool)`` hands each a segment.  One video per pool."""
+
+    def __init__(self, workers: int):
+        import multiprocessing as mp
+
+        ctx = mp.get_context("spawn")                   # fresh interpreters: no GL state shared by fork
+        self.workers = workers
+        self.stop = ctx.Event()
+        self.msgs = ctx.Queue()
+        self.tasks = [ctx.Queue() for _ in range(workers)]
+        self.t0 = time.perf_counter()
+        self.procs = [ctx.Process(target=_pool_worker, daemon=True,
+                                  args=(k, self.tasks[k], self.msgs, self.stop, os.getpid()))
+                      for k in range(workers)]
+        self.used = False
+        self._closed = False
+        try:
+            for p in self.procs:
+                p.start()
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self):
+        if self._closed:
+            return
+        self._closed = True
+        self.stop.set()                                 # workers finish their frame and close their encoder
+        for q in self.tasks:
+            try:
+                q.put(None)
+            except (OSError, ValueError):
+                pass
+        for p in self.procs:
+            if p.pid is None:
+                continue
+            p.join(timeout=5)
+            if p.is_alive():
+                p.terminate()
+                p.join(timeout=5)
+        for q in (*self.tasks, self.msgs):
+            q.close()
+            q.join_thread()
+
+    def __enter__(self) -> WorkerPool:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def plan_workers(spec, out: str, workers: int | None = None, frames: int | None = None) -> int:
+    """How many processes ``render_video`` uses: one per core (at most 4) for an MP4 long
+    enough to split (4 frames per worker at least); 1 (in-process) otherwise."""
+    workers = workers or default_workers()
+    F = frames or spec.frames
+    if os.path.splitext(out)[1].lower() != ".mp4" or F < 4 * workers:
+        return 1
+    return workers
+
+
 def render_video(plan, out: str, workers: int | None = None, supersample: float | None = None,
                  progress: bool = True, poster: bool = True, max_frames: int | None = None,
-                 inputs=()) -> RenderResult:
+                 inputs=(), pool: WorkerPool | None = None) -> RenderResult:
     """Render ``plan`` to ``out`` (.mp4 or .gif) and a PNG poster beside it; atomically, as a
     group (``atomic.Outputs``: neither lands unless both are complete).
 
     workers : render processes for MP4 (default: one per core, at most 4); 1 renders in-process.
     max_frames : stop after this many frames (benchmarks).
     inputs : files the outputs must not overwrite (the scene).
+    pool : render processes already started (``WorkerPool``); closed by the caller.
     """
     plan.spec.check_output(out, len(plan.panels))          # the format's rules live in the spec
     size = plan.spec.size
     supersample = supersample or SUPERSAMPLE
     F = plan.frames if max_frames is None else min(plan.frames, max_frames)
-    fmt = os.path.splitext(out)[1].lower()
-    workers = workers or default_workers()
-    if fmt != ".mp4" or F < 4 * workers:
+    workers = pool.workers if pool is not None else plan_workers(plan.spec, out, workers, F)
+    if workers > 1 and F < 4 * workers:
         workers = 1
     poster_f = min(int(round(plan.spec.poster * (plan.frames - 1))), F - 1)
     paths = [out, poster_for(out)] if poster else [out]
@@ -172,8 +261,11 @@ def render_video(plan, out: str, workers: int | None = None, supersample: float 
     with Outputs(paths, inputs) as tmps:                # video and poster land together, or neither does
         if workers == 1:
             poster_img, startup = _render_in_process(plan, tmps[0], size, supersample, F, poster_f, bar)
+        elif pool is not None:
+            poster_img, startup = _render_segments(plan, tmps[0], size, supersample, F, poster_f, pool, bar, start)
         else:
-            poster_img, startup = _render_segments(plan, tmps[0], size, supersample, F, poster_f, workers, bar)
+            with WorkerPool(workers) as own:
+                poster_img, startup = _render_segments(plan, tmps[0], size, supersample, F, poster_f, own, bar, start)
         if poster:
             save_png(tmps[1], poster_img)
         interrupt.check()                               # a stop swallowed on the way still counts
@@ -207,43 +299,40 @@ def _render_in_process(plan, path, size, supersample, F, poster_f, bar):
     return poster_img, startup
 
 
-def _render_segments(plan, path, size, supersample, F, poster_f, workers, bar):
-    import multiprocessing as mp
-
-    ctx = mp.get_context("spawn")                   # fresh interpreters: no GL state shared by fork
-    stop = ctx.Event()
-    msgs = ctx.Queue()
+def _render_segments(plan, path, size, supersample, F, poster_f, pool: WorkerPool, bar, start):
+    """Hand each worker of ``pool`` a contiguous segment, follow their progress, join the
+    segments.  Returns (poster image, start-up seconds: until every worker drew its first
+    frame, counted from ``start``)."""
+    if pool.used:
+        raise RenderError("a worker pool renders one video")
+    pool.used = True
+    workers = pool.workers
     bounds = np.linspace(0, F, workers + 1).round().astype(int)
     tmpdir = tempfile.mkdtemp(prefix=".spinviz-segments-", dir=os.path.dirname(os.path.abspath(path)))
     segs = [os.path.join(tmpdir, f"part{k}.mp4") for k in range(workers)]
-    procs = [ctx.Process(target=_segment_worker, daemon=True,
-                         args=(k, plan, size, supersample, int(bounds[k]), int(bounds[k + 1]), segs[k], poster_f, msgs,
-                               stop, os.getpid()))
-             for k in range(workers)]
-    t0 = time.perf_counter()
     startup = None
     poster_img = None
     counts = [0] * workers
     try:
-        for p in procs:
-            p.start()
+        for k in range(workers):
+            pool.tasks[k].put((plan, size, supersample, int(bounds[k]), int(bounds[k + 1]), segs[k], poster_f))
         pending = set(range(workers))
         ready = 0
         while pending:
             interrupt.check()
             try:
-                kind, k, payload = msgs.get(timeout=0.5)
+                kind, k, payload = pool.msgs.get(timeout=0.5)
             except _queue.Empty:
-                dead = [i for i in pending if not procs[i].is_alive()]
+                dead = [i for i in pending if not pool.procs[i].is_alive()]
                 if dead:
-                    raise RenderError(f"render worker {dead[0]} exited with status {procs[dead[0]].exitcode}") from None
+                    raise RenderError(f"render worker {dead[0]} exited with status {pool.procs[dead[0]].exitcode}") from None
                 continue
             if kind == "error":
                 raise RenderError(f"render worker {k} failed: {payload.strip().splitlines()[-1]}")
             if kind == "ready":
                 ready += 1
                 if ready == workers:
-                    startup = time.perf_counter() - t0
+                    startup = time.perf_counter() - start
             elif kind == "progress":
                 counts[k] = payload
                 bar.update(sum(counts))
@@ -253,14 +342,7 @@ def _render_segments(plan, path, size, supersample, F, poster_f, workers, bar):
                 pending.discard(k)
         _concat(segs, path)
     finally:
-        stop.set()                                      # workers finish their frame and close their encoder
-        for p in procs:
-            p.join(timeout=5)
-            if p.is_alive():
-                p.terminate()
-                p.join(timeout=5)
-        msgs.close()
-        msgs.join_thread()
+        pool.close()                                    # workers finish their frame and close their encoder
         shutil.rmtree(tmpdir, ignore_errors=True)
     return poster_img, startup or 0.0
 

@@ -1,0 +1,205 @@
+"""The words and numbers on screen, in two registers: ``"outreach"`` (plain words, numbers
+for people) and ``"physics"`` (symbols, equation numbers, scientific notation).
+
+Pure Python: the HUD (``hud``) decides where text goes, this module what it says.
+"""
+
+from __future__ import annotations
+
+import math
+
+# one colour per model everywhere: headings and inset of the videos, ``spinviz compare``'s plots
+MODEL_COLORS = {"reduced": (0, 128, 128), "truncated": (136, 60, 180), "free": (120, 120, 120)}
+MODEL_LABELS = {"reduced": "reduced (2.2)+(2.3)", "truncated": "truncated (2.5)", "free": "free (d = 0)"}
+
+# (heading, equation numbers) per model and register
+HEADINGS = {
+    "outreach": {"reduced": ("Reduced equation", "(2.2)+(2.3)"), "truncated": ("Truncated equation", "(2.5)"),
+                 "free": ("No radiation", "(2.3a)")},
+    "physics": {"reduced": ("reduced", "(2.2)+(2.3)"), "truncated": ("truncated", "(2.5)"), "free": ("free", "d = 0")},
+}
+# what each model predicts, in general (a scene's [render].subtitles says it for its own case)
+SUBTITLES = {
+    "outreach": {"reduced": "radiation slows the tumbling; a spin about the dipole can last",
+                 "truncated": "radiation slows every rotation, all the way to rest",
+                 "free": "no braking: the top turns freely"},
+    "physics": {"reduced": "Ω̇, Ω̈ in the torque taken from the free motion",
+                "truncated": "textbook torque without the Schott-like term",
+                "free": "torque-free Euler top"},
+}
+ARROW_NAMES = {"dipole": ("d", "dipole"), "L": ("L", "angular momentum"), "omega": ("Ω", "rotation")}
+
+_SUP = str.maketrans("0123456789-", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻")
+_WORDS = ((1e12, "trillion"), (1e9, "billion"), (1e6, "million"), (1e3, "thousand"))
+_MINUTE, _HOUR, _DAY = 60.0, 3600.0, 86400.0
+_YEAR = 365.25 * _DAY
+
+
+def superscript(n: int) -> str:
+    return str(int(n)).translate(_SUP)
+
+
+def sci(x: float, digits: int = 2) -> str:
+    """x with ``digits`` significant figures, as "3.8 × 10¹⁵" when it is large or small."""
+    x = float(x)
+    if not math.isfinite(x) or x == 0.0:
+        return f"{x:g}"
+    e = math.floor(math.log10(abs(x)))
+    m = round(x / 10.0**e, digits - 1)
+    if abs(m) >= 10.0:
+        m, e = m / 10.0, e + 1
+    if -3 <= e < 4:
+        return f"{x:.{digits}g}"
+    return f"{m:.{digits - 1}f} × 10{superscript(e)}"
+
+
+def words(x: float, digits: int = 2) -> str:
+    """A count for people: "5 billion", "1.3 million", "870"; beyond a trillion, "3.8 × 10¹⁵"."""
+    x = float(x)
+    a = abs(x)
+    if not math.isfinite(x):
+        return f"{x:g}"
+    if a >= 1e15:
+        return sci(x, digits)
+    for scale, name in _WORDS:
+        if a >= scale:
+            return f"{_sig(x / scale, digits)} {name}"
+    return _sig(x, digits) if a >= 1 else f"{x:.{digits}g}"
+
+
+def _sig(x: float, digits: int) -> str:
+    """Significant figures without exponent and without trailing zeros: 5, 1.3, 870."""
+    if x == 0:
+        return "0"
+    places = max(0, digits - 1 - math.floor(math.log10(abs(x))))
+    s = f"{x:.{places}f}"
+    return s.rstrip("0").rstrip(".") if "." in s else s
+
+
+def people_time(seconds: float) -> str:
+    """A duration for people: "40 s", "23 minutes", "9.5 days", "1.3 million years"."""
+    s = float(seconds)
+    if not math.isfinite(s):
+        return f"{s:g} s"
+    a = abs(s)
+    if a < 1.0:
+        return f"{sci(s, 2)} s" if a > 0 else "0 s"
+    if a < _MINUTE:
+        return f"{_sig(s, 2)} s"
+    if a < _HOUR:
+        return f"{_sig(s / _MINUTE, 2)} minutes"
+    if a < _DAY:
+        return f"{_sig(s / _HOUR, 2)} hours"
+    if a < 2 * _YEAR:
+        return f"{_sig(s / _DAY, 2)} days"
+    return f"{words(s / _YEAR, 2)} years"
+
+
+def sim_time(t: float, units: str, register: str) -> str:
+    """A simulation time in the scene's units: people's units (CGS), or tau0 (dimensionless)."""
+    if units != "cgs":
+        return f"{_sig(t, 3) if t >= 1 else f'{t:.2g}'} τ₀"
+    if register == "outreach":
+        return people_time(t)
+    from ..units import human_time
+
+    return human_time(t)
+
+
+class Captions:
+    """The texts of a plan's frames in the register of its ``[render].captions``."""
+
+    def __init__(self, plan):
+        self.plan = plan
+        self.spec = plan.spec
+        self.register = plan.spec.captions
+        self.cgs = plan.units == "cgs"
+
+    # -- per panel -------------------------------------------------------------------------
+    def heading(self, k: int) -> tuple[str, str]:
+        """(heading, secondary text: the equation numbers) of panel k."""
+        model = self.plan.panels[k].model
+        return HEADINGS[self.register].get(model, (model, ""))
+
+    def subtitle(self, k: int) -> str:
+        subs = self.spec.subtitles
+        if k < len(subs):
+            return subs[k]
+        return SUBTITLES[self.register].get(self.plan.panels[k].model, "")
+
+    def readouts(self, k: int, f: int) -> list[str]:
+        """Panel k's numbers at frame f: its spin rate and the angle between d and L."""
+        p = self.plan.panels[k]
+        w = float(p.omega_mag[f])
+        out = []
+        if self.cgs and self.register == "outreach":
+            out.append(f"turns {words(w / (2 * math.pi))} times a second")
+        elif self.cgs:
+            out.append(f"|Ω| = {sci(w, 3)} rad/s")
+        else:
+            out.append(f"|ω| = {w:.3g} /τ₀")
+        name = "angle d–L" if self.register == "outreach" else "∠(d, L)"
+        if p.angle_dL_range_deg is not None:
+            lo, hi = p.angle_dL_range_deg[f]
+            if hi - lo < 0.5:
+                out.append(f"{name} = {_deg(0.5 * (lo + hi))}")
+            else:
+                out.append(f"{name} swings {_deg(lo)}–{_deg(hi)} each turn")
+        elif p.angle_dL_deg is not None:
+            out.append(f"{name} = {_deg(p.angle_dL_deg[f])}")
+        return out
+
+    # -- shared ----------------------------------------------------------------------------
+    def time_text(self, f: int) -> str:
+        t = float(self.plan.sim_t[f])
+        if self.register == "outreach":
+            return ("after " if t > 0 else "start, ") + sim_time(t, self.plan.units, "outreach")
+        text = f"t = {sim_time(t, self.plan.units, 'physics')}"
+        ts = self.plan.time_scale
+        if ts is not None:
+            text += f" = {t / ts[1]:.2f} {ts[0]}"
+        return text
+
+    def scale_text(self) -> str:
+        """What the time bar's unit is: "Θ = 3.2 days" (empty without a scale)."""
+        ts = self.plan.time_scale
+        if ts is None:
+            return ""
+        return f"{ts[0]} = {sim_time(ts[1], self.plan.units, self.register)}"
+
+    def notes(self, f: int) -> list[str]:
+        """How time and spin are shown: the slowed spin's factor, the log time axis, and any
+        phase that is not the true one."""
+        plan, out = self.plan, []
+        outreach = self.register == "outreach"
+        if plan.spin_mode == "slowed":
+            factor = float(plan.slowdown[f])
+            if factor >= 1.0:
+                x = sci(factor, 2)
+                out.append(f"spin shown {x} times slower" if outreach else f"spin shown slowed {x}×")
+            else:                                   # a slow top shown at the set turn rate
+                x = sci(1.0 / factor, 2)
+                out.append(f"spin shown {x} times faster" if outreach else f"spin shown sped up {x}×")
+        elif plan.spin_mode == "aliased":
+            out.append("spin too fast for the frame rate: shown aliased" if outreach
+                       else "spin aliased (too fast for the frame rate)")
+        if not plan.phase_resolved and plan.spin_mode != "slowed":
+            out.append("spin phase not resolved: the pose is illustrative")
+        if self.spec.time_map == "log":
+            if outreach:
+                out.append("log time: ticks 10× apart")
+            else:
+                k = self.spec.log_knee or plan.t_end / 1000.0
+                out.append(f"time axis logarithmic after {sim_time(k, plan.units, 'physics')}")
+        return out
+
+    def footer(self) -> str:
+        return self.spec.title or self.plan.body_name
+
+    def legend(self, show) -> list[tuple[str, str, str]]:
+        """(key, symbol, name) of each drawn arrow."""
+        return [(key, *ARROW_NAMES[key]) for key in ("dipole", "L", "omega") if key in show]
+
+
+def _deg(x: float) -> str:
+    return f"{x:.0f}°" if x >= 9.5 else f"{x:.1f}°"

@@ -105,3 +105,16 @@ def test_4_18_amplitude_corrected():
     wp2tau = (tr.omega[1:, 0] ** 2 + tr.omega[1:, 1] ** 2) * tr.t[1:]
     assert wp2tau[-1] == pytest.approx(A2, rel=0.01)
     assert abs(tr.omega[-1, 2]) < 0.1 * math.sqrt(wp2tau[-1] / tr.t[-1])       # omega3 is the smaller one
+
+
+def test_check_secular_holds_each_run_to_its_stated_errors():
+    """The spinviz check row for domain 3 at tau0 |Omega0| = 1e-4, 1e-5: passes, the slow error
+    falls at second order in eps, and every accepted run's error is under twice its statement."""
+    from spinviz.validation import checks
+
+    r = checks.check_secular("domain 3", 0.3, 0.72, epsilons=(1e-4, 1e-5))
+    assert r.passed, r.details
+    assert r.details["order_in_eps_slow"] == pytest.approx(2.0, abs=0.3)
+    for row in r.details["rows"]:
+        assert row["rel_error_slow"] <= 2 * row["slow_error_estimate"] + 1e-8
+        assert row["steps"] < 100 < row["steps_full"] / 1000       # the point of it: ~30 steps for 1e5-1e6 turns

@@ -74,6 +74,18 @@ def deg_to_rad(x_deg):
 _SI_PREFIXES = ((1e-15, "fs"), (1e-12, "ps"), (1e-9, "ns"), (1e-6, "\u00b5s"), (1e-3, "ms"))
 
 
+def time_in_unit(seconds: float, long_names: bool = False, years_from: float = YEAR) -> tuple[float, str]:
+    """A duration of at least a second in its best unit: (value, unit) with the unit s, min, h,
+    days or years ("minutes", "hours" with ``long_names``); years from ``years_from`` seconds on."""
+    s = float(seconds)
+    a = abs(s)
+    for limit, scale, short, long in ((MINUTE, 1.0, "s", "s"), (HOUR, MINUTE, "min", "minutes"),
+                                      (DAY, HOUR, "h", "hours"), (years_from, DAY, "days", "days")):
+        if a < limit:
+            return s / scale, long if long_names else short
+    return s / YEAR, "years"
+
+
 def human_time(seconds: float, digits: int = 3) -> str:
     """Best human unit for a duration in seconds: fs..ms, s, min, h, days, years.
 
@@ -91,15 +103,8 @@ def human_time(seconds: float, digits: int = 3) -> str:
             if a >= scale:
                 return f"{s / scale:.{digits}g} {name}"
         return f"{s:.{digits}g} s"
-    if a < MINUTE:
-        return f"{s:.{digits}g} s"
-    if a < HOUR:
-        return f"{s / MINUTE:.{digits}g} min"
-    if a < DAY:
-        return f"{s / HOUR:.{digits}g} h"
-    if a < YEAR:
-        return f"{s / DAY:.{digits}g} days"
-    return f"{s / YEAR:.{digits}g} years"
+    value, unit = time_in_unit(s)
+    return f"{value:.{digits}g} {unit}"
 
 
 def format_time(t: float, units: str) -> str:

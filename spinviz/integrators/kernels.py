@@ -222,39 +222,51 @@ def lie_fixed(model, J, g, w0, q0, t_eval, h, A, b, with_q, max_steps, stop):
 
 
 @_jit
-def initial_step(model, J, g, y, K, ys, n, rtol, atol, span, h_max, with_q):
-    """First step size by Hairer, Norsett & Wanner (II.4), from f(y0) in K[0]; uses K[1] as
-    scratch (one extra evaluation).  Returns the step."""
-    sc = np.empty(6)
-    for k in range(n):
-        sc[k] = atol + abs(y[k]) * rtol
+def first_guess(y, f0, n, rtol, atol, span, sc, ys):
+    """Hairer, Norsett & Wanner (II.4), first half: the trial step h0 from y and f(y) = f0, the
+    error scales ``sc`` and the trial point ``ys`` = y + h0 f0 (where the caller evaluates f1).
+    Returns (h0, d1)."""
     d0 = 0.0
     d1 = 0.0
     for k in range(n):
+        sc[k] = atol + abs(y[k]) * rtol
         d0 += (y[k] / sc[k]) ** 2
-        d1 += (K[0, k] / sc[k]) ** 2
+        d1 += (f0[k] / sc[k]) ** 2
     d0 = math.sqrt(d0 / n)
     d1 = math.sqrt(d1 / n)
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h0 = min(h0, span)
     for k in range(n):
-        ys[k] = y[k] + h0 * K[0, k]
-    lie_rhs(model, J, g, ys, K[1], with_q)
+        ys[k] = y[k] + h0 * f0[k]
+    return h0, d1
+
+
+@_jit
+def second_guess(f0, f1, n, sc, h0, d1, h_max):
+    """II.4, second half: the first step from the change f1 - f0 over the trial step (order 8)."""
     d2 = 0.0
     for k in range(n):
-        d2 += ((K[1, k] - K[0, k]) / sc[k]) ** 2
+        d2 += ((f1[k] - f0[k]) / sc[k]) ** 2
     d2 = math.sqrt(d2 / n) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    h1 = max(1e-6, h0 * 1e-3) if (d1 <= 1e-15 and d2 <= 1e-15) else (0.01 / max(d1, d2)) ** (1.0 / 8.0)
     return min(100.0 * h0, h1, h_max)
 
 
 @_jit
-def error_norm(K, y, y_new, h, n, rtol, atol, E3, E5):
+def initial_step(model, J, g, y, K, ys, n, rtol, atol, span, h_max, with_q):
+    """First step size by Hairer, Norsett & Wanner (II.4), from f(y0) in K[0]; uses K[1] as
+    scratch (one extra evaluation).  Returns the step."""
+    sc = np.empty(6)
+    h0, d1 = first_guess(y, K[0], n, rtol, atol, span, sc, ys)
+    lie_rhs(model, J, g, ys, K[1], with_q)
+    return second_guess(K[0], K[1], n, sc, h0, d1, h_max)
+
+
+@_jit
+def error_norm(K, y, y_new, h, n, rtol, atol, E3, E5, by_increment=-1):
     """DOP853's scaled error of the step (5th- and 3rd-order embedded estimates, SciPy's norm),
-    and whether y_new is finite."""
+    and whether y_new is finite.  Component ``by_increment`` (if >= 0), a phase that grows to
+    2 pi x the turns, is held to rtol x its increment rather than rtol x its size."""
     e5 = 0.0
     e3 = 0.0
     finite = True
@@ -264,7 +276,10 @@ def error_norm(K, y, y_new, h, n, rtol, atol, E3, E5):
         for l in range(13):
             s5 += E5[l] * K[l, k]
             s3 += E3[l] * K[l, k]
-        scale = atol + max(abs(y[k]), abs(y_new[k])) * rtol
+        if k == by_increment:
+            scale = atol + abs(y_new[k] - y[k]) * rtol
+        else:
+            scale = atol + max(abs(y[k]), abs(y_new[k])) * rtol
         e5 += (s5 / scale) ** 2
         e3 += (s3 / scale) ** 2
         if not math.isfinite(y_new[k]):
@@ -293,6 +308,13 @@ def dense_coefficients(model, J, g, A, D, K, y, y_new, h, n, ys, F, with_q):
     for s in range(13, 16):
         stage_point(A, K, y, h, s, n, ys)
         lie_rhs(model, J, g, ys, K[s], with_q)
+    dense_assemble(D, K, y, y_new, h, n, F)
+    return 3
+
+
+@_jit
+def dense_assemble(D, K, y, y_new, h, n, F):
+    """The 7 x n dense-output coefficients F from the 16 stages in K (after the 3 extra ones)."""
     for k in range(n):
         dy = y_new[k] - y[k]
         F[0, k] = dy
@@ -303,7 +325,6 @@ def dense_coefficients(model, J, g, A, D, K, y, y_new, h, n, ys, F, with_q):
             for l in range(16):
                 acc += D[r, l] * K[l, k]
             F[3 + r, k] = h * acc
-    return 3
 
 
 @_jit

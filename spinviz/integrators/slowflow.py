@@ -180,53 +180,14 @@ def nit(model, J, g, cM, sM, wp, w3, p):
 
 
 @_jit
-def error_norm(K, y, y_new, h, n, rtol, atol, E3, E5):
-    """DOP853's scaled error; the phase Sigma (index 3), which grows to 2 pi x the turns, is
-    held to rtol x its increment instead of rtol x its size."""
-    e5 = 0.0
-    e3 = 0.0
-    for k in range(n):
-        s5 = 0.0
-        s3 = 0.0
-        for l in range(13):
-            s5 += E5[l] * K[l, k]
-            s3 += E3[l] * K[l, k]
-        if k == 3:
-            scale = atol + abs(y_new[k] - y[k]) * rtol
-        else:
-            scale = atol + max(abs(y[k]), abs(y_new[k])) * rtol
-        e5 += (s5 / scale) ** 2
-        e3 += (s3 / scale) ** 2
-    if e5 == 0.0 and e3 == 0.0:
-        return 0.0
-    return h * e5 / math.sqrt((e5 + 0.01 * e3) * n)
-
-
-@_jit
 def initial_step(mode, sgn, model, J, g, cM, sM, equiv, y, f0, rtol, atol, n, h_max):
+    """The first step of a mode (II.4), as for the other kernels (one extra evaluation)."""
     sc = np.empty(n)
-    for k in range(n):
-        sc[k] = atol + abs(y[k]) * rtol
-    d0 = 0.0
-    d1 = 0.0
-    for k in range(n):
-        d0 += (y[k] / sc[k]) ** 2
-        d1 += (f0[k] / sc[k]) ** 2
-    d0 = math.sqrt(d0 / n)
-    d1 = math.sqrt(d1 / n)
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    h0 = min(h0, h_max)
     ys = np.empty(n)
     f1 = np.empty(n)
-    for k in range(n):
-        ys[k] = y[k] + h0 * f0[k]
+    h0, d1 = KN.first_guess(y, f0, n, rtol, atol, h_max, sc, ys)
     rhs(mode, sgn, model, J, g, cM, sM, equiv, ys, f1)
-    d2 = 0.0
-    for k in range(n):
-        d2 += ((f1[k] - f0[k]) / sc[k]) ** 2
-    d2 = math.sqrt(d2 / n) / h0
-    h1 = max(1e-6, h0 * 1e-3) if (d1 <= 1e-15 and d2 <= 1e-15) else (0.01 / max(d1, d2)) ** (1.0 / 8.0)
-    return min(100.0 * h0, h1, h_max)
+    return KN.second_guess(f0, f1, n, sc, h0, d1, h_max)
 
 
 @_jit
@@ -331,10 +292,10 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
             y_new[k] = y[k] + h * acc
         rhs(mode, sgn, model, J, g, cM, sM, equiv, y_new, K[12])
         nf += 12
-        for k in range(n):
-            if not math.isfinite(y_new[k]):
-                return out, cnt, sw[:nsw], NOT_FINITE
-        err = error_norm(K, y, y_new, h, n, rtol, atol, E3, E5)
+        # the phase Sigma (index 3) is held to rtol x its increment
+        err, finite = KN.error_norm(K, y, y_new, h, n, rtol, atol, E3, E5, 3)
+        if not finite:
+            return out, cnt, sw[:nsw], NOT_FINITE
         if not err <= 1.0:
             h = h * max(0.2, 0.9 * err ** err_exp)
             cnt[4] += 1
@@ -351,16 +312,7 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
                 KN.stage_point(A, K, y, h, s, n, ys)
                 rhs(mode, sgn, model, J, g, cM, sM, equiv, ys, K[s])
             nf += 3
-            for k in range(n):
-                dy = y_new[k] - y[k]
-                F[0, k] = dy
-                F[1, k] = h * K[0, k] - dy
-                F[2, k] = 2.0 * dy - h * (K[12, k] + K[0, k])
-                for r in range(4):
-                    acc = 0.0
-                    for l in range(16):
-                        acc += D[r, l] * K[l, k]
-                    F[3 + r, k] = h * acc
+            KN.dense_assemble(D, K, y, y_new, h, n, F)
             while j_out < N and t_eval[j_out] <= t:
                 KN.dense_eval(F, y, (t_eval[j_out] - t_old) / h, n, ys)
                 if mode == FULL:

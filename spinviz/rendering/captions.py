@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import math
 
+from .. import units as U
+
 # one colour per model everywhere: headings and inset of the videos, ``spinviz compare``'s plots
 MODEL_COLORS = {"reduced": (0, 128, 128), "truncated": (136, 60, 180), "free": (120, 120, 120)}
 MODEL_LABELS = {"reduced": "reduced (2.2)+(2.3)", "truncated": "truncated (2.5)", "free": "free (d = 0)"}
@@ -31,8 +33,6 @@ ARROW_NAMES = {"dipole": ("d", "dipole"), "L": ("L", "angular momentum"), "omega
 
 _SUP = str.maketrans("0123456789-", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻")
 _WORDS = ((1e12, "trillion"), (1e9, "billion"), (1e6, "million"), (1e3, "thousand"))
-_MINUTE, _HOUR, _DAY = 60.0, 3600.0, 86400.0
-_YEAR = 365.25 * _DAY
 
 
 def superscript(n: int) -> str:
@@ -84,15 +84,8 @@ def people_time(seconds: float) -> str:
     a = abs(s)
     if a < 1.0:
         return f"{sci(s, 2)} s" if a > 0 else "0 s"
-    if a < _MINUTE:
-        return f"{_sig(s, 2)} s"
-    if a < _HOUR:
-        return f"{_sig(s / _MINUTE, 2)} minutes"
-    if a < _DAY:
-        return f"{_sig(s / _HOUR, 2)} hours"
-    if a < 2 * _YEAR:
-        return f"{_sig(s / _DAY, 2)} days"
-    return f"{words(s / _YEAR, 2)} years"
+    value, unit = U.time_in_unit(s, long_names=True, years_from=2 * U.YEAR)
+    return f"{words(value, 2) if unit == 'years' else _sig(value, 2)} {unit}"
 
 
 def sim_time(t: float, units: str, register: str) -> str:

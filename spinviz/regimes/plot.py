@@ -1,0 +1,206 @@
+"""Pictures of an atlas: the delta-chi diagram (figures 2, 3.D and 5) and the hodographs (figure 3).
+
+* ``diagram``: one panel per model; each cell is split into bars whose widths are the shares
+  of the types among its members (computed, not yet computed, failed and "other" included),
+  with the paper's boundaries (4.15), (4.17), (4.19), (4.20), (4.43) drawn over it (black),
+  spinviz's derived lines (blue: alpha = -1, red: beta = -3/4; see ``formulas``) and the two
+  DAST families of figure 5 (grey: family 1 solid, family 2 dash-dotted).
+* ``hodographs``: one small panel per type found, the run with the highest confidence of that
+  type re-integrated (the store keeps summaries, not series; the runs are deterministic), as
+  omega scaled by sqrt(tau + 1/|omega0|^2): the unit sphere at the start, omega sqrt(tau) at
+  the end, where the asymptotic types are fixed points (1), circles (3, 4), spirals onto an
+  axis (2) or arcs (5).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from ..atomic import Outputs
+from ..errors import UsageError
+from ..plotting import pyplot
+from . import formulas as FM
+
+COLORS = {"1": "#1f5fa8", "2": "#8fc1e3", "3": "#3a9a3a", "4": "#f08c1e", "5": "#d62728", "3.9": "#8c564b",
+          "R": "#7f7f7f", "T2": "#8fc1e3", "Tcone": "#3a9a3a", "T4": "#f08c1e", "TF": "#8c564b", "T1": "#1f5fa8",
+          "T5": "#d62728", "other": "#e4e4e4", "1|2": "#e4e4e4", "4|5": "#e4e4e4", "failed": "#111111", "missing": "#ffffff"}
+ORDER = ("1", "2", "3", "4", "5", "3.9", "R", "T2", "Tcone", "T4", "TF", "other", "failed", "missing")
+
+
+def hodograph_path(path: str) -> str:
+    stem, ext = os.path.splitext(path)
+    return f"{stem}_hodographs{ext}"
+
+
+def check_plot_paths(path: str, out: str, spec=None) -> list[str]:
+    """The two picture paths of ``--plot PATH``, checked before any work."""
+    if os.path.splitext(path)[1].lower() != ".png":
+        raise UsageError(f"--plot: {path}: the pictures are PNG; give a path ending in .png")
+    paths = [path, hodograph_path(path)]
+    for p in paths:
+        if os.path.abspath(p).startswith(os.path.abspath(out) + os.sep) or os.path.abspath(p) == os.path.abspath(out):
+            raise UsageError(f"--plot: {p}: inside the store {out}")
+    inputs = [spec.path] if spec is not None and os.path.exists(spec.path) else []
+    Outputs(paths, inputs)                      # checks only (writable, not a directory, not an input)
+    return paths
+
+
+def draw(store_path: str, paths: list[str]) -> list[str]:
+    """Both pictures of the store, landed together (atomically)."""
+    from .store import open_atlas
+
+    ds = open_atlas(store_path)
+    with Outputs(paths) as tmps:
+        diagram(ds, tmps[0])
+        hodographs(ds, tmps[1])
+    return list(paths)
+
+
+def shares(ds, model: str) -> dict:
+    """label -> array (delta, chi) of the share of the members with that label."""
+    lab = ds["label"].sel(model=model).values                # (delta, chi, member) strings
+    n = lab.shape[-1]
+    out = {}
+    for name in ORDER:
+        if name == "other":
+            s = np.isin(lab, ["other", "1|2", "4|5"]).sum(axis=-1) / n
+        else:
+            s = (lab == name).sum(axis=-1) / n
+        if np.any(s > 0):
+            out[name] = s
+    return out
+
+
+def _edges(v: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """Cell edges around the centres ``v`` (midpoints; the outer ones reflected, clipped to [lo, hi])."""
+    if len(v) == 1:
+        w = 0.1 * (hi - lo)
+        return np.array([max(lo, v[0] - w / 2), min(hi, v[0] + w / 2)])
+    mid = 0.5 * (v[1:] + v[:-1])
+    return np.concatenate([[max(lo, 2 * v[0] - mid[0])], mid, [min(hi, 2 * v[-1] - mid[-1])]])
+
+
+def diagram(ds, path: str, title: str | None = None):
+    """The delta-chi diagram, one panel per model (see the module docstring)."""
+    plt = pyplot()
+    from matplotlib.patches import Patch, Rectangle
+
+    models = [str(m) for m in ds["model"].values]
+    deltas = ds["delta"].values
+    chis = np.degrees(ds["chi"].values)
+    de, ce = _edges(deltas, -1.0, 1.0), _edges(chis, 0.0, 90.0)
+    fig, axes = plt.subplots(1, len(models), figsize=(6.4 * len(models), 5.6), squeeze=False)
+    seen = set()
+    for ax, model in zip(axes[0], models):
+        sh = shares(ds, model)
+        for i in range(len(deltas)):
+            for j in range(len(chis)):
+                x0, w = de[i], de[i + 1] - de[i]
+                y0, h = ce[j], ce[j + 1] - ce[j]
+                x = x0
+                for name, s in sh.items():
+                    if s[i, j] > 0:
+                        ax.add_patch(Rectangle((x, y0), w * s[i, j], h, facecolor=COLORS[name], edgecolor="none"))
+                        x += w * s[i, j]
+                        seen.add(name)
+                ax.add_patch(Rectangle((x0, y0), w, h, facecolor="none", edgecolor="white", lw=0.6))
+        for line in FM.boundaries(model):
+            paper = line["source"] == "paper"
+            color = "k" if paper else ("#1030c0" if "alpha" in line["name"] else "#c01010")
+            ls = {"(4.15)": "-", "(4.17)": "--", "(4.20)": ":", "(4.43)": "-."}.get(line["name"][:6], "-")
+            ax.plot(line["delta"], np.degrees(line["chi"]), color=color, ls=ls if paper else "-", lw=1.4 if paper else 1.8,
+                    label=("paper " if paper else "spinviz ") + line["name"])
+        for fam in FM.dast_families():
+            ax.plot(fam["delta"], np.degrees(fam["chi"]), color="0.35", ls=fam["style"], lw=2.2, alpha=0.8, label=fam["name"])
+        ax.set_xlim(-1, 1)
+        ax.set_ylim(0, 90)
+        ax.set_xlabel("\u03b4 = 1 \u2212 I\u2083/I\u2081")
+        ax.set_ylabel("\u03c7 (deg)")
+        n = ds.sizes["member"]
+        ax.set_title(f"{model} model: share of each type among {n} member{'s' if n != 1 else ''} per cell", fontsize=10)
+        ax.legend(loc="lower left", fontsize=6.5, framealpha=0.85)
+    handles = [Patch(facecolor=COLORS[k], edgecolor="0.6", label=k) for k in ORDER if k in seen]
+    fig.legend(handles=handles, loc="upper center", ncol=len(handles), fontsize=8, frameon=False,
+               bbox_to_anchor=(0.5, 1.0))
+    s = _spec(ds)
+    fig.suptitle(title or f"{ds.attrs.get('title', 'atlas')}: \u03c4_end = {s['run']['tau_end']:.0e}, "
+                 f"|\u03c9\u2080| = {s['members']['omega']}", y=0.955, fontsize=10)
+    fig.tight_layout(rect=(0, 0, 1, 0.93))
+    fig.savefig(path, dpi=90, format="png")
+    plt.close(fig)
+
+
+def _spec(ds) -> dict:
+    import json
+
+    return json.loads(ds.attrs["spec"])
+
+
+def representatives(ds) -> list[tuple]:
+    """(model, label, delta, chi, member index, confidence) of the most confident run of each
+    type found, per model."""
+    out = []
+    for model in [str(m) for m in ds["model"].values]:
+        lab = ds["label"].sel(model=model).values
+        conf = ds["confidence"].sel(model=model).values
+        for name in ORDER:
+            if name in ("other", "failed", "missing"):
+                continue
+            m = lab == name
+            if not m.any():
+                continue
+            c = np.where(m, conf, -1.0)
+            i, j, k = np.unravel_index(int(np.argmax(c)), c.shape)
+            out.append((model, name, float(ds["delta"].values[i]), float(ds["chi"].values[j]), int(k), float(c[i, j, k])))
+    return out
+
+
+def hodographs(ds, path: str):
+    """One panel per type found (per model), the most confident run of that type."""
+    from .runs import Settings, integrate
+
+    plt = pyplot()
+    reps = representatives(ds)
+    s = _spec(ds)
+    r = s["run"]
+    st = Settings(tau_end=r["tau_end"], tau_start=r["tau_start"], per_decade=max(40, r["samples_per_decade"]),
+                  rtol=r["rtol"], atol=r["atol"], max_steps=r["max_steps"], window=s["classify"]["window_decades"])
+    n = max(1, len(reps))
+    cols = min(n, 4)
+    rows = math.ceil(n / cols)
+    fig = plt.figure(figsize=(3.3 * cols, 3.2 * rows))
+    omega0 = ds["omega0"].values
+    for idx, (model, name, d, c, k, conf) in enumerate(reps):
+        r = integrate(model, d, c, omega0[k], st)
+        w0 = float(np.linalg.norm(omega0[k]))
+        scale = np.sqrt(r.tau + 1.0 / w0**2)[:, None]
+        x = r.omega * scale
+        ax = fig.add_subplot(rows, cols, idx + 1, projection="3d")
+        lt = np.log10(np.maximum(r.tau, st.tau_start))
+        pts = x.reshape(-1, 1, 3)
+        segs = np.concatenate([pts[:-1], pts[1:]], axis=1)
+        from mpl_toolkits.mplot3d.art3d import Line3DCollection
+
+        lc = Line3DCollection(segs, cmap="viridis", lw=0.9)
+        lc.set_array(lt[:-1])
+        ax.add_collection(lc)
+        lim = float(np.max(np.abs(x))) * 1.05 or 1.0
+        ax.set_xlim(-lim, lim)
+        ax.set_ylim(-lim, lim)
+        ax.set_zlim(-lim, lim)
+        ax.scatter(*x[-1], color="crimson", s=10)
+        ax.set_xlabel("\u03c9\u2081\u221a\u03c4", fontsize=7, labelpad=-8)
+        ax.set_ylabel("\u03c9\u2082\u221a\u03c4", fontsize=7, labelpad=-8)
+        ax.set_zlabel("\u03c9\u2083\u221a\u03c4", fontsize=7, labelpad=-8)
+        ax.tick_params(labelsize=5, pad=-3)
+        ax.set_title(f"{model} \"{name}\"  \u03b4={d:+.2f} \u03c7={math.degrees(c):.1f}\u00b0\nconfidence {conf:.2f}",
+                     fontsize=8)
+    fig.suptitle("hodographs of \u03c9 \u221a(\u03c4 + 1/|\u03c9\u2080|\u00b2), colour = log\u2081\u2080 \u03c4 (dark: start, "
+                 "yellow: end; red dot: last sample)", fontsize=8)
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    fig.savefig(path, dpi=90, format="png")
+    plt.close(fig)
+

@@ -69,7 +69,8 @@ def default_out(spec: AtlasSpec) -> str:
 
 
 def plan(spec: AtlasSpec, chunks: tuple, done: np.ndarray, runs_per_task: int = RUNS_PER_TASK):
-    """Batches covering every run not yet done, each inside one storage chunk, in store order.
+    """Batches covering exactly the runs not yet done, each inside one storage chunk, in store
+    order (a block that is partly done is cut into the missing stretches of members).
 
     Returns (batches, chunk keys, expected batches per chunk)."""
     _, _, cc, cm = chunks
@@ -86,15 +87,36 @@ def plan(spec: AtlasSpec, chunks: tuple, done: np.ndarray, runs_per_task: int = 
                     for m0 in range(0, nm, cm):
                         for ma in range(m0, min(m0 + cm, nm), tm):
                             mb = min(ma + tm, m0 + cm, nm)
-                            if done[mi, di, a:b, ma:mb].all():
+                            block = done[mi, di, a:b, ma:mb]
+                            if block.all():
                                 continue
-                            batches.append(RN.Batch(model, (float(spec.deltas[di]),),
-                                                    tuple(float(x) for x in spec.chis[a:b]),
-                                                    np.asarray(spec.omega0[ma:mb]), spec.settings,
-                                                    (mi, (di, di + 1), (a, b), (ma, mb))))
-                            keys.append(key)
-                            expected[key] = expected.get(key, 0) + 1
+                            if not block.any():
+                                parts = [(a, b, ma, mb)]
+                            else:                    # partly done: only the missing runs, cell by cell
+                                parts = [(a + j, a + j + 1, ma + s0, ma + s1) for j in range(b - a)
+                                         for s0, s1 in _runs_of(~block[j])]
+                            for pa, pb, pma, pmb in parts:
+                                batches.append(RN.Batch(model, (float(spec.deltas[di]),),
+                                                        tuple(float(x) for x in spec.chis[pa:pb]),
+                                                        np.asarray(spec.omega0[pma:pmb]), spec.settings,
+                                                        (mi, (di, di + 1), (pa, pb), (pma, pmb))))
+                                keys.append(key)
+                                expected[key] = expected.get(key, 0) + 1
     return batches, keys, expected
+
+
+def _runs_of(mask: np.ndarray) -> list[tuple[int, int]]:
+    """[start, stop) of each stretch of True in a 1-D mask."""
+    out, start = [], None
+    for i, m in enumerate(mask):
+        if m and start is None:
+            start = i
+        elif not m and start is not None:
+            out.append((start, i))
+            start = None
+    if start is not None:
+        out.append((start, len(mask)))
+    return out
 
 
 def check_out(path: str, spec_path: str | None = None) -> None:
@@ -115,7 +137,7 @@ def check_out(path: str, spec_path: str | None = None) -> None:
 
 def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers: int | None = None,
           plot: str | None = None, progress: bool = True, runs_per_task: int = RUNS_PER_TASK,
-          processes: bool = True, flush_s: float = 30.0, on_result=None) -> AtlasResult:
+          processes: bool = True, flush_s: float = 30.0, retry_failed: bool = False, on_result=None) -> AtlasResult:
     """Compute (or complete) the regime atlas of ``spec`` into the Zarr store ``out``.
 
     spec : a path to an atlas spec (TOML) or an ``AtlasSpec``.
@@ -130,6 +152,7 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
     runs_per_task : runs per Dask task (the store's chunking is fixed when it is created).
     processes : LocalCluster workers as processes (default) or threads of this process.
     flush_s : results waiting longer than this for the rest of their chunk are written anyway.
+    retry_failed : also recompute the runs recorded as failed (e.g. after workers died).
     on_result : called with (batches done so far, the batch's result) after each result
         (tests interrupt with it, or kill the worker that ran the batch).
     """
@@ -149,6 +172,8 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
         ST.check_identity(spec, out)
         chunks = ST.chunks_of(out)
         done = ST.done_mask(out)
+        if retry_failed:
+            done &= ST.regime_codes(out) != -1
     else:
         chunks = ST.chunk_shape(spec)
         done = np.zeros((len(spec.models), len(spec.deltas), len(spec.chis), spec.members), dtype=bool)
@@ -174,11 +199,7 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
     seconds = time.perf_counter() - t0
     failed = 0
     if batches:
-        import zarr
-
-        g = zarr.open_group(out, mode="r", zarr_format=2)
-        regime = np.asarray(g["regime"][...])
-        failed = int(((regime == -1) & ~done).sum())
+        failed = int(((ST.regime_codes(out) == -1) & ~done).sum())
     res = AtlasResult(out, spec.runs, todo, reused, failed, seconds, where, [], stats)
     if plot is not None:
         from .plot import draw

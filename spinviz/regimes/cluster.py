@@ -198,6 +198,7 @@ class Stats:
     failed_tasks: int = 0
     wall_s: float = 0.0
     compute_s: float = 0.0
+    cpu_s: float = 0.0
     threads: int = 0
     max_rss_mb: dict = field(default_factory=dict)        # worker pid -> peak RSS, MiB
     task_compute_s: list = field(default_factory=list)
@@ -208,6 +209,12 @@ class Stats:
         start-up and the idle tail together."""
         cap = self.wall_s * max(1, self.threads)
         return 1.0 - self.compute_s / cap if cap > 0 else math.nan
+
+    @property
+    def cpu_share(self) -> float:
+        """CPU time / wall time inside the tasks: 1 when the workers had their cores to
+        themselves, less when other work on the machine took them."""
+        return self.cpu_s / self.compute_s if self.compute_s > 0 else math.nan
 
 
 def failed_result(batch: RN.Batch, message: str) -> dict:
@@ -223,7 +230,7 @@ def failed_result(batch: RN.Batch, message: str) -> dict:
         "evidence": np.full(shape + (len(C.EVIDENCE),), np.nan), "omega_final": np.full(shape + (3,), np.nan),
         "reason": np.full(shape, f"task failed: {message}"[:RN.REASON_CHARS], dtype=f"<U{RN.REASON_CHARS}"),
     }
-    return {"region": batch.region, "data": data, "worker_pid": -1, "compute_s": 0.0, "max_rss_mb": math.nan}
+    return {"region": batch.region, "data": data, "worker_pid": -1, "compute_s": 0.0, "cpu_s": 0.0, "max_rss_mb": math.nan}
 
 
 def execute(cluster: Cluster, batches: list, keys: list, writer, progress: Progress, on_result=None) -> Stats:
@@ -262,6 +269,7 @@ def execute(cluster: Cluster, batches: list, keys: list, writer, progress: Progr
             if f.status == "finished":
                 res = f.result()
                 stats.compute_s += res["compute_s"]
+                stats.cpu_s += res.get("cpu_s", 0.0)
                 stats.task_compute_s.append(res["compute_s"])
                 stats.max_rss_mb[res["worker_pid"]] = max(stats.max_rss_mb.get(res["worker_pid"], 0.0), res["max_rss_mb"])
             else:

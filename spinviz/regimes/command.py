@@ -30,6 +30,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     a.add_argument("--workers", type=_count, help="worker processes of the embedded LocalCluster (default: one per core)")
     a.add_argument("--plot", metavar="PATH", help="also draw the delta-chi diagram (PNG) and PATH_hodographs.png")
     a.add_argument("--runs-per-task", type=_count, default=None, help="runs per Dask task (default 32)")
+    a.add_argument("--retry-failed", action="store_true", help="also recompute the runs the store records as failed")
     a.add_argument("--json", action="store_true", help="print the summary as JSON")
     a.add_argument("--quiet", action="store_true", help="no progress bar")
     a.add_argument("--bench", action="store_true",
@@ -49,7 +50,7 @@ def _count(text: str) -> int:
 
 
 def run(args) -> int:
-    from .api import RUNS_PER_TASK, atlas
+    from .api import RUNS_PER_TASK, atlas, default_out
     from .spec import load_spec
 
     spec = load_spec(args.spec)                       # SceneError: file, key, reason
@@ -64,12 +65,15 @@ def run(args) -> int:
         return 0
     try:
         res = atlas(spec, args.out, scheduler=args.scheduler, workers=args.workers, plot=args.plot,
-                    progress=not args.quiet, runs_per_task=args.runs_per_task or RUNS_PER_TASK)
-    except Interrupted:
-        out = args.out or "the store"
-        print(f"spinviz: atlas stopped; every finished chunk is in {printable(out, 200)} and the same command "
+                    progress=not args.quiet, runs_per_task=args.runs_per_task or RUNS_PER_TASK,
+                    retry_failed=args.retry_failed)
+    except Interrupted as e:
+        # said here, not by the command line's generic "nothing was written": the finished
+        # chunks are on disk, and that is the point
+        out = args.out or default_out(spec)
+        print(f"spinviz: atlas stopped by {e}; every finished chunk is in {printable(out, 200)} and the same command "
               f"computes only what is missing", file=sys.stderr)
-        raise
+        return e.exit_status
     if args.json:
         st = res.stats
         print(json.dumps({"path": res.path, "total": res.total, "computed": res.computed, "reused": res.reused,

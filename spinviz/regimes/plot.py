@@ -92,7 +92,7 @@ def diagram(ds, path: str, title: str | None = None):
     deltas = ds["delta"].values
     chis = np.degrees(ds["chi"].values)
     de, ce = _edges(deltas, -1.0, 1.0), _edges(chis, 0.0, 90.0)
-    fig, axes = plt.subplots(1, len(models), figsize=(6.4 * len(models), 5.6), squeeze=False)
+    fig, axes = plt.subplots(1, len(models), figsize=(6.4 * len(models), 6.6), squeeze=False)
     seen = set()
     for ax, model in zip(axes[0], models):
         sh = shares(ds, model)
@@ -121,14 +121,16 @@ def diagram(ds, path: str, title: str | None = None):
         ax.set_ylabel("\u03c7 (deg)")
         n = ds.sizes["member"]
         ax.set_title(f"{model} model: share of each type among {n} member{'s' if n != 1 else ''} per cell", fontsize=10)
-        ax.legend(loc="lower left", fontsize=6.5, framealpha=0.85)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.11), ncol=2, fontsize=7, frameon=False)
     handles = [Patch(facecolor=COLORS[k], edgecolor="0.6", label=k) for k in ORDER if k in seen]
     fig.legend(handles=handles, loc="upper center", ncol=len(handles), fontsize=8, frameon=False,
                bbox_to_anchor=(0.5, 1.0))
     s = _spec(ds)
-    fig.suptitle(title or f"{ds.attrs.get('title', 'atlas')}: \u03c4_end = {s['run']['tau_end']:.0e}, "
-                 f"|\u03c9\u2080| = {s['members']['omega']}", y=0.955, fontsize=10)
-    fig.tight_layout(rect=(0, 0, 1, 0.93))
+    w0 = s["members"]["omega"]
+    starts = f"|\u03c9\u2080| = {w0}" if w0 else "explicit starts"
+    fig.suptitle(title or f"{ds.attrs.get('title', 'atlas')}: \u03c4_end = {s['run']['tau_end']:.0e}, {starts}",
+                 y=0.955, fontsize=10)
+    fig.tight_layout(rect=(0, 0, 1, 0.94))
     fig.savefig(path, dpi=90, format="png")
     plt.close(fig)
 
@@ -140,9 +142,11 @@ def _spec(ds) -> dict:
 
 
 def representatives(ds) -> list[tuple]:
-    """(model, label, delta, chi, member index, confidence) of the most confident run of each
-    type found, per model."""
+    """(model, label, delta, chi, member index, confidence) for each type found, per model:
+    the cell where the type has its largest share (ties: the one nearest the centre of that
+    type's cells), and there the member labelled so with the highest confidence."""
     out = []
+    d_all, c_all = ds["delta"].values, ds["chi"].values
     for model in [str(m) for m in ds["model"].values]:
         lab = ds["label"].sel(model=model).values
         conf = ds["confidence"].sel(model=model).values
@@ -152,9 +156,13 @@ def representatives(ds) -> list[tuple]:
             m = lab == name
             if not m.any():
                 continue
-            c = np.where(m, conf, -1.0)
-            i, j, k = np.unravel_index(int(np.argmax(c)), c.shape)
-            out.append((model, name, float(ds["delta"].values[i]), float(ds["chi"].values[j]), int(k), float(c[i, j, k])))
+            share = m.mean(axis=-1)
+            ii, jj = np.nonzero(share > 0)
+            cd, cc = np.average(d_all[ii], weights=share[ii, jj]), np.average(c_all[jj], weights=share[ii, jj])
+            dist = (d_all[:, None] - cd) ** 2 + ((c_all[None, :] - cc) / (0.5 * math.pi)) ** 2
+            i, j = min(zip(ii, jj), key=lambda ij: (-share[ij], dist[ij]))
+            k = int(np.argmax(np.where(m[i, j], conf[i, j], -1.0)))
+            out.append((model, name, float(d_all[i]), float(c_all[j]), k, float(conf[i, j, k])))
     return out
 
 
@@ -165,9 +173,9 @@ def hodographs(ds, path: str):
     plt = pyplot()
     reps = representatives(ds)
     s = _spec(ds)
-    r = s["run"]
-    st = Settings(tau_end=r["tau_end"], tau_start=r["tau_start"], per_decade=max(40, r["samples_per_decade"]),
-                  rtol=r["rtol"], atol=r["atol"], max_steps=r["max_steps"], window=s["classify"]["window_decades"])
+    rs = s["run"]
+    st = Settings(tau_end=rs["tau_end"], tau_start=rs["tau_start"], per_decade=max(60, rs["samples_per_decade"]),
+                  rtol=rs["rtol"], atol=rs["atol"], max_steps=rs["max_steps"], window=s["classify"]["window_decades"])
     n = max(1, len(reps))
     cols = min(n, 4)
     rows = math.ceil(n / cols)
@@ -176,17 +184,14 @@ def hodographs(ds, path: str):
     for idx, (model, name, d, c, k, conf) in enumerate(reps):
         r = integrate(model, d, c, omega0[k], st)
         w0 = float(np.linalg.norm(omega0[k]))
-        scale = np.sqrt(r.tau + 1.0 / w0**2)[:, None]
-        x = r.omega * scale
+        # omega sqrt(tau) has a limit for every braking type; a residual rotation does not brake
+        scale = np.full_like(r.tau, 1.0 / w0) if name == "R" else np.sqrt(r.tau + 1.0 / w0**2)
+        x = r.omega * scale[:, None]
         ax = fig.add_subplot(rows, cols, idx + 1, projection="3d")
         lt = np.log10(np.maximum(r.tau, st.tau_start))
-        pts = x.reshape(-1, 1, 3)
-        segs = np.concatenate([pts[:-1], pts[1:]], axis=1)
-        from mpl_toolkits.mplot3d.art3d import Line3DCollection
-
-        lc = Line3DCollection(segs, cmap="viridis", lw=0.9)
-        lc.set_array(lt[:-1])
-        ax.add_collection(lc)
+        # points, not a line: log-spaced samples alias the precession, and chords between
+        # them would draw a motion that never happened
+        ax.scatter(x[:, 0], x[:, 1], x[:, 2], c=lt, cmap="viridis", s=1.2, linewidths=0, depthshade=False)
         lim = float(np.max(np.abs(x))) * 1.05 or 1.0
         ax.set_xlim(-lim, lim)
         ax.set_ylim(-lim, lim)
@@ -196,10 +201,11 @@ def hodographs(ds, path: str):
         ax.set_ylabel("\u03c9\u2082\u221a\u03c4", fontsize=7, labelpad=-8)
         ax.set_zlabel("\u03c9\u2083\u221a\u03c4", fontsize=7, labelpad=-8)
         ax.tick_params(labelsize=5, pad=-3)
-        ax.set_title(f"{model} \"{name}\"  \u03b4={d:+.2f} \u03c7={math.degrees(c):.1f}\u00b0\nconfidence {conf:.2f}",
-                     fontsize=8)
-    fig.suptitle("hodographs of \u03c9 \u221a(\u03c4 + 1/|\u03c9\u2080|\u00b2), colour = log\u2081\u2080 \u03c4 (dark: start, "
-                 "yellow: end; red dot: last sample)", fontsize=8)
+        unit = "  (\u03c9/|\u03c9\u2080|)" if name == "R" else ""
+        ax.set_title(f"{model} \"{name}\"  \u03b4={d:+.2f} \u03c7={math.degrees(c):.1f}\u00b0{unit}\n"
+                     f"confidence {conf:.2f}", fontsize=8)
+    fig.suptitle("hodographs of \u03c9 \u221a(\u03c4 + 1/|\u03c9\u2080|\u00b2) at log-spaced samples, colour = "
+                 "log\u2081\u2080 \u03c4 (dark: start, yellow: end; red: last sample)", fontsize=8)
     fig.tight_layout(rect=(0, 0, 1, 0.95))
     fig.savefig(path, dpi=90, format="png")
     plt.close(fig)

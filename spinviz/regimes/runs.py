@@ -224,8 +224,10 @@ def run_batch(batch: Batch) -> dict:
     """Run and classify every run of ``batch``; arrays shaped (n_delta, n_chi, n_member[, k]).
 
     Also returns where and how it ran: ``worker_pid``, ``compute_s`` (wall time inside this
-    function) and ``max_rss_mb`` (the worker process's peak resident memory so far)."""
-    start = time.perf_counter()
+    function), ``cpu_s`` (the process's CPU time meanwhile: below ``compute_s`` when other
+    work on the machine took the core) and ``max_rss_mb`` (the worker process's peak
+    resident memory so far)."""
+    start, cpu0 = time.perf_counter(), time.process_time()
     nd, nc, nm = len(batch.deltas), len(batch.chis), len(batch.omega0)
     shape = (nd, nc, nm)
     out = {
@@ -253,8 +255,8 @@ def run_batch(batch: Batch) -> dict:
                 out["evidence"][i, j, k] = r.evidence
                 out["omega_final"][i, j, k] = r.omega_final
                 out["reason"][i, j, k] = r.reason[:REASON_CHARS]
-    return {"region": batch.region, "data": out, "worker_pid": os.getpid(),
-            "compute_s": time.perf_counter() - start, "max_rss_mb": max_rss_mb()}
+    return {"region": batch.region, "data": out, "worker_pid": os.getpid(), "compute_s": time.perf_counter() - start,
+            "cpu_s": time.process_time() - cpu0, "max_rss_mb": max_rss_mb()}
 
 
 REASON_CHARS = 96

@@ -197,6 +197,13 @@ def done_mask(path: str) -> np.ndarray:
     return np.asarray(zarr.open_group(path, mode="r", zarr_format=2)["done"][...]) == 1
 
 
+def regime_codes(path: str) -> np.ndarray:
+    """The label codes of every run, shape (model, delta, chi, member), int8 (0 = not computed)."""
+    import zarr
+
+    return np.asarray(zarr.open_group(path, mode="r", zarr_format=2)["regime"][...])
+
+
 def chunks_of(path: str) -> tuple:
     import zarr
 

@@ -379,3 +379,20 @@ def test_plan_covers_exactly_the_missing_runs():
         assert c0 // chunks[2] == (c1 - 1) // chunks[2]                        # inside one chunk
     assert np.array_equal(cover, (~done).astype(int))
     assert sum(expected.values()) == len(batches) == len(keys)
+
+
+@pytest.mark.parametrize("delta, chi, slow", [(0.3, 0.72, -0.0396), (0.8, math.radians(11.4), -0.4598),
+                                              (-0.6, math.radians(77), -0.1049)])
+def test_type_3_is_the_fixed_point_of_4_12_and_how_fast_it_attracts(delta, chi, slow):
+    """(4.12) for x = omega_perp^2 tau, y = omega3^2 tau against ln tau: dx/ds = x (1 - 2 (a x + b y)),
+    dy/ds = y (1 - 2 (c x + e y)).  Its interior fixed point is (4.16)'s (A^2, B^2), also at
+    delta < -1/2; the slow eigenvalue there says why type 3's amplitudes settle so slowly."""
+    a_, b_ = (-np.array(CF.averaged_rate_eq4_12(1.0, y, delta, chi)[0]) for y in (0.0, 1.0))
+    a, b = a_, b_ - a_
+    e = -CF.averaged_rate_eq4_12(0.0, 1.0, delta, chi)[1]
+    c = -CF.averaged_rate_eq4_12(1.0, 1.0, delta, chi)[1] - e
+    x, y = np.linalg.solve(2.0 * np.array([[a, b], [c, e]]), [1.0, 1.0])
+    f = FM.type3_eq4_16(delta, chi)
+    assert x == pytest.approx(f["A2"], rel=1e-12) and y == pytest.approx(f["B2"], rel=1e-12)
+    jac = np.array([[-2 * a * x, -2 * b * x], [-2 * c * y, -2 * e * y]])
+    assert sorted(np.linalg.eigvals(jac).real) == pytest.approx([-1.0, slow], abs=1e-4)

@@ -394,6 +394,8 @@ def deviations(label: str, ev: dict, delta: float, chi: float, model: str = "red
             return {"beta (4.18)": _rel(ev["slope_3"], f["beta"]), "A^2 (4.18) corrected": _rel(ev["X2"], f["A2"])}
         if label == "5":
             f = F.type5_eq4_42(delta, chi)
+            if not f["real"]:
+                return {}                  # (4.42) has no real solution here (A^2 outside (0, 1])
             return {"A^2 (4.42)": _rel(ev["libration_A2"], f["A2"]), "B (4.42)": _rel(ev["libration_B"], f["B"]),
                     "M^2 (4.42)": _rel(ev["libration_M2"], f["M2"])}
     else:
@@ -403,7 +405,7 @@ def deviations(label: str, ev: dict, delta: float, chi: float, model: str = "red
         if label == "T2":
             return {"B^2 (averaged)": _rel(ev["Y2"], f["T2_B2"]), "alpha (averaged)": _rel(ev["slope_perp"], f["T2_alpha"])}
         if label == "TF":
-            return {"|omega| sqrt(2 tau) |d x omega^| = 1": _rel(ev["frozen_norm"], 1.0)}
+            return {"omega sqrt(2 tau) sin(d, omega) = 1": _rel(ev["frozen_norm"], 1.0)}
     if label == "3.9":
         return {"omega2^2 2 tau (3.9)": _rel(2.0 * ev["X2"], 1.0)}
     return {}

@@ -90,6 +90,9 @@ def format_table(rows) -> str:
         if r["label"] == "5":
             meas += f", A²(4.23) {m['libration_A2']:.4g}, h {m['h_mean']:.4f}"
         dev = "; ".join(f"{k} {100 * v[0]:+.2f} % [{100 * v[1]:+.2f}, {100 * v[2]:+.2f}]" for k, v in r["deviations"].items())
+        if not dev and r["label"] == "5":
+            a2 = FM.type5_eq4_42(r["delta"], math.radians(r["chi_deg"]))["A2"]
+            dev = f"(4.42) has no real solution here (A² = {a2:.3g})"
         lines.append(f"| {r['point']} | {r['model']} | {r['delta']:g} | {r['chi_deg']:.1f}° | {sh} | {meas} | {dev or '—'} |")
     return "\n".join(lines)
 

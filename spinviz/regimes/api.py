@@ -53,6 +53,8 @@ class AtlasResult:
         return ST.open_atlas(self.path)
 
     def summary(self) -> str:
+        if self.computed == 0:
+            return f"{self.path}: all {self.total} runs already there, nothing to compute"
         s = (f"{self.path}: {self.total} runs ({self.reused} already there, {self.computed} computed now"
              f"{f', {self.failed} failed' if self.failed else ''}) in {self.seconds:.1f} s on {self.cluster}")
         if self.stats is not None and self.stats.runs:

@@ -131,9 +131,13 @@ def format_table(r: dict) -> str:
                      f"{100 * p['cpu_share']:.0f} % | {p['max_rss_mb']:.0f} MiB |")
     p1 = r["by_workers"][min(r["by_workers"])]
     pj = r["projection"]
+    busy = [n for n, p in r["by_workers"].items() if p["cpu_share"] < 0.9]
+    shares = ", ".join("%.0f %%" % (100 * r["by_workers"][n]["cpu_share"]) for n in busy)
+    note = (f" (NOT the atlas's: with {', '.join(map(str, busy))} worker(s) the tasks got only {shares} of a core: "
+            f"other work was running on this machine)") if busy else ""
     lines += [
         "",
-        f"speed-up 1 -> {max(r['by_workers'])} workers: {r['speedup']:.2f}",
+        f"speed-up 1 -> {max(r['by_workers'])} workers: {r['speedup']:.2f}{note}",
         f"cost of one run (1 worker): mean {p1['mean_run_s'] * 1e3:.1f} ms, median {p1['median_run_s'] * 1e3:.1f} ms, "
         f"99th percentile {p1['p99_run_s'] * 1e3:.0f} ms, max {p1['max_run_s']:.2f} s; median {p1['median_steps']:.0f} steps",
         f"an empty Dask task: {r['task_ms']:.2f} ms = {100 * r['task_overhead_share']:.2f} % of a mean task",

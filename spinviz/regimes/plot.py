@@ -109,7 +109,7 @@ def diagram(ds, path: str, title: str | None = None):
                 ax.add_patch(Rectangle((x0, y0), w, h, facecolor="none", edgecolor="white", lw=0.6))
         for line in FM.boundaries(model):
             paper = line["source"] == "paper"
-            color = "k" if paper else ("#1030c0" if "alpha" in line["name"] else "#c01010")
+            color = "k" if paper else ("#1030c0" if ("alpha" in line["name"] or "delta = 0" in line["name"]) else "#c01010")
             ls = {"(4.15)": "-", "(4.17)": "--", "(4.20)": ":", "(4.43)": "-."}.get(line["name"][:6], "-")
             ax.plot(line["delta"], np.degrees(line["chi"]), color=color, ls=ls if paper else "-", lw=1.4 if paper else 1.8,
                     label=("paper " if paper else "spinviz ") + line["name"])
@@ -131,8 +131,23 @@ def diagram(ds, path: str, title: str | None = None):
     fig.suptitle(title or f"{ds.attrs.get('title', 'atlas')}: \u03c4_end = {s['run']['tau_end']:.0e}, {starts}",
                  y=0.955, fontsize=10)
     fig.tight_layout(rect=(0, 0, 1, 0.94))
-    fig.savefig(path, dpi=90, format="png")
+    _save_small(fig, path, dpi=90)
+
+
+def _save_small(fig, path: str, dpi: int) -> None:
+    """PNG with a 256-colour palette (flat colours and thin lines lose nothing visible; the
+    file is ~3x smaller, small enough for the repository's gallery)."""
+    import io
+
+    from PIL import Image
+
+    plt = pyplot()
+    buf = io.BytesIO()
+    fig.savefig(buf, dpi=dpi, format="png")
     plt.close(fig)
+    buf.seek(0)
+    Image.open(buf).convert("RGB").quantize(colors=256, method=Image.Quantize.MEDIANCUT).save(path, format="PNG",
+                                                                                             optimize=True)
 
 
 def _spec(ds) -> dict:
@@ -177,9 +192,9 @@ def hodographs(ds, path: str):
     st = Settings(tau_end=rs["tau_end"], tau_start=rs["tau_start"], per_decade=max(60, rs["samples_per_decade"]),
                   rtol=rs["rtol"], atol=rs["atol"], max_steps=rs["max_steps"], window=s["classify"]["window_decades"])
     n = max(1, len(reps))
-    cols = min(n, 4)
+    cols = min(n, 3)
     rows = math.ceil(n / cols)
-    fig = plt.figure(figsize=(3.3 * cols, 3.2 * rows))
+    fig = plt.figure(figsize=(3.7 * cols, 3.5 * rows))
     omega0 = ds["omega0"].values
     for idx, (model, name, d, c, k, conf) in enumerate(reps):
         r = integrate(model, d, c, omega0[k], st)
@@ -191,7 +206,7 @@ def hodographs(ds, path: str):
         lt = np.log10(np.maximum(r.tau, st.tau_start))
         # points, not a line: log-spaced samples alias the precession, and chords between
         # them would draw a motion that never happened
-        ax.scatter(x[:, 0], x[:, 1], x[:, 2], c=lt, cmap="viridis", s=1.2, linewidths=0, depthshade=False)
+        ax.scatter(x[:, 0], x[:, 1], x[:, 2], c=lt, cmap="viridis", s=2.5, linewidths=0, depthshade=False)
         lim = float(np.max(np.abs(x))) * 1.05 or 1.0
         ax.set_xlim(-lim, lim)
         ax.set_ylim(-lim, lim)
@@ -200,13 +215,13 @@ def hodographs(ds, path: str):
         ax.set_xlabel("\u03c9\u2081\u221a\u03c4", fontsize=7, labelpad=-8)
         ax.set_ylabel("\u03c9\u2082\u221a\u03c4", fontsize=7, labelpad=-8)
         ax.set_zlabel("\u03c9\u2083\u221a\u03c4", fontsize=7, labelpad=-8)
-        ax.tick_params(labelsize=5, pad=-3)
+        ax.tick_params(labelsize=6, pad=-3)
+        ax.locator_params(nbins=4)
         unit = "  (\u03c9/|\u03c9\u2080|)" if name == "R" else ""
         ax.set_title(f"{model} \"{name}\"  \u03b4={d:+.2f} \u03c7={math.degrees(c):.1f}\u00b0{unit}\n"
                      f"confidence {conf:.2f}", fontsize=8)
     fig.suptitle("hodographs of \u03c9 \u221a(\u03c4 + 1/|\u03c9\u2080|\u00b2) at log-spaced samples, colour = "
                  "log\u2081\u2080 \u03c4 (dark: start, yellow: end; red: last sample)", fontsize=8)
     fig.tight_layout(rect=(0, 0, 1, 0.95))
-    fig.savefig(path, dpi=90, format="png")
-    plt.close(fig)
+    _save_small(fig, path, dpi=80)
 

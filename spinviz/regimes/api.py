@@ -1,0 +1,216 @@
+"""``atlas(spec, out)``: the regime atlas from Python (the command line calls the same).
+
+    import spinviz
+    res = spinviz.atlas("scenes/atlas_quick.toml", out="atlas_quick.zarr", plot="atlas_quick.png")
+    ds = res.dataset          # xarray, straight from the Zarr store (xarray.open_zarr works too)
+
+Order of work, chosen so that nothing half-made is ever left behind: the spec is validated,
+the output is checked (an existing store must be of this very spec), the cluster is reached
+(an unreachable scheduler stops everything here), and only then is the store created -- in
+one atomic step -- and filled batch by batch.  Running it again computes only what the
+store lacks, with the same numbers.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import UsageError
+from . import runs as RN
+from . import store as ST
+from .spec import AtlasSpec, load_spec
+
+RUNS_PER_TASK = 32          # a task of ~32 runs lasts ~0.2-10 s: scheduling (~ms) stays below 1 %
+
+
+@dataclass
+class AtlasResult:
+    """What ``atlas`` did.
+
+    path : the store.  computed : runs computed now.  reused : runs already in the store.
+    failed : runs recorded as failed now.  seconds : wall time.  cluster : where it ran.
+    plots : pictures written.  stats : the execution's measurements (``cluster.Stats``) or None.
+    """
+
+    path: str
+    total: int
+    computed: int
+    reused: int
+    failed: int
+    seconds: float
+    cluster: str
+    plots: list = field(default_factory=list)
+    stats: object = None
+
+    @property
+    def dataset(self):
+        """The atlas (``store.open_atlas``: labels decoded, evidence unpacked)."""
+        return ST.open_atlas(self.path)
+
+    def summary(self) -> str:
+        if self.computed == 0:
+            return f"{self.path}: all {self.total} runs already there, nothing to compute"
+        s = (f"{self.path}: {self.total} runs ({self.reused} already there, {self.computed} computed now"
+             f"{f', {self.failed} failed' if self.failed else ''}) in {self.seconds:.1f} s on {self.cluster}")
+        if self.stats is not None and self.stats.runs:
+            st = self.stats
+            s += (f"; {st.runs / st.wall_s:.1f} runs/s, {st.tasks} tasks, overhead {100 * st.overhead_share:.0f} % "
+                  f"of worker time")
+        return s
+
+
+def default_out(spec: AtlasSpec) -> str:
+    """``<spec stem>.zarr`` in the current directory."""
+    stem = os.path.splitext(os.path.basename(spec.path))[0] or "atlas"
+    return f"{stem}.zarr"
+
+
+def plan(spec: AtlasSpec, chunks: tuple, done: np.ndarray, runs_per_task: int = RUNS_PER_TASK):
+    """Batches covering exactly the runs not yet done, each inside one storage chunk, in store
+    order (a block that is partly done is cut into the missing stretches of members).
+
+    Returns (batches, chunk keys, expected batches per chunk)."""
+    _, _, cc, cm = chunks
+    tm = min(cm, max(1, runs_per_task))
+    tc = max(1, min(cc, runs_per_task // tm))
+    batches, keys, expected = [], [], {}
+    nd, nc, nm = len(spec.deltas), len(spec.chis), spec.members
+    for mi, model in enumerate(spec.models):
+        for di in range(nd):
+            for c0 in range(0, nc, cc):
+                key = (mi, di, c0)
+                for a in range(c0, min(c0 + cc, nc), tc):
+                    b = min(a + tc, c0 + cc, nc)
+                    for m0 in range(0, nm, cm):
+                        for ma in range(m0, min(m0 + cm, nm), tm):
+                            mb = min(ma + tm, m0 + cm, nm)
+                            block = done[mi, di, a:b, ma:mb]
+                            if block.all():
+                                continue
+                            if not block.any():
+                                parts = [(a, b, ma, mb)]
+                            else:                    # partly done: only the missing runs, cell by cell
+                                parts = [(a + j, a + j + 1, ma + s0, ma + s1) for j in range(b - a)
+                                         for s0, s1 in _runs_of(~block[j])]
+                            for pa, pb, pma, pmb in parts:
+                                batches.append(RN.Batch(model, (float(spec.deltas[di]),),
+                                                        tuple(float(x) for x in spec.chis[pa:pb]),
+                                                        np.asarray(spec.omega0[pma:pmb]), spec.settings,
+                                                        (mi, (di, di + 1), (pa, pb), (pma, pmb))))
+                                keys.append(key)
+                                expected[key] = expected.get(key, 0) + 1
+    return batches, keys, expected
+
+
+def _runs_of(mask: np.ndarray) -> list[tuple[int, int]]:
+    """[start, stop) of each stretch of True in a 1-D mask."""
+    out, start = [], None
+    for i, m in enumerate(mask):
+        if m and start is None:
+            start = i
+        elif not m and start is not None:
+            out.append((start, i))
+            start = None
+    if start is not None:
+        out.append((start, len(mask)))
+    return out
+
+
+def check_out(path: str, spec_path: str | None = None) -> None:
+    """The store path: a directory to be created, or an existing atlas store (checked later)."""
+    if os.path.exists(path) and not os.path.isdir(path):
+        raise UsageError(f"{path}: exists and is a file; an atlas store is a directory (e.g. atlas.zarr)")
+    if spec_path and os.path.exists(path) and os.path.exists(spec_path) and os.path.samefile(path, spec_path):
+        raise UsageError(f"{path}: is the spec itself")
+    parent = os.path.dirname(os.path.abspath(path))
+    probe = parent
+    while not os.path.exists(probe):
+        probe = os.path.dirname(probe)
+    if not os.path.isdir(probe):
+        raise UsageError(f"{path}: {probe} is not a directory")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise UsageError(f"{path}: cannot write in {probe} (permission denied)")
+
+
+def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers: int | None = None,
+          plot: str | None = None, progress: bool = True, runs_per_task: int = RUNS_PER_TASK,
+          processes: bool = True, flush_s: float = 30.0, retry_failed: bool = False, on_result=None) -> AtlasResult:
+    """Compute (or complete) the regime atlas of ``spec`` into the Zarr store ``out``.
+
+    spec : a path to an atlas spec (TOML) or an ``AtlasSpec``.
+    out : the store (a directory, default ``<spec stem>.zarr``); an existing store of the same
+        spec is completed, one of another spec refused.
+    scheduler : address of an existing Dask cluster (``tcp://HOST:8786``); default: a
+        LocalCluster with ``workers`` single-threaded processes (default one per core) that
+        starts and stops here.
+    plot : also draw the delta-chi diagram there (PNG) and the hodographs beside it
+        (``<stem>_hodographs.png``).
+    progress : the progress bar on stderr.
+    runs_per_task : runs per Dask task (the store's chunking is fixed when it is created).
+    processes : LocalCluster workers as processes (default) or threads of this process.
+    flush_s : results waiting longer than this for the rest of their chunk are written anyway.
+    retry_failed : also recompute the runs recorded as failed (e.g. after workers died).
+    on_result : called with (batches done so far, the batch's result) after each result
+        (tests interrupt with it, or kill the worker that ran the batch).
+    """
+    from .cluster import Cluster, Progress, execute
+
+    spec = spec if isinstance(spec, AtlasSpec) else load_spec(spec)
+    out = os.fspath(out) if out is not None else default_out(spec)
+    check_out(out, spec.path)
+    plots = []
+    if plot is not None:
+        from .plot import check_plot_paths
+
+        plots = check_plot_paths(plot, out, spec)
+    t0 = time.perf_counter()
+    exists = os.path.exists(out)
+    if exists:
+        ST.check_identity(spec, out)
+        chunks = ST.chunks_of(out)
+        done = ST.done_mask(out)
+        if retry_failed:
+            done &= ST.regime_codes(out) != -1
+    else:
+        chunks = ST.chunk_shape(spec)
+        done = np.zeros((len(spec.models), len(spec.deltas), len(spec.chis), spec.members), dtype=bool)
+    reused = int(done.sum())
+    batches, keys, expected = plan(spec, chunks, done, runs_per_task)
+    todo = int(sum(b.runs for b in batches))
+    stats = None
+    where = "nothing to compute"
+    if batches:
+        with Cluster(scheduler, workers, processes=processes) as cl:
+            where = cl.describe
+            if not exists:
+                ST.create(spec, out, chunks)
+            writer = ST.Writer(out, expected, flush_s=flush_s)
+            bar = Progress(todo, f"atlas {os.path.basename(out)}", enabled=progress)
+            try:
+                stats = execute(cl, batches, keys, writer, bar, on_result=on_result)
+            finally:
+                writer.close()
+                bar.finish()
+    elif not exists:                               # an empty plan and no store: cannot happen
+        raise UsageError(f"{spec.path}: the spec holds no runs")
+    seconds = time.perf_counter() - t0
+    failed = 0
+    if batches:
+        failed = int(((ST.regime_codes(out) == -1) & ~done).sum())
+    res = AtlasResult(out, spec.runs, todo, reused, failed, seconds, where, [], stats)
+    if plot is not None:
+        from .plot import draw
+
+        res.plots = draw(out, plots)
+    return res
+
+
+def projected_wall_s(runs: int, s_per_run: float, cores: int, overhead_share: float) -> float:
+    """Wall time of ``runs`` runs at ``s_per_run`` each on ``cores`` cores, with the measured
+    overhead share of worker time (the benchmark's projection)."""
+    return runs * s_per_run / cores / max(1e-9, 1.0 - overhead_share) if cores > 0 else math.inf

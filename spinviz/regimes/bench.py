@@ -1,0 +1,175 @@
+"""The atlas benchmark (a command, not a test): ``spinviz atlas SPEC --bench`` or
+``python -m spinviz.regimes.bench SPEC [--json PATH]``.
+
+Measured on the spec as given, each time into a fresh temporary store, one after the other:
+
+* the whole atlas on an embedded LocalCluster with 1 worker, then with 2 (or ``workers``):
+  runs per second (of the execution phase, and of the whole command with the cluster's
+  start and stop), the speed-up, peak resident memory per worker process, and the
+  scheduling overhead as a share of worker time, 1 - (time inside tasks)/(wall x threads);
+* the bare cost of a Dask task: 200 empty tasks on the 2-worker cluster, ms each, beside the
+  mean task's compute time;
+* the per-call cost of the driver (``simulate(..., kinematics="none")``) against the kernel
+  called directly, on a run of a few steps (why ``runs`` calls the kernel);
+* projections of a figure-quality atlas, 64 x 64 cells x 32 members per model, on 1, 2 and
+  64 cores: runs x (one worker's seconds per run) / cores, on 64 with the empty-task cost as
+  a share and the longest task as the tail.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+from .api import atlas
+from .spec import AtlasSpec, load_spec
+
+FIGURE_RUNS = 64 * 64 * 32
+
+
+def _noop(x):
+    return x
+
+
+def task_cost(n: int = 200, workers: int = 2) -> float:
+    """Milliseconds per empty task (submit, schedule, run, gather) on a local cluster."""
+    from .cluster import Cluster
+
+    with Cluster(None, workers) as cl:
+        cl.client.gather(cl.client.map(_noop, range(10), pure=False))         # warm
+        t0 = time.perf_counter()
+        cl.client.gather(cl.client.map(_noop, range(n), pure=False))
+        return 1e3 * (time.perf_counter() - t0) / n
+
+
+def driver_overhead(n: int = 300) -> dict:
+    """Microseconds per call: ``simulate`` (kinematics none) vs the kernel, a short run."""
+    from ..driver import simulate
+    from ..physics.bodies import symmetric_top
+    from .runs import Settings, integrate
+
+    body = symmetric_top(0.3, 0.5)
+    w0 = np.array([0.05, 0.02, 0.04])
+    st = Settings(tau_end=10.0, tau_start=1.0, per_decade=6)
+    t_eval = st.times()
+    simulate(body, "reduced", w0, t_eval=t_eval, method="lie-dop853", kinematics="none", rtol=1e-8, atol=1e-20)
+    integrate("reduced", 0.3, 0.5, w0, st)
+    t0 = time.perf_counter()
+    for _ in range(n):
+        simulate(body, "reduced", w0, t_eval=t_eval, method="lie-dop853", kinematics="none", rtol=1e-8, atol=1e-20)
+    t1 = time.perf_counter()
+    for _ in range(n):
+        integrate("reduced", 0.3, 0.5, w0, st)
+    t2 = time.perf_counter()
+    return {"driver_us": 1e6 * (t1 - t0) / n, "kernel_us": 1e6 * (t2 - t1) / n}
+
+
+def run(spec, workers: int | None = None, progress: bool = True) -> dict:
+    """All measurements (see the module docstring) as a dict of plain numbers."""
+    spec = spec if isinstance(spec, AtlasSpec) else load_spec(spec)
+    many = workers or min(2, os.cpu_count() or 1)
+    rows = {"spec": spec.path, "runs": spec.runs, "models": list(spec.models), "cores": os.cpu_count()}
+    tmp = tempfile.mkdtemp(prefix="spinviz-atlas-bench-")
+    try:
+        per = {}
+        for n in sorted({1, many}):
+            out = os.path.join(tmp, f"w{n}.zarr")
+            t0 = time.perf_counter()
+            res = atlas(spec, out, workers=n, progress=progress)
+            total = time.perf_counter() - t0
+            st = res.stats
+            from .store import open_atlas
+
+            ds = open_atlas(out)
+            secs = ds["run_seconds"].values
+            per[n] = {
+                "workers": n, "wall_s": st.wall_s, "command_s": total, "runs_per_s": st.runs / st.wall_s,
+                "runs_per_s_per_worker": st.runs / st.wall_s / n, "command_runs_per_s": st.runs / total,
+                "tasks": st.tasks, "overhead_share": st.overhead_share, "cpu_share": st.cpu_share,
+                "mean_task_s": float(np.mean(st.task_compute_s)), "max_task_s": float(np.max(st.task_compute_s)),
+                "max_rss_mb": max(st.max_rss_mb.values()),
+                "mean_run_s": float(np.nanmean(secs)), "median_run_s": float(np.nanmedian(secs)),
+                "p99_run_s": float(np.nanpercentile(secs, 99)), "max_run_s": float(np.nanmax(secs)),
+                "median_steps": float(np.nanmedian(ds["nsteps"].values)),
+            }
+            shutil.rmtree(out, ignore_errors=True)
+        rows["by_workers"] = per
+        rows["speedup"] = per[many]["runs_per_s"] / per[1]["runs_per_s"] if many != 1 else 1.0
+        rows["task_ms"] = task_cost(workers=many)
+        rows["task_overhead_share"] = rows["task_ms"] / 1e3 / per[1]["mean_task_s"]
+        rows.update(driver_overhead())
+        # projections: one worker's measured seconds per run (everything included), divided
+        # over n cores; on 64 the scheduler's cost per task is added as a share, and the
+        # longest task as the tail while the last tasks finish
+        s_run = 1.0 / per[1]["runs_per_s"]
+        runs_fig = FIGURE_RUNS * len(spec.models)
+        tail = max(per[n]["max_task_s"] for n in per)
+        rows["projection"] = {
+            "runs": runs_fig,
+            "1_core_h": runs_fig * s_run / 3600.0,
+            "2_cores_h": runs_fig / per[many]["runs_per_s"] / 3600.0 if many == 2 else runs_fig * s_run / 2 / 3600.0,
+            "64_cores_min": (runs_fig * s_run / 64.0 / (1.0 - rows["task_overhead_share"]) + tail) / 60.0,
+        }
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return rows
+
+
+def format_table(r: dict) -> str:
+    lines = [f"atlas benchmark: {r['spec']}, {r['runs']} runs ({', '.join(r['models'])}), {r['cores']} cores", "",
+             "| workers | runs/s | runs/s per worker | whole command runs/s | tasks | mean task | overhead share | "
+             "CPU / wall in tasks | peak RSS per worker |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for n, p in r["by_workers"].items():
+        lines.append(f"| {n} | {p['runs_per_s']:.1f} | {p['runs_per_s_per_worker']:.1f} | {p['command_runs_per_s']:.1f} | "
+                     f"{p['tasks']} | {p['mean_task_s']:.2f} s | {100 * p['overhead_share']:.1f} % | "
+                     f"{100 * p['cpu_share']:.0f} % | {p['max_rss_mb']:.0f} MiB |")
+    p1 = r["by_workers"][min(r["by_workers"])]
+    pj = r["projection"]
+    busy = [n for n, p in r["by_workers"].items() if p["cpu_share"] < 0.9]
+    shares = ", ".join("%.0f %%" % (100 * r["by_workers"][n]["cpu_share"]) for n in busy)
+    note = (f" (NOT the atlas's: with {', '.join(map(str, busy))} worker(s) the tasks got only {shares} of a core: "
+            f"other work was running on this machine)") if busy else ""
+    lines += [
+        "",
+        f"speed-up 1 -> {max(r['by_workers'])} workers: {r['speedup']:.2f}{note}",
+        f"cost of one run (1 worker): mean {p1['mean_run_s'] * 1e3:.1f} ms, median {p1['median_run_s'] * 1e3:.1f} ms, "
+        f"99th percentile {p1['p99_run_s'] * 1e3:.0f} ms, max {p1['max_run_s']:.2f} s; median {p1['median_steps']:.0f} steps",
+        f"an empty Dask task: {r['task_ms']:.2f} ms = {100 * r['task_overhead_share']:.2f} % of a mean task",
+        f"per call, a short run: driver simulate() {r['driver_us']:.0f} us, kernel direct {r['kernel_us']:.0f} us",
+        f"projected 64 x 64 x 32 x {len(r['models'])} model(s) = {pj['runs']} runs: {pj['1_core_h']:.2f} h on 1 core, "
+        f"{pj['2_cores_h']:.2f} h on 2, {pj['64_cores_min']:.1f} min on 64 (with the longest task, "
+        f"{max(p['max_task_s'] for p in r['by_workers'].values()):.0f} s, as the tail)",
+    ]
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    import argparse
+    import json
+
+    from ..atomic import write_json
+
+    ap = argparse.ArgumentParser(prog="python -m spinviz.regimes.bench")
+    ap.add_argument("spec")
+    ap.add_argument("--workers", type=int, default=None)
+    ap.add_argument("--json", metavar="PATH")
+    ap.add_argument("--quiet", action="store_true")
+    a = ap.parse_args(argv)
+    r = run(a.spec, a.workers, progress=not a.quiet)
+    print(format_table(r))
+    if a.json:
+        write_json(a.json, r)
+    else:
+        print(json.dumps(r, default=float), file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
+

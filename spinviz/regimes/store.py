@@ -1,0 +1,286 @@
+"""The atlas on disk: an xarray Dataset in a Zarr store, written region by region.
+
+Layout (dims ``model``, ``delta``, ``chi``, ``member``; ``axis`` = 1, 2, 3; ``quantity`` =
+``classify.EVIDENCE``; ``formula`` = ``FORMULAS``):
+
+    regime, regime_early, candidate   int8   label codes (flag_values / flag_meanings; 0 = not computed yet)
+    status, method                    int8   how the run ended (``runs.STATUS_TEXT``), the integrator
+    confidence, tau_reached, run_seconds  float64
+    nsteps, nfev                      int64
+    reason                            <U96   why the label (or the failure), one line
+    evidence                          float64 (..., quantity): slopes, amplitudes, phase statistics
+    omega_final                       float64 (..., axis): omega at tau_reached
+    done                              int8   1 once the run's results are on disk
+    omega0                            float64 (member, axis): the starts, the same at every cell
+    paper                             float64 (delta, chi, formula): the formulas' predictions
+
+Attributes: ``spec`` (canonical JSON), ``spec_sha256`` (identity), ``seed``, ``spinviz_version``,
+``classifier_version``, ``title``.  Zarr format 2 with consolidated metadata, so plain
+``xarray.open_zarr(path)`` opens it with no warning.
+
+Safety.  The store is created complete but empty in a temporary directory and renamed into
+place, so a path either holds a whole atlas skeleton or nothing.  Results are written as they
+arrive, one storage chunk (one model, one delta, a row of chi, the members) at a time, each
+chunk file atomically (Zarr writes a temporary file and renames it), with stop signals held
+back for the few milliseconds of the write, and ``done`` is written last: a run counts as
+computed only when everything it produced is on disk.  A later run of the same spec computes
+what ``done`` lacks; a store of another spec is refused, never mixed.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import tempfile
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import UsageError
+from ..interrupt import deferred
+from . import classify as C
+from . import formulas as FM
+from . import runs as RN
+
+DIMS = ("model", "delta", "chi", "member")
+PER_RUN = {            # name -> (dtype, description)
+    "regime": ("int8", "asymptotic type (see flag_meanings); 0 = not computed yet"),
+    "regime_early": ("int8", "the same run's label window_decades before its end (agreement = the label held)"),
+    "candidate": ("int8", "the best class even where regime is 'other' (or a mixture 1|2, 4|5)"),
+    "status": ("int8", "how the run ended (flag_meanings)"),
+    "method": ("int8", "integrator (flag_meanings)"),
+    "confidence": ("float64", "0..1: how sure the label is (labels below 0.5 are 'other')"),
+    "tau_reached": ("float64", "last sample, tau = t/tau0 (tau_end unless stopped early or out of steps)"),
+    "run_seconds": ("float64", "wall time of the run (integration and classification), s"),
+    "nsteps": ("int64", "accepted steps"),
+    "nfev": ("int64", "right-hand-side evaluations"),
+    "reason": (f"<U{RN.REASON_CHARS}", "why this label, or why the run failed"),
+    "done": ("int8", "1 once the run's results are on disk"),
+}
+FORMULAS = (
+    "C2 (4.9)", "B (4.9)", "A (4.9) for C > 0",
+    "alpha (4.14)", "B2 (4.14)", "in (4.15)",
+    "A2 (4.16)", "B2 (4.16)", "in (4.17)",
+    "beta (4.18)", "A2 (4.18) corrected", "A2 (4.18) printed", "in (4.19)", "in (4.20)",
+    "A2 (4.42)", "B (4.42)", "M2 (4.42)", "K (4.45) printed", "in (4.43)",
+    "truncated T4 A2", "truncated T4 beta", "truncated T2 B2", "truncated T2 alpha",
+)
+MAX_CHUNK_RUNS = 4096
+MAX_CHUNK_MEMBERS = 256
+
+
+def predictions(delta: float, chi: float) -> list[float]:
+    """The ``FORMULAS`` at one cell (flags as 1.0 / 0.0)."""
+    t1, t2, t3 = FM.type1_eq4_9(delta, chi), FM.type2_eq4_14(delta, chi), FM.type3_eq4_16(delta, chi)
+    t4, t5, tr = FM.type4_eq4_18(delta, chi), FM.type5_eq4_42(delta, chi), FM.truncated_averaged(delta, chi)
+    q = delta > 0.0 and math.tan(chi) ** 2 > FM.xi_eq4_20(delta)
+    return [t1["C2"], t1["B"], t1["A_for_C_positive"], t2["alpha"], t2["B2"], float(t2["in_domain"]),
+            t3["A2"], t3["B2"], float(t3["in_domain"]), t4["beta"], t4["A2"], t4["A2_printed"], float(t4["in_domain"]),
+            float(q), t5["A2"], t5["B"], t5["M2"], t5["K_printed"], float(t5["in_domain"]),
+            tr["T4_A2"], tr["T4_beta"], tr["T2_B2"], tr["T2_alpha"]]
+
+
+def chunk_shape(spec) -> tuple:
+    """Storage chunk: one model, one delta, a row of chi, the members (at most ~4096 runs)."""
+    cm = min(spec.members, MAX_CHUNK_MEMBERS)
+    cc = max(1, min(len(spec.chis), MAX_CHUNK_RUNS // cm))
+    return (1, 1, cc, cm)
+
+
+def _flags(names) -> dict:
+    return {"flag_values": list(names.keys()), "flag_meanings": " ".join(str(v).replace(" ", "_") for v in names.values())}
+
+
+def template(spec, chunks: tuple):
+    """The empty Dataset (dask-backed, so writing it writes only metadata)."""
+    import dask.array as da
+    import xarray as xr
+
+    from .. import __version__
+
+    shape = (len(spec.models), len(spec.deltas), len(spec.chis), spec.members)
+    label_flags = _flags({C.CODE[k]: k for k in C.LABELS})
+    data = {}
+    for name, (dtype, desc) in PER_RUN.items():
+        fill = "" if dtype.startswith("<U") else (np.nan if dtype == "float64" else 0)
+        arr = da.full(shape, fill, dtype=dtype, chunks=chunks)
+        attrs = {"description": desc}
+        if name in ("regime", "regime_early", "candidate"):
+            attrs.update(label_flags)
+        elif name == "status":
+            attrs.update(_flags(RN.STATUS_TEXT))
+        elif name == "method":
+            attrs.update(_flags({v: k for k, v in RN.METHOD_CODE.items()}))
+        data[name] = (DIMS, arr, attrs)
+    data["evidence"] = (DIMS + ("quantity",), da.full(shape + (len(C.EVIDENCE),), np.nan, chunks=chunks + (-1,)),
+                        {"description": "the classifier's measurements (see the quantity coordinate and classify.EVIDENCE)"})
+    data["omega_final"] = (DIMS + ("axis",), da.full(shape + (3,), np.nan, chunks=chunks + (-1,)),
+                           {"description": "body-frame omega at tau_reached (dimensionless)"})
+    data["omega0"] = (("member", "axis"), np.asarray(spec.omega0, dtype=float),
+                      {"description": "body-frame omega(0), the same at every cell and model (dimensionless)"})
+    pred = np.array([[predictions(float(d), float(c)) for c in spec.chis] for d in spec.deltas], dtype=float)
+    data["paper"] = (("delta", "chi", "formula"), pred,
+                     {"description": "the paper's formulas at each cell ((4.18)'s A2 also corrected; truncated: "
+                                     "spinviz's averaged flow); flags are 1/0"})
+    coords = {
+        "model": list(spec.models),
+        "delta": ("delta", np.asarray(spec.deltas, dtype=float), {"long_name": "delta = 1 - I3/I1 (3.6)"}),
+        "chi": ("chi", np.asarray(spec.chis, dtype=float), {"long_name": "dipole angle from e3 (3.2)", "units": "rad"}),
+        "chi_deg": ("chi", np.degrees(spec.chis), {"units": "deg"}),
+        "member": np.arange(spec.members),
+        "axis": ["1", "2", "3"],
+        "quantity": list(C.EVIDENCE),
+        "formula": list(FORMULAS),
+    }
+    s = spec.settings
+    attrs = {
+        "title": spec.title or os.path.basename(spec.path),
+        "spec": spec.canonical_json(),
+        "spec_sha256": spec.identity(),
+        "seed": -1 if spec.seed is None else int(spec.seed),
+        "spinviz_version": __version__,
+        "classifier_version": C.VERSION,
+        "method": f"{RN.METHOD} (compiled, Euler equation only), rtol {s.rtol:g}, atol {s.atol:g}, decade by decade",
+        "conventions": "dimensionless (4.1): tau = t/tau0, omega = tau0 Omega; body frame; J = (1, 1, 1 - delta), "
+                       "d = (sin chi, 0, cos chi)",
+    }
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def create(spec, path: str, chunks: tuple | None = None) -> None:
+    """Write the empty store at ``path`` atomically (temporary sibling, then rename)."""
+    chunks = chunks or chunk_shape(spec)
+    parent = os.path.dirname(os.path.abspath(path)) or "."
+    os.makedirs(parent, exist_ok=True)
+    tmp = tempfile.mkdtemp(prefix=f".{os.path.basename(path)}.", suffix=".partial", dir=parent)
+    try:
+        store = os.path.join(tmp, "atlas.zarr")
+        template(spec, chunks).to_zarr(store, mode="w-", compute=False, zarr_format=2, consolidated=True)
+        with deferred():
+            if os.path.exists(path):
+                raise UsageError(f"{path}: appeared while the atlas was being created; not overwritten")
+            os.rename(store, path)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def check_identity(spec, path: str) -> None:
+    """Refuse (``UsageError``, one line) a store that is not an atlas of this very spec."""
+    import zarr
+
+    try:
+        attrs = dict(zarr.open_group(path, mode="r", zarr_format=2).attrs)
+    except Exception as e:                             # not a Zarr group at all
+        raise UsageError(f"{path}: exists and is not an atlas store ({type(e).__name__}); choose another --out") from None
+    if "spec_sha256" not in attrs:
+        raise UsageError(f"{path}: exists and is not an atlas store (no spec_sha256); choose another --out")
+    if attrs["spec_sha256"] != spec.identity():
+        what = "the same spec from another classifier version" if _same_spec(attrs, spec) else "another spec"
+        raise UsageError(f"{path}: holds an atlas of {what} (sha256 {attrs['spec_sha256'][:12]}, this spec "
+                         f"{spec.identity()[:12]}); refusing to mix them: choose another --out or delete it")
+
+
+def _same_spec(attrs: dict, spec) -> bool:
+    try:
+        return json.loads(attrs.get("spec", "")) == json.loads(spec.canonical_json())
+    except ValueError:
+        return False
+
+
+def done_mask(path: str) -> np.ndarray:
+    """Which runs are on disk, shape (model, delta, chi, member), bool."""
+    import zarr
+
+    return np.asarray(zarr.open_group(path, mode="r", zarr_format=2)["done"][...]) == 1
+
+
+def regime_codes(path: str) -> np.ndarray:
+    """The label codes of every run, shape (model, delta, chi, member), int8 (0 = not computed)."""
+    import zarr
+
+    return np.asarray(zarr.open_group(path, mode="r", zarr_format=2)["regime"][...])
+
+
+def chunks_of(path: str) -> tuple:
+    import zarr
+
+    return tuple(zarr.open_group(path, mode="r", zarr_format=2)["regime"].chunks)
+
+
+@dataclass
+class _Pending:
+    """Results of one storage chunk waiting to be written."""
+
+    parts: list
+    since: float
+    expected: int
+
+
+class Writer:
+    """Writes batch results into the store: a storage chunk as soon as all its batches are
+    in, and whatever has waited ``flush_s`` seconds (read-modify-write of the chunk); ``done``
+    last.  ``close()`` writes everything still waiting (also on an interrupt)."""
+
+    def __init__(self, path: str, expected: dict, flush_s: float = 30.0):
+        import zarr
+
+        self.group = zarr.open_group(path, mode="r+", zarr_format=2)
+        self.arrays = {k: self.group[k] for k in list(PER_RUN) + ["evidence", "omega_final"]}
+        self.expected = expected              # chunk key -> number of batches in it
+        self.pending: dict = {}
+        self.flush_s = flush_s
+        self.written_runs = 0
+
+    def add(self, chunk_key, result: dict) -> None:
+        p = self.pending.setdefault(chunk_key, _Pending([], time.monotonic(), self.expected[chunk_key]))
+        p.parts.append(result)
+        if len(p.parts) >= p.expected:
+            self._write(chunk_key)
+        else:
+            self.flush(older_than=self.flush_s)
+
+    def flush(self, older_than: float = 0.0) -> None:
+        now = time.monotonic()
+        for key in [k for k, p in self.pending.items() if now - p.since >= older_than]:
+            self._write(key)
+
+    def close(self) -> None:
+        self.flush(0.0)
+
+    def _write(self, key) -> None:
+        p = self.pending.pop(key)
+        with deferred():                      # a stop signal waits for these few milliseconds
+            for res in p.parts:
+                region = _region(res["region"])
+                for name, values in res["data"].items():
+                    self.arrays[name][region] = values[None]
+            for res in p.parts:
+                region = _region(res["region"])
+                shape = tuple(s.stop - s.start for s in region)
+                self.arrays["done"][region] = np.ones(shape, dtype=np.int8)
+                self.written_runs += int(np.prod(shape))
+
+
+def _region(r) -> tuple:
+    m, ds, cs, ms = r
+    return (slice(m, m + 1), slice(*ds), slice(*cs), slice(*ms))
+
+
+def open_atlas(path: str):
+    """The store as an xarray Dataset, with ``label`` (strings) and the evidence unpacked into
+    one variable per quantity (``slope_perp``, ``X2``, ...); runs not computed yet are masked."""
+    import xarray as xr
+
+    ds = xr.open_zarr(path)
+    names = np.array(["" for _ in range(256)], dtype=object)
+    for lab, c in C.CODE.items():
+        names[c % 256] = lab
+    done = ds["done"] == 1
+    ds["label"] = xr.apply_ufunc(lambda a: names[a.astype(np.int64) % 256].astype(str), ds["regime"].where(done, 0)
+                                 .astype(np.int8), dask="parallelized", output_dtypes=[str])
+    for q in C.EVIDENCE:
+        ds[q] = ds["evidence"].sel(quantity=q, drop=True).where(done)
+    return ds

@@ -1,0 +1,168 @@
+"""The atlas at single points inside each domain: label shares, exponents and amplitudes
+against the paper's formulas (the README's validation table).
+
+    python -m spinviz.regimes.validate [--members 32] [--workers 2] [--json PATH]
+
+Each point is an atlas of one cell (built with ``parse_spec``, run with ``atlas`` into a
+temporary store), so the table is made by exactly the code that makes the diagrams.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import sys
+import tempfile
+from collections import Counter
+
+import numpy as np
+
+from . import classify as C
+from . import formulas as FM
+from .api import atlas
+from .spec import parse_spec
+
+# (name, model, delta, chi_deg, |omega0|)
+POINTS = [
+    ("2: alpha above -1", "reduced", 0.5, 22.0, 0.1),
+    ("2 -> 1: alpha = -21.7", "reduced", -0.6, math.degrees(0.3), 0.1),
+    ("3 deep", "reduced", 0.8, 11.4, 0.1),
+    ("3 slow", "reduced", 0.3, math.degrees(0.72), 0.1),
+    ("3 at delta < -1/2", "reduced", -0.6, 77.0, 0.1),
+    ("4, beta > -3/4", "reduced", 0.5, 39.0, 0.1),
+    ("4 -> 5: beta = -0.83", "reduced", 0.5, 45.0, 0.1),
+    ("5 in '?' and (4.43)", "reduced", 0.8, math.degrees(1.2), 0.1),
+    ("5 outside (4.43)", "reduced", 0.2, 70.0, 0.1),
+    ("T4", "truncated", 0.5, 22.0, 0.04),
+    ("T2", "truncated", -0.6, 60.0, 0.04),
+    ("TF", "truncated", 0.8, math.degrees(1.2), 0.04),
+]
+
+
+def run(members: int = 32, workers: int | None = None, tau_end: float = 1e10, points=POINTS, progress: bool = False):
+    rows = []
+    tmp = tempfile.mkdtemp(prefix="spinviz-atlas-validate-")
+    try:
+        for i, (name, model, d, cdeg, w) in enumerate(points):
+            spec = parse_spec({"title": name, "models": [model], "grid": {"delta": [d], "chi_deg": [cdeg]},
+                               "members": {"count": members, "seed": 1, "omega": w}, "run": {"tau_end": tau_end}},
+                              f"<validation point {name}>")
+            out = os.path.join(tmp, f"p{i}.zarr")
+            res = atlas(spec, out, workers=workers, progress=progress)
+            from .store import open_atlas
+
+            ds = open_atlas(out).isel(model=0, delta=0, chi=0)
+            labels = [str(x) for x in ds["label"].values]
+            shares = Counter(labels)
+            top = shares.most_common(1)[0][0]
+            sel = np.array([lab == top for lab in labels])
+            ev = {q: ds[q].values[sel] for q in C.EVIDENCE}
+            devs = {}
+            for k in range(members):
+                if sel[k]:
+                    e = {q: float(ds[q].values[k]) for q in C.EVIDENCE}
+                    for key, val in C.deviations(top, e, d, math.radians(cdeg), model).items():
+                        devs.setdefault(key, []).append(val)
+            rows.append({"point": name, "model": model, "delta": d, "chi_deg": cdeg, "omega0": w, "members": members,
+                         "shares": dict(shares), "label": top,
+                         "median": {q: float(np.median(ev[q])) for q in ("slope_perp", "slope_3", "X2", "Y2", "w2_tau",
+                                                                         "libration_A2", "h_mean", "confidence")
+                                    if q in ev},
+                         "deviations": {k: (float(np.median(v)), float(np.min(v)), float(np.max(v))) for k, v in devs.items()},
+                         "seconds": res.seconds,
+                         "median_run_s": float(np.nanmedian(ds["run_seconds"].values))})
+            shutil.rmtree(out, ignore_errors=True)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return rows
+
+
+def format_table(rows) -> str:
+    lines = ["| point | model | δ | χ | labels | median measured | deviation from the formula, median [min, max] |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        sh = ", ".join(f"{k} {v}/{r['members']}" for k, v in sorted(r["shares"].items(), key=lambda x: -x[1]))
+        m = r["median"]
+        meas = f"p {m['slope_perp']:.4f}, q {m['slope_3']:.4f}, X² {m['X2']:.4g}, Y² {m['Y2']:.4g}"
+        if r["label"] == "1":
+            meas += f", ω₂τ {m['w2_tau']:.4g}"
+        if r["label"] == "5":
+            meas += f", A²(4.23) {m['libration_A2']:.4g}, h {m['h_mean']:.4f}"
+        dev = "; ".join(f"{k} {100 * v[0]:+.2f} % [{100 * v[1]:+.2f}, {100 * v[2]:+.2f}]" for k, v in r["deviations"].items())
+        if not dev and r["label"] == "5":
+            a2 = FM.type5_eq4_42(r["delta"], math.radians(r["chi_deg"]))["A2"]
+            dev = f"(4.42) has no real solution here (A² = {a2:.3g})"
+        lines.append(f"| {r['point']} | {r['model']} | {r['delta']:g} | {r['chi_deg']:.1f}° | {sh} | {meas} | {dev or '—'} |")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    import argparse
+
+    from ..atomic import write_json
+
+    ap = argparse.ArgumentParser(prog="python -m spinviz.regimes.validate")
+    ap.add_argument("--members", type=int, default=32)
+    ap.add_argument("--workers", type=int, default=None)
+    ap.add_argument("--json", metavar="PATH")
+    a = ap.parse_args(argv)
+    rows = run(a.members, a.workers, progress=False)
+    print(format_table(rows))
+    if a.json:
+        write_json(a.json, rows)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
+
+
+# --- the diagram against the domains ---------------------------------------------------------
+def paper_domain(delta: float, chi: float) -> str:
+    """The type figure 2 assigns to a cell: (4.15) "2", (4.17) "3", (4.19) "4", (4.20) "?",
+    or "none" (delta <= -1/2 above (4.15): no domain of the paper)."""
+    xi = math.tan(chi) ** 2
+    if xi < FM.xi_eq4_15(delta):
+        return "2"
+    if delta > -0.5 and xi <= FM.xi_eq4_17(delta):
+        return "3"
+    if delta > 0.0 and xi > FM.xi_eq4_20(delta):
+        return "?"
+    if delta > -0.5:
+        return "4"
+    return "none"
+
+
+def spinviz_domain(delta: float, chi: float) -> str:
+    """The late state spinviz's reading of the averaged flow predicts: "1" below alpha = -1,
+    "2" up to (4.15), "3" where (4.16) is positive, "5" beyond beta = -3/4 (delta > -1/5),
+    else "4"."""
+    xi = math.tan(chi) ** 2
+    if xi < FM.xi_spinviz_alpha_minus_one(delta):
+        return "1"
+    if xi < FM.xi_eq4_15(delta):
+        return "2"
+    if FM.type3_eq4_16(delta, chi)["positive"]:
+        return "3"
+    if delta > -0.2 and xi > FM.xi_spinviz_beta_minus_three_quarters(delta):
+        return "5"
+    return "4"
+
+
+def compare_domains(ds, model: str = "reduced") -> dict:
+    """Majority label of each cell against ``paper_domain`` and ``spinviz_domain``:
+    {"paper": {domain: Counter of majority labels}, "spinviz": {...}, "cells": n, "agree_spinviz": k}."""
+    lab = ds["label"].sel(model=model).values
+    out = {"paper": {}, "spinviz": {}, "cells": 0, "agree_spinviz": 0, "agree_paper": 0, "share_other": 0.0}
+    for i, d in enumerate(ds["delta"].values):
+        for j, c in enumerate(ds["chi"].values):
+            maj = Counter(str(x) for x in lab[i, j]).most_common(1)[0][0]
+            p, s = paper_domain(float(d), float(c)), spinviz_domain(float(d), float(c))
+            out["paper"].setdefault(p, Counter())[maj] += 1
+            out["spinviz"].setdefault(s, Counter())[maj] += 1
+            out["cells"] += 1
+            out["agree_spinviz"] += maj == s
+            out["agree_paper"] += maj == p
+    out["share_other"] = float(np.isin(lab, ["other", "1|2", "4|5"]).mean())
+    return out

@@ -81,11 +81,55 @@ def write_text(path, text: str) -> None:
         fh.write(text)
 
 
+def plain(x):
+    """NumPy scalars and arrays, tuples and nested containers as built-in JSON types, recursively
+    (lists of mixed numbers and strings stay mixed)."""
+    import numpy as np
+
+    if isinstance(x, dict):
+        return {str(k): plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [plain(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return plain(x.tolist())
+    if isinstance(x, np.generic):
+        return x.item()
+    return x
+
+
 def write_json(path, data) -> None:
     """JSON written atomically (NumPy scalars as floats)."""
     import json
 
     write_text(path, json.dumps(data, indent=2, default=float) + "\n")
+
+
+def _backup(path: str) -> str | None:
+    """A hard link to an existing output beside it (so that a failed group commit can put it
+    back), or None when there is nothing to keep or links are not possible here."""
+    if not os.path.isfile(path):
+        return None
+    d, name = os.path.split(os.path.abspath(path))
+    fd, b = tempfile.mkstemp(prefix=f".{name}.", suffix=".old", dir=d)
+    os.close(fd)
+    os.unlink(b)
+    try:
+        os.link(path, b)
+    except OSError:
+        return None
+    return b
+
+
+def check_parent_writable(p: str) -> None:
+    """The nearest existing folder above ``p`` (created folders go below it) is a directory
+    this process may write in; otherwise one line naming ``p``."""
+    d = os.path.dirname(os.path.abspath(p))
+    while not os.path.exists(d):
+        d = os.path.dirname(d)
+    if not os.path.isdir(d):
+        raise UsageError(f"{p}: {d} is not a directory")
+    if not os.access(d, os.W_OK | os.X_OK):
+        raise UsageError(f"{p}: cannot write in {d} (permission denied)")
 
 
 def check_outputs(paths, inputs=()) -> list[str]:
@@ -105,13 +149,7 @@ def check_outputs(paths, inputs=()) -> list[str]:
             i = os.fspath(i)
             if os.path.exists(p) and os.path.exists(i) and os.path.samefile(p, i):
                 raise UsageError(f"{p}: is an input of this command ({i}); choose another output path")
-        d = os.path.dirname(os.path.abspath(p))
-        while not os.path.exists(d):
-            d = os.path.dirname(d)
-        if not os.path.isdir(d):
-            raise UsageError(f"{p}: {d} is not a directory")
-        if not os.access(d, os.W_OK | os.X_OK):
-            raise UsageError(f"{p}: cannot write in {d} (permission denied)")
+        check_parent_writable(p)
         if os.path.exists(p) and not os.access(p, os.W_OK) and not os.access(os.path.dirname(os.path.abspath(p)), os.W_OK):
             raise UsageError(f"{p}: cannot be replaced (permission denied)")
     return paths
@@ -150,12 +188,29 @@ class Outputs:
             raise
 
     def commit(self) -> None:
+        """Rename every temporary file into place, or none: the old files are kept as hard
+        links until the last rename succeeded, and put back if one fails."""
         with deferred():
             for t in self.targets:                     # the world may have changed since the check
                 if os.path.isdir(t.path):
                     raise UsageError(f"{t.path}: is a directory; an output must be a file path")
-            for t in self.targets:
-                t.commit()
+            backups = {t.path: _backup(t.path) for t in self.targets}
+            done = []
+            try:
+                for t in self.targets:
+                    t.commit()
+                    done.append(t.path)
+            except BaseException:
+                for path in done:                      # undo: the old file back, or no file
+                    if backups[path]:
+                        os.replace(backups.pop(path), path)
+                    else:
+                        os.unlink(path)
+                raise
+            finally:
+                for b in backups.values():
+                    if b and os.path.exists(b):
+                        os.unlink(b)
 
     def discard(self) -> None:
         for t in reversed(self.targets):

@@ -78,12 +78,25 @@ def simulate(
     sol, integrator, reason = _solve(integrator, problem, kw, auto, reason, time_scale,
                                      resolvable=auto and _resolvable(body, model, omega0, float(t_eval[-1]), kinematics))
     runtime = time.perf_counter() - start
-    stats = dict(sol.stats)
+    stats = _stats_in_units(sol.stats, time_scale)
     stats.update(method=integrator.name, method_reason=reason, runtime_s=runtime, eps_rad=eps, rtol=rtol, atol=atol)
     if step is not None:
         stats["step"] = step
     return Trajectory(t=t_eval, omega=U.omega_from_dimensionless(sol.omega * eps, body.tau0), q=sol.q,
                       euler=sol.euler, body=body, model=model, stats=stats, slow=sol.slow)
+
+
+def _stats_in_units(stats: dict, time_scale: float) -> dict:
+    """The integrator's stats with its times (spin units) in the trajectory's (s or tau0)."""
+    out = dict(stats)
+    for key in ("stiff_at", "runaway_at"):
+        if key in out:
+            out[key] = out[key] / time_scale
+    if "segments" in out:
+        out["segments"] = [[t / time_scale, mode] for t, mode in out["segments"]]
+    if "resonances" in out:
+        out["resonances"] = [[m, t / time_scale, kick] for m, t, kick in out["resonances"]]
+    return out
 
 
 def output_times(t_end=None, samples=None, t_eval=None) -> np.ndarray:
@@ -153,7 +166,7 @@ def _solve(integrator, problem, kw, auto: bool, reason: str, time_scale: float, 
         reason = f"{reason}; but {sol.message} -- so resolved in full by lie-dop853"
         integrator = get("lie-dop853")
         sol = integrator.solve(problem, **kw, stop_on_stiffness=True)
-    if auto and not sol.success and not integrator.stiff and integrator.name != "secular":
+    if auto and not sol.success and not integrator.stiff and integrator.name != "secular" and "runaway_at" not in sol.stats:
         stiff_at = sol.stats.get("stiff_at")
         why = f"stiffness detected at t = {stiff_at / time_scale:.3g}" if stiff_at is not None else sol.message
         reason = f"{integrator.name} gave up ({why}); switched to radau (implicit, exact Jacobian)"

@@ -19,7 +19,6 @@ Two places need more than a Python handler:
 from __future__ import annotations
 
 import contextlib
-import os
 import signal
 import threading
 
@@ -43,15 +42,21 @@ class Interrupted(KeyboardInterrupt):
 
 
 # Libraries that call back into Python and swallow what the callback raises (VTK prints an
-# error block and carries on): a signal arriving there is only recorded, and the caller's
-# loop raises it at its next ``check()`` -- between two frames.
-_SWALLOWING = (f"{os.sep}vtkmodules{os.sep}",
-               f"{os.sep}pyvista{os.sep}")
+# error block and carries on): a signal arriving inside them is only recorded, and the
+# caller's loop raises it at its next ``check()`` -- between two frames.
+_SWALLOWING = ("vtkmodules", "vtk", "pyvista")
+
+_deferring = 0            # depth of ``deferred()`` blocks: a signal is only recorded inside one
 
 
 def _inside_swallowing_library(frame) -> bool:
+    """Whether the interrupted code runs in one of those libraries: judged by module names,
+    from the innermost frame out to the first of spinviz's own."""
     while frame is not None:
-        if any(s in frame.f_code.co_filename for s in _SWALLOWING):
+        name = str(frame.f_globals.get("__name__", ""))
+        if name.split(".")[0] == "spinviz":
+            return False
+        if name.split(".")[0] in _SWALLOWING:
             return True
         frame = frame.f_back
     return False
@@ -61,7 +66,7 @@ def _handler(signum, frame):
     global _received
     first = _received is None
     _received = signum
-    if first and not _inside_swallowing_library(frame):
+    if first and not _deferring and not _inside_swallowing_library(frame):
         raise Interrupted(signum)
 
 
@@ -80,6 +85,7 @@ def handlers():
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    global _received
     old = {s: signal.getsignal(s) for s in SIGNALS}
     install()
     try:
@@ -87,6 +93,7 @@ def handlers():
     finally:
         for s, h in old.items():
             signal.signal(s, h)
+        _received = None                           # a later run in this process starts clean
 
 
 def received() -> int | None:
@@ -103,15 +110,18 @@ def check() -> None:
 @contextlib.contextmanager
 def deferred():
     """Hold stop signals back for the few lines that must not be cut in two (renaming a
-    group of outputs into place); they are delivered when the block ends."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+    group of outputs into place): inside, the handler only records a signal; it is raised
+    when the block ends.  (Not a signal mask: a mask covers one thread, and a signal sent to
+    the process may land on any other -- OpenBLAS's, a queue's, a kernel's -- while Python
+    still runs the handler in the main thread.)"""
+    global _deferring
+    _deferring += 1
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        _deferring -= 1
+    if not _deferring:
+        check()
 
 
 POLL_S = 0.05
@@ -132,13 +142,14 @@ def call_stoppable(kernel, *args):
             box["error"] = e
 
     t = threading.Thread(target=run, name="spinviz-kernel", daemon=True)
-    t.start()
     try:
+        t.start()
         while t.is_alive():
             t.join(POLL_S)
     except BaseException:
         stop[0] = 1
-        t.join()
+        if t.ident is not None:                    # started (the signal may land inside start())
+            t.join()
         raise
     if "error" in box:
         raise box["error"]

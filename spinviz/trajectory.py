@@ -16,7 +16,7 @@ import numpy as np
 
 from . import rotations as R
 from . import units as U
-from .atomic import atomic_path
+from .atomic import atomic_path, plain
 from .physics.bodies import Body
 from .physics.equations import angular_momentum_world, kinetic_energy
 
@@ -284,13 +284,5 @@ FORMAT = "spinviz-trajectory-1"
 
 
 def _plain_stats(stats: dict) -> dict:
-    """The JSON-representable part of ``stats`` (numbers, strings, lists of numbers)."""
-    out = {}
-    for k, v in stats.items():
-        if isinstance(v, np.generic):
-            v = v.item()
-        if isinstance(v, (tuple, list, np.ndarray)):
-            v = np.asarray(v).tolist()
-        if isinstance(v, (int, float, str, bool, type(None), list)):
-            out[k] = v
-    return out
+    """``stats`` as JSON-ready values (so that ``load`` gives back what ``save`` was given)."""
+    return {k: v for k, v in plain(stats).items() if isinstance(v, (int, float, str, bool, type(None), list, dict))}

@@ -1,6 +1,7 @@
 """Bad input and odd corners: one line and exit 2, never a traceback or a stray file."""
 
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -144,3 +145,52 @@ def test_truncated_start_beyond_the_singular_surface_is_one_line(tmp_path, capsy
     assert code == 1 and "\n" not in err and "Traceback" not in err
     assert str(p) in err and "(2.5) is singular at the initial state" in err
     assert not (tmp_path / "t.npz").exists()
+
+
+def test_a_group_of_outputs_lands_together_even_when_a_rename_fails(tmp_path, monkeypatch):
+    """The second rename of a group fails: the first output is put back as it was."""
+    from spinviz.atomic import Outputs
+
+    a, b = tmp_path / "v.mp4", tmp_path / "v.png"
+    a.write_bytes(b"old video")
+    b.write_bytes(b"old poster")
+    real = os.replace
+    calls = []
+
+    def flaky(src, dst):
+        calls.append(dst)
+        if str(dst) == str(b) and len(calls) == 2:
+            raise OSError(28, "No space left on device")
+        return real(src, dst)
+
+    monkeypatch.setattr(os, "replace", flaky)
+    with pytest.raises(OSError, match="No space left"):
+        with Outputs([a, b]) as (ta, tb):
+            open(ta, "wb").write(b"new video")
+            open(tb, "wb").write(b"new poster")
+    assert a.read_bytes() == b"old video" and b.read_bytes() == b"old poster"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["v.mp4", "v.png"]
+
+
+def test_a_crashing_render_worker_fails_the_render_in_one_line(tmp_path):
+    """A render worker whose drawing stack cannot load (here: a vtkmodules that raises, as a
+    missing libGL would) ends the render with exit status 1 and one line naming the worker and
+    the cause; nothing is left in the output folder (no video, poster, segment or temp file)."""
+    import subprocess
+    import sys
+
+    fake = tmp_path / "fake"
+    (fake / "vtkmodules").mkdir(parents=True)
+    (fake / "vtkmodules" / "__init__.py").write_text('raise ImportError("libGL.so.1: cannot open (simulated)")\n')
+    out = tmp_path / "out"
+    out.mkdir()
+    root = Path(__file__).resolve().parents[1]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(fake), str(root)]))
+    r = subprocess.run([sys.executable, "-m", "spinviz", "render", str(root / "scenes" / "askew_example.toml"),
+                        "--out", str(out / "a.mp4"), "--size", "160x90", "--duration", "1", "--fps", "10",
+                        "--workers", "2"], capture_output=True, text=True, env=env, timeout=300)
+    assert r.returncode == 1
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in r.stderr
+    assert "render worker" in lines[0] and "ImportError: libGL.so.1: cannot open (simulated)" in lines[0]
+    assert list(out.iterdir()) == []

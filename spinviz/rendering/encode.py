@@ -38,6 +38,10 @@ class Mp4Writer:
     def close(self):
         self._gen.close()
 
+    def abort(self):
+        """Stop ffmpeg; the caller discards the temporary file."""
+        self._gen.close()
+
 
 class GifWriter:
     """Animated GIF via Pillow, frames kept in memory.
@@ -52,6 +56,10 @@ class GifWriter:
 
     def write(self, img: np.ndarray):
         self.frames.append(Image.fromarray(np.ascontiguousarray(img)))
+
+    def abort(self):
+        """Drop the frames: nothing is quantized or written (the caller discards the file)."""
+        self.frames = []
 
     def close(self):
         if self.frames:

@@ -7,7 +7,8 @@ consumes frames planned from stored trajectories and never steps physics.
 Parallel MP4: the frames are split into contiguous segments, one per worker process (one
 per core); each worker renders its segment and encodes it with its own single-threaded
 x264 (H.264, yuv420p), and the segments are joined by ffmpeg's concat demuxer without
-re-encoding.  No frame crosses a process boundary, so the parent costs nothing per frame.
+re-encoding.  Only the poster frame crosses a process boundary, so the parent costs
+nothing per frame.
 GIFs (small by nature) are rendered in-process.
 
 Start-up overlaps the work: ``WorkerPool`` starts the render processes before the plan
@@ -216,8 +217,10 @@ class WorkerPool:
                 p.terminate()
                 p.join(timeout=5)
         for q in (*self.tasks, self.msgs):
+            # a task (the pickled plan, ~100 kB: more than a pipe holds) that a worker never
+            # read -- it failed to start, or was stopped first -- must not block us here
+            q.cancel_join_thread()
             q.close()
-            q.join_thread()
 
     def __enter__(self) -> WorkerPool:
         return self
@@ -282,6 +285,7 @@ def _render_in_process(plan, path, size, supersample, F, poster_f, bar):
     startup = time.perf_counter() - t0
     writer = open_writer(path, size, plan.spec.fps)
     poster_img = None
+    finished = False
     try:
         for f in range(F):
             interrupt.check()                   # VTK may have swallowed the signal's exception
@@ -290,11 +294,15 @@ def _render_in_process(plan, path, size, supersample, F, poster_f, bar):
             if f == poster_f:
                 poster_img = img
             bar.update(f + 1)
+        finished = True
     except RuntimeError as e:                   # VTK / OpenGL failures: one line, as from the workers
         why = str(e).strip().splitlines()[-1] if str(e).strip() else type(e).__name__
         raise RenderError(f"rendering frame {f} failed: {why}") from None
     finally:
-        writer.close()
+        if finished:
+            writer.close()
+        else:                                   # interrupted or failed: no GIF is quantized for nothing
+            writer.abort()
         session.close()
     return poster_img, startup
 
@@ -342,8 +350,10 @@ def _render_segments(plan, path, size, supersample, F, poster_f, pool: WorkerPoo
                 pending.discard(k)
         _concat(segs, path)
     finally:
-        pool.close()                                    # workers finish their frame and close their encoder
-        shutil.rmtree(tmpdir, ignore_errors=True)
+        try:
+            pool.close()                                # workers finish their frame and close their encoder
+        finally:
+            shutil.rmtree(tmpdir, ignore_errors=True)
     return poster_img, startup or 0.0
 
 

@@ -24,6 +24,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from .. import rotations as R
+from ..atomic import plain
 from ..driver import simulate
 from ..errors import SimulationError
 from ..physics import bodies as B
@@ -47,20 +48,7 @@ class CheckResult:
 
     def record(self) -> dict:
         """Plain-JSON record: equation, description, passed, max_error, criterion, runtime_s, details."""
-        return _plain(asdict(self))
-
-
-def _plain(x):
-    """NumPy scalars and arrays to built-in types, recursively (for json.dumps)."""
-    if isinstance(x, dict):
-        return {k: _plain(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_plain(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return x.tolist()
-    if isinstance(x, np.generic):
-        return x.item()
-    return x
+        return plain(asdict(self))
 
 
 def _dimless(inertia, dipole) -> B.Body:

@@ -60,11 +60,13 @@ def test_secular_refuses_when_a_resonance_makes_L_uncertain(eps):
         spinviz.simulate(body, "reduced", W_DIR * eps, t_end=horizon(eps, 30), samples=5, method="secular")
 
 
-@pytest.mark.parametrize("eps", [1e-4, 1e-5])
+@pytest.mark.parametrize("eps", [1e-4, 3e-6])
 def test_phase_resolved_is_never_claimed_beyond_the_stated_error(eps):
     """delta = 0.3, chi = 1.0, 3 T: the phases were off by O(1) rad (2.8 rad in q) while
     reported resolved.  Now q is within the stated phase error, and called resolved only when
-    that is below 1e-3 rad (measured: 1.2e-3 rad at eps = 1e-4, not resolved; 1.2e-4 at 1e-5)."""
+    that is below 1e-3 rad.  Measured q error / stated: 1.2e-3 / 1.1e-2 at eps = 1e-4 (not
+    resolved), 1.2e-4 / 1.1e-3 at 1e-5 (not resolved: the stated bound counts the drift an
+    O(eps^2) error in omega3 could give the phases), 3.5e-5 / 3.4e-4 at 3e-6 (resolved)."""
     body = B.symmetric_top(0.3, 1.0)
     w = np.array([0.3, 0.4, 0.866])
     kw = dict(t_end=horizon(eps, 3, w), samples=31, euler_zxz0=(0.3, 1.1, -0.4))
@@ -73,7 +75,7 @@ def test_phase_resolved_is_never_claimed_beyond_the_stated_error(eps):
     mis = float(R.misorientation(a.q, b.q).max())
     assert mis <= a.stats["phase_error_rad"]
     assert a.phase_resolved == (a.stats["phase_error_rad"] <= 1e-3)
-    assert a.phase_resolved == (eps == 1e-5)
+    assert a.phase_resolved == (eps == 3e-6)
     lo, hi = b.angle_d_L_range()                   # the HUD's range holds the true angle
     assert np.all(b.angle_d_L() >= lo - 1e-9) and np.all(b.angle_d_L() <= hi + 1e-9)
 
@@ -118,3 +120,19 @@ def test_check_secular_holds_each_run_to_its_stated_errors():
     for row in r.details["rows"]:
         assert row["rel_error_slow"] <= 2 * row["slow_error_estimate"] + 1e-8
         assert row["steps"] < 100 < row["steps_full"] / 1000       # the point of it: ~30 steps for 1e5-1e6 turns
+
+
+def test_stated_errors_bound_the_measured_ones_on_random_bodies():
+    """secular's phase_error_rad and slow_error_estimate against lie-dop853 (rtol 1e-12) on 40
+    random symmetric tops (random delta, chi, spin direction, near-axial starts, eps = 1e-4 and
+    3e-5, 0.3-3 T, resonance refusal lifted): measured/stated stays below 1.  The seed holds the
+    case whose hand-over error domain "?" amplified 7x past the old statement (delta = 0.8,
+    chi = 1.17).  The full sweep (python -m spinviz.validation.secular_sweep --seeds 1-9) runs
+    360 of these."""
+    from spinviz.validation import secular_sweep as SW
+
+    rng = np.random.default_rng(6)
+    rows = [SW.run_case(SW.draw(rng, k)) for k in range(40)]
+    assert max(r["q_ratio"] for r in rows) <= 1.0
+    assert max(r["slow_ratio"] for r in rows) <= 1.0
+    assert any(r["switches"] for r in rows) and any(r["resolved"] for r in rows)    # both kinds were met

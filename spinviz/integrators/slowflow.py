@@ -45,6 +45,40 @@ M_PHASES = 32          # phase-average nodes: exact for trigonometric polynomial
 HYST = 0.5             # AVG again only below HYST * mu_star: no chattering
 NIT_MAX = 0.1          # the transform is applied only where it is a small correction
 MAX_SWITCHES = 100_000
+MAX_CROSSINGS = 100_000
+RESONANCES = (1.0, 2.0, -1.0, -2.0)   # m of |L|/I1 = m delta w3: the torque across L has only these harmonics
+
+
+@_jit
+def detunings(mode, y, J3, delta, F):
+    """F_m = |L| - m delta w3 for the m of RESONANCES at the state y (either mode)."""
+    if mode == FULL:
+        wp = math.hypot(y[0], y[1])
+        w3 = y[2]
+    else:
+        wp = y[0]
+        w3 = y[1]
+    L = math.sqrt(wp * wp + J3 * J3 * w3 * w3)
+    for i in range(4):
+        F[i] = L - RESONANCES[i] * delta * w3
+    return wp, w3
+
+
+@_jit
+def forced_response(model, J, g, wp, w3):
+    """How far averaging in (w_perp, p) misses the forced response of omega_perp (the late type
+    "1"), |c| = |a_perp(0, 0, w3)| / |delta w3|: |c|^2 / w_perp while the transform carries it,
+    1.5 |c| where the transform is off because |c| > NIT_MAX w_perp (measured on near-axial starts,
+    omega_perp(0) = 1e-3 omega3: misses of 0.93-1.05 |c|, e.g. delta = -0.3, chi = 0.92, eps = 1e-4:
+    0.97 |c|)."""
+    delta = 1.0 - J[2]
+    if w3 == 0.0 or delta == 0.0:
+        return 0.0
+    a = KN.radiation(model, 0.0, 0.0, w3, J, g)
+    c = math.hypot(a[0], a[1]) / abs(delta * w3)
+    if c > NIT_MAX * wp:
+        return 1.5 * c
+    return c * c / wp
 
 
 @_jit
@@ -150,7 +184,7 @@ def nit(model, J, g, cM, sM, wp, w3, p):
         # c_j = (1/M) sum_k f_k e^{-i j p_k}; the antiderivative term is 2 Re(c_j e^{ijp} / (ij))
         cr_wp = ci_wp = cr_w3 = ci_w3 = cr_g = ci_g = 0.0
         for k in range(M):
-            ck, sk = math.cos(j * 2.0 * math.pi * k / M), math.sin(j * 2.0 * math.pi * k / M)
+            ck, sk = cM[(j * k) % M], sM[(j * k) % M]     # cos, sin of j p_k, from the table
             cr_wp += Fwp[k] * ck
             ci_wp -= Fwp[k] * sk
             cr_w3 += Fw3[k] * ck
@@ -223,18 +257,26 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
                   stop):
     """Integrate from the body-frame w0 (spin units) over t_eval.
 
-    Returns (out (N, 6): w1, w2, w3, phi, p, mode at each output; counters (10,); switches
-    (K, 2): time and new mode; status).  phi: the ZXZ precession angle about the fixed L, from
-    phi0; p: the unwrapped body-frame phase of omega_perp (psi = pi/2 - p).
-    counters: steps FULL, steps AVG, evaluations FULL, evaluations AVG, rejected steps,
-    switches, the largest mu_ad met in AVG, precession turns in FULL, sign changes of w3,
-    the time of the last sign change."""
+    Returns (out (N, 6): w1, w2, w3, phi, p, mode at each output; counters (16,); switches
+    (K, 2): time and new mode; crossings (K, 4): time, w_perp, w3 and m of every passage
+    through a resonance |L|/I1 = m delta w3; status).  phi: the ZXZ precession angle about the
+    fixed L, from phi0; p: the unwrapped body-frame phase of omega_perp (psi = pi/2 - p).
+    counters: 0 steps FULL, 1 steps AVG, 2 evaluations FULL, 3 evaluations AVG, 4 rejected
+    steps, 5 switches, 6 the largest mu_ad met in AVG, 7 precession turns in FULL, 8 sign
+    changes of w3, 9 the time of the last and 13 of the first, 10 the integral of mu^2 dt over
+    AVG (mu = eps |w|^2 / |delta w3|), 11 the phase Sigma covered in FULL, 12 the largest
+    forced-response error met in AVG."""
     N = t_eval.shape[0]
     n = 4
     out = np.empty((N, 6))
-    cnt = np.zeros(10)
+    cnt = np.zeros(16)
+    cnt[13] = -1.0
     sw = np.zeros((MAX_SWITCHES, 2))
     nsw = 0
+    cross = np.zeros((MAX_CROSSINGS, 4))
+    ncross = 0
+    Fold = np.empty(4)
+    Fnew = np.empty(4)
     M = M_PHASES
     cM = np.empty(M)
     sM = np.empty(M)
@@ -259,6 +301,7 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
         dphi = to_avg(model, J, g, cM, sM, y, p_unw, use_nit and not equiv)
     sgn = 1.0 if w0[2] >= 0.0 else -1.0
     y[3] = phi0 + dphi + sgn * (0.5 * math.pi - (y[2] if mode == AVG else p_unw))
+    detunings(mode, y, J[2], delta, Fold)
     t = t_eval[0]
     t_end = t_eval[-1]
     out[0, 0], out[0, 1], out[0, 2] = w0[0], w0[1], w0[2]
@@ -275,11 +318,11 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
     err_exp = -1.0 / 8.0
     while t < t_end:
         if nsteps >= max_steps:
-            return out, cnt, sw[:nsw], TOO_MANY_STEPS
+            return out, cnt, sw[:nsw], cross[:ncross], TOO_MANY_STEPS
         if (nsteps + int(cnt[4])) % STOP_POLL == 0 and stop[0] != 0:
-            return out, cnt, sw[:nsw], INTERRUPTED
+            return out, cnt, sw[:nsw], cross[:ncross], INTERRUPTED
         if h < 10.0 * abs(np.nextafter(t, np.inf) - t):
-            return out, cnt, sw[:nsw], STEP_UNDERFLOW
+            return out, cnt, sw[:nsw], cross[:ncross], STEP_UNDERFLOW
         if t + h > t_end:
             h = t_end - t
         for i in range(1, 12):
@@ -295,7 +338,7 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
         # the phase Sigma (index 3) is held to rtol x its increment
         err, finite = KN.error_norm(K, y, y_new, h, n, rtol, atol, E3, E5, 3)
         if not finite:
-            return out, cnt, sw[:nsw], NOT_FINITE
+            return out, cnt, sw[:nsw], cross[:ncross], NOT_FINITE
         if not err <= 1.0:
             h = h * max(0.2, 0.9 * err ** err_exp)
             cnt[4] += 1
@@ -332,6 +375,8 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
                     out[j_out, 4] = p_o
                 out[j_out, 5] = mode
                 j_out += 1
+        if mode == FULL:
+            cnt[11] += abs(y_new[3] - y[3])
         for k in range(n):
             y[k] = y_new[k]
             K[0, k] = K[12, k]
@@ -342,6 +387,20 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
         else:
             cnt[1] += 1
             cnt[3] += nf
+        # resonances crossed in this step, and what the error statements need
+        wp_n, w3_n = detunings(mode, y, J[2], delta, Fnew)
+        for i in range(4):
+            if Fnew[i] * Fold[i] < 0.0 and ncross < MAX_CROSSINGS:
+                cross[ncross, 0], cross[ncross, 1], cross[ncross, 2], cross[ncross, 3] = t, wp_n, w3_n, RESONANCES[i]
+                ncross += 1
+            Fold[i] = Fnew[i]
+        if mode == AVG and not equiv:
+            if delta * w3_n != 0.0:
+                mu_now = eps * (wp_n * wp_n + w3_n * w3_n) / abs(delta * w3_n)
+                cnt[10] += mu_now * mu_now * (t - t_old)
+            fr = forced_response(model, J, g, wp_n, w3_n)
+            if fr > cnt[12]:
+                cnt[12] = fr
         nf = 0
         factor = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** err_exp)
         if rejected:
@@ -357,6 +416,8 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
             sgn = s_new
             cnt[8] += 1
             cnt[9] = t
+            if cnt[13] < 0.0:
+                cnt[13] = t
             rhs(mode, sgn, model, J, g, cM, sM, equiv, y, K[0])
             nf += 1
         # the hand-over
@@ -386,7 +447,7 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
                 rhs(mode, sgn, model, J, g, cM, sM, equiv, y, K[0])
                 h = initial_step(mode, sgn, model, J, g, cM, sM, equiv, y, K[0], rtol, atol, n, t_end - t)
                 nf = 2
-    return out, cnt, sw[:nsw], OK
+    return out, cnt, sw[:nsw], cross[:ncross], OK
 
 
 @_jit

@@ -39,10 +39,11 @@ _API = {
     "SpinvizError": ("errors", "SpinvizError"),
     "SceneError": ("errors", "SceneError"),
     "SimulationError": ("errors", "SimulationError"),
+    "atlas": ("regimes.api", "atlas"),
 }
 _SUBMODULES = {
     "units", "rotations", "errors", "atomic", "plotting", "physics", "integrators", "driver", "trajectory", "scene",
-    "rendering", "pipeline", "analysis", "validation", "cli",
+    "rendering", "pipeline", "analysis", "validation", "regimes", "cli",
 }
 
 __all__ = sorted(_API) + ["__version__"]

@@ -82,6 +82,10 @@ def _parser() -> argparse.ArgumentParser:
     rp.add_argument("--out-dir", default="renders", help="where the plot and JSON go")
 
     sub.add_parser("methods", help="list the integrators")
+
+    from .regimes import command as atlas_command  # argparse and spinviz.errors only: light
+
+    atlas_command.add_parser(sub)
     return p
 
 
@@ -368,9 +372,15 @@ def _cmd_report(args) -> int:
     return EXIT_OK if all(r.passed for r in results) else EXIT_FAIL
 
 
+def _cmd_atlas(args) -> int:
+    from .regimes import command
+
+    return command.run(args)
+
+
 _COMMANDS = {"check": _cmd_check, "info": _cmd_info, "simulate": _cmd_simulate, "methods": _cmd_methods,
              "render": _cmd_render, "compare": _cmd_compare, "bench": _cmd_bench, "stress": _cmd_stress,
-             "report": _cmd_report}
+             "report": _cmd_report, "atlas": _cmd_atlas}
 
 
 def entry() -> None:

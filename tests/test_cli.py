@@ -75,7 +75,8 @@ def test_every_shipped_scene_loads():
     from spinviz.scene import load_scene
 
     for p in sorted(SCENES.glob("*.toml")):
-        load_scene(p)
+        if not p.name.startswith("atlas_"):          # atlas specs: tests/test_atlas.py
+            load_scene(p)
 
 
 BAD = [
@@ -185,7 +186,7 @@ def test_info_unknown_target(capsys):
 
 
 def test_check_json_records_and_exit_status(capsys):
-    code, out, _ = run(["check", "--json"], capsys)
+    code, out, _ = run(["check", "--quick", "--json"], capsys)   # every equation; the full list is spinviz check
     records = json.loads(out)
     assert code == 0
     assert {r["equation"] for r in records} >= {"6.5", "6.6", "6.8", "6.10", "3.9", "5.2", "5.4"}

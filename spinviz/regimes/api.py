@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..atomic import check_parent_writable
 from ..errors import UsageError
 from . import runs as RN
 from . import store as ST
@@ -127,14 +128,7 @@ def check_out(path: str, spec_path: str | None = None) -> None:
         raise UsageError(f"{path}: exists and is a file; an atlas store is a directory (e.g. atlas.zarr)")
     if spec_path and os.path.exists(path) and os.path.exists(spec_path) and os.path.samefile(path, spec_path):
         raise UsageError(f"{path}: is the spec itself")
-    parent = os.path.dirname(os.path.abspath(path))
-    probe = parent
-    while not os.path.exists(probe):
-        probe = os.path.dirname(probe)
-    if not os.path.isdir(probe):
-        raise UsageError(f"{path}: {probe} is not a directory")
-    if not os.access(probe, os.W_OK | os.X_OK):
-        raise UsageError(f"{path}: cannot write in {probe} (permission denied)")
+    check_parent_writable(path)
 
 
 def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers: int | None = None,

@@ -127,7 +127,8 @@ def integrate(model: str, delta: float, chi: float, omega0, settings: Settings, 
         b = min(len(t) - 1, (a // per + 1) * per)   # a decade of samples (the first segment adds 0 -> tau_start)
         seg = t[a:b + 1]
         w, _, nf, ns, _, st, _ = KN.lie_dop853(mid, J, g, out[a].copy(), q0, seg, settings.rtol, settings.atol, np.inf,
-                                               False, max(1, settings.max_steps - nsteps), False, *KN.DOP853_ARRAYS, stop)
+                                               False, max(1, settings.max_steps - nsteps), False, np.inf,
+                                               *KN.DOP853_ARRAYS, stop)
         nsteps += int(ns)
         nfev += int(nf)
         if st != ST.OK:

@@ -31,9 +31,14 @@ def same(a, b):
     lambda: spinviz.simulate(P.dast_cube(), "reduced", (0.0, W, W), t_end=1e5, samples=30),      # secular, CGS
     lambda: spinviz.simulate(B.symmetric_top(0.3, 0.7), "free", (0.0, 0.05, 0.3), t_end=10.0, samples=5,
                              kinematics="none"),
-], ids=["quaternion", "euler_zxz", "secular-cgs", "no-orientation"])
+    # secular with a hand-over into full (domain "?"): the stats hold nested [time, "full"] lists
+    lambda: spinviz.simulate(B.symmetric_top(0.8, 1.17), "reduced", (1.573e-5, -2.458e-5, 6.944e-6),
+                             t_end=1.18e8, samples=11, method="secular"),
+], ids=["quaternion", "euler_zxz", "secular-cgs", "no-orientation", "secular-segments"])
 def test_save_and_load_round_trip_exactly(make, tmp_path):
     tr = make()
+    if tr.stats["method"] == "secular" and tr.body.name == "symmetric top":
+        assert tr.stats["segments"] and tr.stats["segments"][0][1] == "full"
     tr.save(tmp_path / "run.npz")
     back = spinviz.Trajectory.load(tmp_path / "run.npz")
     same(tr, back)

@@ -32,9 +32,9 @@ def _parser() -> argparse.ArgumentParser:
     sub.required = True
 
     c = sub.add_parser("check", help="validate the integrators against the paper's closed forms, and secular against "
-                                     "full integration at real scales (~3.5 min)")
+                                     "full integration at real scales (~2.5 min)")
     c.add_argument("--json", action="store_true", help="print a JSON list of records instead of a table")
-    c.add_argument("--quick", action="store_true", help="secular comparisons at tau0 |Omega0| = 1e-4, 1e-5 only (~30 s)")
+    c.add_argument("--quick", action="store_true", help="secular comparisons at tau0 |Omega0| = 1e-4, 1e-5 only (~16 s)")
 
     i = sub.add_parser("info", help="derived quantities of a preset or scene, beside the paper's figures")
     i.add_argument("target", help="a preset name (cellulose_rod, dast_cube, dast_family1) or a scene file")

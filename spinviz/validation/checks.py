@@ -304,10 +304,9 @@ def check_secular(name: str, delta: float, chi: float, epsilons=SECULAR_EPS, hor
                        phase_error_estimate_rad=tr.stats["phase_error_rad"],
                        L_uncertainty_predicted_rad=tr.stats["L_direction_uncertainty_rad"],
                        steps=tr.stats["nsteps"], steps_full=ref.stats["nsteps"])
-            ok &= slow <= 2.0 * tr.stats["slow_error_estimate"] + 1e-8
-            if tr.phase_resolved:
-                ref_phase_error = 10.0 * RTOL * 2.0 * math.pi * tr.stats["turns"]
-                ok &= mis <= 2.0 * tr.stats["phase_error_rad"] + ref_phase_error
+            ok &= slow <= tr.stats["slow_error_estimate"] + 1e-8        # 1e-8: the slow metric's floor
+            ref_phase_error = 10.0 * RTOL * 2.0 * math.pi * tr.stats["turns"]   # the reference's own
+            ok &= mis <= tr.stats["phase_error_rad"] + ref_phase_error
             row["slow_error_estimate"] = tr.stats["slow_error_estimate"]
         rows.append(row)
     slow = [r.get("rel_error_slow") for r in rows]
@@ -319,7 +318,7 @@ def check_secular(name: str, delta: float, chi: float, epsilons=SECULAR_EPS, hor
         description=f"{name}: secular vs full at tau0 Omega = {', '.join(f'{e:g}' for e in epsilons)}, {horizon_T:g} T",
         passed=bool(ok),
         max_error=float(worst),
-        criterion="errors within 2x what secular states (slow variables, resolved phases); a declined run's L "
+        criterion="errors within what secular states (slow variables, orientation); a declined run's L "
                   "uncertainty within 2x the measured turn of L, and auto then within 1e-5",
         runtime_s=time.perf_counter() - start,
         details={"rows": rows, "order_in_eps_slow": order},

@@ -16,7 +16,7 @@ from . import rotations as R
 from . import units as U
 from .errors import SimulationError
 from .integrators import get
-from .integrators.auto import check_cost, choose_method
+from .integrators.auto import HARD_MAX_TURNS, check_cost, choose_method, estimated_turns
 from .integrators.scaling import body_spin_problem, check_scale
 from .physics.bodies import Body
 from .physics.equations import truncated_singularity
@@ -65,18 +65,22 @@ def simulate(
     time_scale = eps / body.tau0                   # spin-unit time per unit of t
     method = str(method).lower()
     auto = method == "auto"
-    check_cost(body, model, omega0, float(t_eval[-1]), method, step, spin=(problem, eps), kinematics=kinematics)
+    horizon = float(t_eval[-1])
     if auto:
-        method, reason = choose_method(body, model, omega0, float(t_eval[-1]), kinematics, spin=(problem, eps))
+        method, reason = choose_method(body, model, omega0, horizon, kinematics, spin=(problem, eps))
     else:
         reason = "chosen by the user"
+    check_cost(body, model, omega0, horizon, "auto" if auto else method, step, spin=(problem, eps),
+               kinematics=kinematics, picked=method if auto else None)
+    # a declining secular run can be handed to lie-dop853 when that one's cost check would pass
+    resolvable = (auto and method == "secular"
+                  and estimated_turns(body, model, omega0, horizon, (problem, eps)) <= HARD_MAX_TURNS)
     integrator = _integrator(method, body, kinematics)
     kw = {"rtol": rtol, "atol": atol}
     if step is not None:
         kw["step"] = step * time_scale
     start = time.perf_counter()
-    sol, integrator, reason = _solve(integrator, problem, kw, auto, reason, time_scale,
-                                     resolvable=auto and _resolvable(body, model, omega0, float(t_eval[-1]), kinematics))
+    sol, integrator, reason = _solve(integrator, problem, kw, auto, reason, time_scale, resolvable=resolvable)
     runtime = time.perf_counter() - start
     stats = _stats_in_units(sol.stats, time_scale)
     stats.update(method=integrator.name, method_reason=reason, runtime_s=runtime, eps_rad=eps, rtol=rtol, atol=atol)
@@ -120,15 +124,6 @@ def initial_orientation(q0=None, euler_zxz0=None):
         return q, R.euler_zxz_from_quat(q)
     euler = np.asarray(euler_zxz0, dtype=float)
     return R.quat_from_euler_zxz(euler), euler
-
-
-def _resolvable(body, model, omega0, t_end, kinematics) -> bool:
-    """Whether lie-dop853 could take over this run (the cost check passes)."""
-    try:
-        check_cost(body, model, omega0, t_end, "lie-dop853", kinematics=kinematics)
-        return True
-    except ValueError:
-        return False
 
 
 def check_truncated_solvable(body: Body, omega0) -> None:

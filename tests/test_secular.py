@@ -17,7 +17,7 @@ from spinviz.physics import presets as P
 W = math.pi * 1e10                      # the spin of section 6, rad/s
 
 
-NODES = np.cos(2 * np.pi * np.arange(SF.M_PHASES) / SF.M_PHASES), np.sin(2 * np.pi * np.arange(SF.M_PHASES) / SF.M_PHASES)
+NODES = SF.phase_nodes(SF.M_PHASES)
 
 
 def averaged(delta, chi, wp, w3, scale=1.0):

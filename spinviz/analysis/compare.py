@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import rotations as R
+from .. import units as U
 from ..plotting import pyplot, save
 from ..trajectory import Trajectory
 from ..units import format_time
@@ -147,7 +148,6 @@ def format_table(c: Comparison, title: str) -> str:
     return "\n".join(lines)
 
 
-_YEAR = 365.25 * 86400.0
 DIFF_STYLES = {"misorientation": ("0.6", "-."), "dipoles": ("0.35", "--"), "cone": ("0.0", "-")}
 
 
@@ -164,14 +164,14 @@ def time_unit(t_end: float, units: str) -> tuple[float, str]:
     beyond a million), or τ₀ for dimensionless runs."""
     if units != "cgs":
         return 1.0, "time t (τ₀)"
-    if t_end >= 2e6 * _YEAR:
-        return 1e6 * _YEAR, "time t (million years)"
-    if t_end >= 2 * _YEAR:
-        return _YEAR, "time t (years)"
-    if t_end >= 2 * 86400.0:
-        return 86400.0, "time t (days)"
-    if t_end >= 2 * 3600.0:
-        return 3600.0, "time t (hours)"
+    if t_end >= 2e6 * U.YEAR:
+        return 1e6 * U.YEAR, "time t (million years)"
+    if t_end >= 2 * U.YEAR:
+        return U.YEAR, "time t (years)"
+    if t_end >= 2 * U.DAY:
+        return U.DAY, "time t (days)"
+    if t_end >= 2 * U.HOUR:
+        return U.HOUR, "time t (hours)"
     return 1.0, "time t (s)"
 
 

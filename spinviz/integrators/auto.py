@@ -26,8 +26,8 @@ def braking_coefficient(problem) -> float:
     if s.is_symmetric:
         wp, p0 = math.hypot(w[0], w[1]), math.atan2(w[1], w[0])
         p = p0 + 2.0 * math.pi * np.arange(32) / 32
-        a = np.array(rad(wp * np.cos(p), wp * np.sin(p), np.full(p.shape, w[2])))
         ws = np.stack([wp * np.cos(p), wp * np.sin(p), np.full(p.shape, w[2])])
+        a = np.array(rad(*ws))
         decay = -float(np.mean(np.sum(ws * a, axis=0)))
     else:
         decay = -float(np.dot(w, rad(*w)))
@@ -40,15 +40,16 @@ MAX_FIXED_STEPS = 1e10
 
 
 def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", step: float | None = None,
-               spin=None, kinematics: str = "quaternion") -> None:
+               spin=None, kinematics: str = "quaternion", picked: str | None = None) -> None:
     """Refuse, before any work, a run that cannot finish: more than 1e10 fixed steps, or more
     than ``HARD_MAX_TURNS`` turns (estimated with braking) for a method that resolves every
     turn.  ``secular`` follows the slow variables instead and has no such limit; ``auto`` is
-    judged by the method it picks.  ``SpecError`` names "step" or "t_end"."""
+    judged by the method it picks (``picked``, when the caller has already chosen it).
+    ``SpecError`` names "step" or "t_end"."""
     method = str(method).lower()
     auto = method == "auto"
     if auto:
-        method = choose_method(body, model, omega0, t_end, kinematics, spin=spin)[0]
+        method = picked or choose_method(body, model, omega0, t_end, kinematics, spin=spin)[0]
     if get(method).fixed_step:
         if step is not None and t_end / step > MAX_FIXED_STEPS:
             raise SpecError("step", f"t_end / step = {t_end / step:.3g} steps; at most {MAX_FIXED_STEPS:g} can finish")

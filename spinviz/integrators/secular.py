@@ -65,6 +65,16 @@ class Setup:
     eps: float
     equivariant: bool
 
+    @property
+    def J3(self) -> float:
+        """I3 / I1."""
+        return float(self.system.inertia[2]) / float(self.system.inertia[0])
+
+    @property
+    def delta(self) -> float:
+        """1 - I3 / I1: the precession rate is delta w3."""
+        return 1.0 - self.J3
+
 
 def prepare(problem: Problem) -> Setup:
     """Validate and set up (raises ``NotApplicable`` with the reason)."""
@@ -107,17 +117,18 @@ def resonance_kicks(setup: Setup, crossings) -> list[dict]:
     s = setup.system
     J = tuple(float(x) for x in s.inertia)
     g = tuple(float(x) for x in s.coupling)
-    J3 = J[2] / J[0]
-    delta = 1.0 - J3
+    J3, delta = setup.J3, setup.delta
     model = ST.MODEL_ID[s.model]
     M = SF.M_PHASES
-    cM, sM = np.cos(2 * np.pi * np.arange(M) / M), np.sin(2 * np.pi * np.arange(M) / M)
+    cM, sM = SF.phase_nodes(M)
     out = []
     for t, wp, w3, m in crossings:
         Lc = math.hypot(wp, J3 * w3)
+        if Lc == 0.0:
+            continue
         dwp, dw3, _, _ = SF.avg_rates(model, J, g, wp, w3, cM, sM, setup.equivariant)
         Fdot = abs((wp * dwp + J3 * J3 * w3 * dw3) / Lc - m * delta * dw3)
-        if Fdot == 0.0 or Lc == 0.0:
+        if Fdot == 0.0:
             continue
         c = SF.torque_harmonic(model, J, g, wp, w3, int(m), M)
         out.append({"m": int(m), "t": float(t), "kick_rad": float(c / Lc * math.sqrt(2.0 * math.pi / Fdot))})
@@ -141,8 +152,8 @@ def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, st
     J = tuple(float(x) for x in s.inertia)
     g = tuple(float(x) for x in s.coupling)
     out, cnt, switches, recorded, status = call_stoppable(
-        SF.hybrid_dop853, ST.MODEL_ID[s.model], J, g, setup.w0, t, float(rtol), float(atol), MU_STAR, True,
-        setup.equivariant, MAX_STEPS, _phi0(setup), *KN.DOP853_ARRAYS)
+        SF.hybrid_dop853, ST.MODEL_ID[s.model], J, g, setup.w0, t, float(rtol), float(atol), MU_STAR, setup.equivariant,
+        MAX_STEPS, _phi0(setup), *KN.DOP853_ARRAYS)
     stats = _stats(setup, cnt, switches, rtol, t)
     if status != ST.OK:
         if status == ST.TOO_MANY_STEPS and cnt[8] >= REGIME5_SIGN_CHANGES:
@@ -165,10 +176,9 @@ def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, st
     # a resonant kick also moves L relative to the body, i.e. the split of |L| between omega_perp and
     # omega3 (measured with L_TOL lifted: delta = 0.8, chi = 1.16, eps = 3e-5: slow error 2.8e-4 against
     # a kick of 2.6e-4), and that error in omega3 drifts the phases for the rest of the run
-    delta = 1.0 - J[2] / J[0]
     # (1.5: measured turns of L are 0.57-1.13 x the predicted kick in spinviz check)
     stats["slow_error_estimate"] += 1.5 * kick_rss
-    stats["phase_error_rad"] += 1.5 * abs(delta) * kick_rss * float(t[-1] - t[0])
+    stats["phase_error_rad"] += 1.5 * abs(setup.delta) * kick_rss * float(t[-1] - t[0])
     if kick_rss > L_TOL:
         first = crossings[0]
         return failed(f"the run crosses the resonance |L|/I1 = {first['m']} delta omega3 at {first['t'] / t[-1]:.3g} of the "
@@ -177,7 +187,7 @@ def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, st
     o = out
     phi, p = o[:, 3], o[:, 4]
     wp, w3 = np.hypot(o[:, 0], o[:, 1]), o[:, 2]
-    J3 = J[2] / J[0]
+    J3 = setup.J3
     theta_L = np.arctan2(wp, J3 * w3)
     psi = 0.5 * np.pi - p
     omega, q = pose_about_L(setup.q_L, phi, theta_L, psi, wp, w3, setup.q_frame,
@@ -234,7 +244,7 @@ def _stats(setup: Setup, cnt, switches, rtol: float, t) -> dict:
         slow_err += max(15.0 * eps * eps, cnt[6] ** 2) + cnt[12]
     # an error in omega3 is an error in the precession rate delta omega3: it feeds the phases
     # for the rest of the run (measured: a hand-over's 1e-6 became 1.4e-2 rad over 0.9 T)
-    delta = 1.0 - float(setup.system.inertia[2]) / float(setup.system.inertia[0])
+    delta = setup.delta
     phase_err += abs(delta) * slow_err * float(t[-1] - t[0])
     # a full stretch carries the errors made before it forward, and in domain "?" (omega3 -> 0, the
     # precession stops) the dynamics amplify them: a hand-over's 1.6e-6 in omega3 grew to 2.1e-4 (7x
@@ -252,7 +262,6 @@ def _stats(setup: Setup, cnt, switches, rtol: float, t) -> dict:
         "equivariant": setup.equivariant,
         "slow_error_estimate": float(slow_err),
         "phase_error_rad": float(phase_err), "phases_resolved": not regime5,
-        "averaging_error_order": eps,
     }
 
 

@@ -253,8 +253,18 @@ def to_full(model, J, g, cM, sM, y, use_nit):
 
 
 @_jit
-def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, max_steps, phi0, A, B, E3, E5, D,
-                  stop):
+def phase_nodes(M):
+    """(cos p_k, sin p_k) at the M equally spaced phases p_k = 2 pi k / M the averages sample."""
+    cM = np.empty(M)
+    sM = np.empty(M)
+    for k in range(M):
+        cM[k] = math.cos(2.0 * math.pi * k / M)
+        sM[k] = math.sin(2.0 * math.pi * k / M)
+    return cM, sM
+
+
+@_jit
+def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_steps, phi0, A, B, E3, E5, D, stop):
     """Integrate from the body-frame w0 (spin units) over t_eval.
 
     Returns (out (N, 6): w1, w2, w3, phi, p, mode at each output; counters (16,); switches
@@ -263,7 +273,7 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
     fixed L, from phi0; p: the unwrapped body-frame phase of omega_perp (psi = pi/2 - p).
     counters: 0 steps FULL, 1 steps AVG, 2 evaluations FULL, 3 evaluations AVG, 4 rejected
     steps, 5 switches, 6 the largest mu_ad met in AVG, 7 precession turns in FULL, 8 sign
-    changes of w3, 9 the time of the last and 13 of the first, 10 the integral of mu^2 dt over
+    changes of w3, 13 the time of the first (9, 14, 15 unused), 10 the integral of mu^2 dt over
     AVG (mu = eps |w|^2 / |delta w3|), 11 the phase Sigma covered in FULL, 12 the largest
     forced-response error met in AVG."""
     N = t_eval.shape[0]
@@ -277,12 +287,7 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
     ncross = 0
     Fold = np.empty(4)
     Fnew = np.empty(4)
-    M = M_PHASES
-    cM = np.empty(M)
-    sM = np.empty(M)
-    for k in range(M):
-        cM[k] = math.cos(2.0 * math.pi * k / M)
-        sM[k] = math.sin(2.0 * math.pi * k / M)
+    cM, sM = phase_nodes(M_PHASES)
     eps = g[0] * g[0] + g[1] * g[1] + g[2] * g[2]
     delta = 1.0 - J[2]
     K = np.zeros((16, n))
@@ -298,7 +303,7 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
         mode = FULL if mu_ad(FULL, y, eps, delta) > mu_star else AVG
     dphi = 0.0
     if mode == AVG:
-        dphi = to_avg(model, J, g, cM, sM, y, p_unw, use_nit and not equiv)
+        dphi = to_avg(model, J, g, cM, sM, y, p_unw, not equiv)
     sgn = 1.0 if w0[2] >= 0.0 else -1.0
     y[3] = phi0 + dphi + sgn * (0.5 * math.pi - (y[2] if mode == AVG else p_unw))
     detunings(mode, y, J[2], delta, Fold)
@@ -365,7 +370,7 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
                 else:
                     out[j_out, 3] = ys[3] - sgn * (0.5 * math.pi - ys[2])
                     wp_o, w3_o, p_o = ys[0], ys[1], ys[2]
-                    if use_nit and not equiv:
+                    if not equiv:
                         u = nit(model, J, g, cM, sM, wp_o, w3_o, p_o)
                         wp_o, w3_o, p_o = wp_o + u[0], w3_o + u[1], p_o + u[2]
                         out[j_out, 3] += u[3]
@@ -415,7 +420,6 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
             y[3] += (s_new - sgn) * psi_now
             sgn = s_new
             cnt[8] += 1
-            cnt[9] = t
             if cnt[13] < 0.0:
                 cnt[13] = t
             rhs(mode, sgn, model, J, g, cM, sM, equiv, y, K[0])
@@ -426,14 +430,14 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, use_nit, equiv, 
             switch = False
             phi_now = y[3] - sgn * (0.5 * math.pi - (y[2] if mode == AVG else p_unw))
             if mode == FULL and mu < HYST * mu_star:
-                phi_now += to_avg(model, J, g, cM, sM, y, p_unw, use_nit)
+                phi_now += to_avg(model, J, g, cM, sM, y, p_unw, True)
                 mode = AVG
                 switch = True
             elif mode == AVG:
                 if mu > cnt[6]:
                     cnt[6] = mu
                 if mu > mu_star:
-                    p_unw, dphi = to_full(model, J, g, cM, sM, y, use_nit)
+                    p_unw, dphi = to_full(model, J, g, cM, sM, y, True)
                     phi_now += dphi
                     mode = FULL
                     switch = True

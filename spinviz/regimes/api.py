@@ -13,7 +13,6 @@ store lacks, with the same numbers.
 
 from __future__ import annotations
 
-import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -21,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..atomic import check_parent_writable
-from ..errors import UsageError
+from ..errors import UsageError, printable
 from . import runs as RN
 from . import store as ST
 from .spec import AtlasSpec, load_spec
@@ -184,7 +183,7 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
             if not exists:
                 ST.create(spec, out, chunks)
             writer = ST.Writer(out, expected, flush_s=flush_s)
-            bar = Progress(todo, f"atlas {os.path.basename(out)}", enabled=progress)
+            bar = Progress(todo, f"atlas {printable(os.path.basename(out), 80)}", enabled=progress)
             try:
                 stats = execute(cl, batches, keys, writer, bar, on_result=on_result)
             finally:
@@ -202,9 +201,3 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
 
         res.plots = draw(out, plots)
     return res
-
-
-def projected_wall_s(runs: int, s_per_run: float, cores: int, overhead_share: float) -> float:
-    """Wall time of ``runs`` runs at ``s_per_run`` each on ``cores`` cores, with the measured
-    overhead share of worker time (the benchmark's projection)."""
-    return runs * s_per_run / cores / max(1e-9, 1.0 - overhead_share) if cores > 0 else math.inf

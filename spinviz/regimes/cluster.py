@@ -37,10 +37,10 @@ CONNECT_TIMEOUT_S = 10.0
 
 
 def worker_info() -> dict:
-    """Run on a worker: its pid, spinviz version and the kernel warm-up time."""
+    """Run on a worker: its pid and spinviz version (``WarmUp`` has already loaded the kernel)."""
     from .. import __version__
 
-    return {"pid": os.getpid(), "version": __version__, "warm_s": RN.warm(), "max_rss_mb": RN.max_rss_mb()}
+    return {"pid": os.getpid(), "version": __version__}
 
 
 class WarmUp(WorkerPlugin):
@@ -65,9 +65,6 @@ class WarmUp(WorkerPlugin):
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
                 signal.signal(signal.SIGHUP, signal.SIG_IGN)
         RN.warm()
-
-    def teardown(self, worker=None):
-        pass
 
 
 class Cluster:

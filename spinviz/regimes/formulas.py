@@ -31,6 +31,7 @@ import math
 
 import numpy as np
 
+from ..physics import closed_forms as CF
 from ..physics import presets as P
 
 NAN = float("nan")
@@ -88,7 +89,7 @@ def type4_eq4_18(delta: float, chi: float) -> dict:
         return {"beta": -(2.0 + delta) / (2.0 * (1.0 - delta)), "A2": 1.0, "A2_printed": 0.0, "in_domain": False}
     beta = -(2.0 + delta) * xi / (2.0 * (1.0 - delta) * (xi + 2.0))
     in_dom = delta > -0.5 and xi > xi_eq4_17(delta) and (delta <= 0.0 or xi < xi_eq4_20(delta))
-    return {"beta": beta, "A2": (1.0 + xi) / (2.0 + xi), "A2_printed": 1.0 / (2.0 - xi) if xi != 2.0 else math.inf,
+    return {"beta": beta, "A2": CF.spiral4_amplitude_sq_eq4_18(chi), "A2_printed": 1.0 / (2.0 - xi) if xi != 2.0 else math.inf,
             "in_domain": bool(in_dom)}
 
 

@@ -19,7 +19,7 @@ import os
 
 import numpy as np
 
-from ..atomic import Outputs
+from ..atomic import Outputs, check_outputs
 from ..errors import UsageError
 from ..plotting import pyplot
 from . import formulas as FM
@@ -44,7 +44,7 @@ def check_plot_paths(path: str, out: str, spec=None) -> list[str]:
         if os.path.abspath(p).startswith(os.path.abspath(out) + os.sep) or os.path.abspath(p) == os.path.abspath(out):
             raise UsageError(f"--plot: {p}: inside the store {out}")
     inputs = [spec.path] if spec is not None and os.path.exists(spec.path) else []
-    Outputs(paths, inputs)                      # checks only (writable, not a directory, not an input)
+    check_outputs(paths, inputs)
     return paths
 
 

@@ -89,6 +89,7 @@ class Run:
     nfev: int
     seconds: float
     reason: str = ""
+    verdict: C.Verdict | None = None     # the classification already made of exactly these samples
 
 
 def integrate(model: str, delta: float, chi: float, omega0, settings: Settings, stop=None) -> Run:
@@ -143,7 +144,8 @@ def integrate(model: str, delta: float, chi: float, omega0, settings: Settings, 
             if v.label == "R" and v.confidence >= 0.9:
                 status, reason = STOPPED_RESIDUAL, f"residual rotation about d reached by tau = {t[a]:.3g} (exact end state)"
                 break
-    return Run(t[:a + 1], out[:a + 1], status, nsteps, nfev, time.perf_counter() - t0, reason)
+    return Run(t[:a + 1], out[:a + 1], status, nsteps, nfev, time.perf_counter() - t0, reason,
+               v if status == STOPPED_RESIDUAL else None)
 
 
 @dataclass
@@ -188,7 +190,7 @@ def run_and_classify(model: str, delta: float, chi: float, omega0, settings: Set
     if r.status not in (ST.OK, STOPPED_RESIDUAL, ST.TOO_MANY_STEPS):
         return Record("failed", "failed", "none", 0.0, r.status, r.reason, nan_ev, **base)
     try:
-        v = C.classify(r.tau, r.omega, delta, chi, model, settings.window)
+        v = r.verdict if r.verdict is not None else C.classify(r.tau, r.omega, delta, chi, model, settings.window)
         cut = r.tau <= reached / 10.0**settings.window * (1.0 + 1e-9)
         early = C.classify(r.tau[cut], r.omega[cut], delta, chi, model, settings.window).label
     except Exception as e:

@@ -47,7 +47,7 @@ import hashlib
 import json
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -83,7 +83,6 @@ class AtlasSpec:
     settings: Settings
     seed: int | None = None
     omega_magnitude: float | None = None
-    grid_given: dict = field(default_factory=dict)
 
     @property
     def members(self) -> int:
@@ -133,15 +132,15 @@ def parse_spec(data: dict, path: str = "<atlas spec>") -> AtlasSpec:
     description = top.string("description", default="") or ""
     models = _models(top)
     grid = top.sub("grid", required=True)
-    deltas, dgiven = _axis(grid, "delta", (-1.0, 1.0), open_ends=True, unit="")
+    deltas = _axis(grid, "delta", (-1.0, 1.0), open_ends=True, unit="")
     if grid.has("chi") and grid.has("chi_deg"):
         raise grid.error("chi", "give chi (rad) or chi_deg, not both")
     if grid.has("chi_deg"):
-        chis_deg, cgiven = _axis(grid, "chi_deg", (0.0, 90.0), open_ends=False, unit=" deg")
+        chis_deg = _axis(grid, "chi_deg", (0.0, 90.0), open_ends=False, unit=" deg")
         chis = np.radians(chis_deg)
         chis[chis_deg == 90.0] = 0.5 * math.pi             # exactly pi/2: the transverse case (5.5)
     else:
-        chis, cgiven = _axis(grid, "chi", (0.0, 0.5 * math.pi), open_ends=False, unit=" rad", required=True)
+        chis = _axis(grid, "chi", (0.0, 0.5 * math.pi), open_ends=False, unit=" rad", required=True)
     grid.finish()
     for d in deltas:
         if 1.0 - d < MIN_INERTIA_RATIO:
@@ -153,8 +152,7 @@ def parse_spec(data: dict, path: str = "<atlas spec>") -> AtlasSpec:
     if n_runs > MAX_RUNS:
         raise SceneError(path, "[grid]", f"{n_runs} runs exceed the limit of {MAX_RUNS}")
     return AtlasSpec(path=path, title=title, description=description, models=models, deltas=deltas, chis=chis,
-                     omega0=omega0, settings=settings, seed=seed, omega_magnitude=mag,
-                     grid_given={"delta": dgiven, "chi": cgiven})
+                     omega0=omega0, settings=settings, seed=seed, omega_magnitude=mag)
 
 
 def _models(top: _Table) -> tuple:
@@ -196,7 +194,7 @@ def _axis(t: _Table, k: str, bounds: tuple, open_ends: bool, unit: str, required
             raise r.error("cells", f"at most {MAX_CELLS}, got {n}")
         v = a + (np.arange(n) + 0.5) * (b - a) / n
         v[np.abs(v) < 1e-12 * (b - a)] = 0.0       # an odd count centred on 0 hits it exactly (delta = 0: (5.2))
-        return v, {"min": a, "max": b, "cells": n}
+        return v
     if isinstance(v, list):
         if not v:
             raise t.error(k, "is empty: give at least one value, or {min, max, cells}")
@@ -215,7 +213,7 @@ def _axis(t: _Table, k: str, bounds: tuple, open_ends: bool, unit: str, required
             raise t.error(k, "values must increase")
         if len(vals) > MAX_CELLS:
             raise t.error(k, f"at most {MAX_CELLS} values, got {len(vals)}")
-        return np.array(vals), {"values": vals}
+        return np.array(vals)
     raise t.error(k, f"must be a list of values or a table {{min, max, cells}}, got {brief(v)}")
 
 

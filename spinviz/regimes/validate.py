@@ -57,17 +57,18 @@ def run(members: int = 32, workers: int | None = None, tau_end: float = 1e10, po
             shares = Counter(labels)
             top = shares.most_common(1)[0][0]
             sel = np.array([lab == top for lab in labels])
-            ev = {q: ds[q].values[sel] for q in C.EVIDENCE}
+            vals = {q: ds[q].values for q in C.EVIDENCE}        # read from the store once
+            ev = {q: v[sel] for q, v in vals.items()}
             devs = {}
             for k in range(members):
                 if sel[k]:
-                    e = {q: float(ds[q].values[k]) for q in C.EVIDENCE}
+                    e = {q: float(v[k]) for q, v in vals.items()}
                     for key, val in C.deviations(top, e, d, math.radians(cdeg), model).items():
                         devs.setdefault(key, []).append(val)
             rows.append({"point": name, "model": model, "delta": d, "chi_deg": cdeg, "omega0": w, "members": members,
                          "shares": dict(shares), "label": top,
                          "median": {q: float(np.median(ev[q])) for q in ("slope_perp", "slope_3", "X2", "Y2", "w2_tau",
-                                                                         "libration_A2", "h_mean", "confidence")
+                                                                         "libration_A2", "h_mean")
                                     if q in ev},
                          "deviations": {k: (float(np.median(v)), float(np.min(v)), float(np.max(v))) for k, v in devs.items()},
                          "seconds": res.seconds,
@@ -114,10 +115,6 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
-
-
 # --- the diagram against the domains ---------------------------------------------------------
 def paper_domain(delta: float, chi: float) -> str:
     """The type figure 2 assigns to a cell: (4.15) "2", (4.17) "3", (4.19) "4", (4.20) "?",
@@ -151,7 +148,7 @@ def spinviz_domain(delta: float, chi: float) -> str:
 
 
 def compare_domains(ds, model: str = "reduced") -> dict:
-    """Majority label of each cell against ``paper_domain`` and ``spinviz_domain``:
+    """``ds``: ``store.open_atlas(path)``.  Majority label of each cell against ``paper_domain`` and ``spinviz_domain``:
     {"paper": {domain: Counter of majority labels}, "spinviz": {...}, "cells": n, "agree_spinviz": k}."""
     lab = ds["label"].sel(model=model).values
     out = {"paper": {}, "spinviz": {}, "cells": 0, "agree_spinviz": 0, "agree_paper": 0, "share_other": 0.0}
@@ -166,3 +163,7 @@ def compare_domains(ds, model: str = "reduced") -> dict:
             out["agree_paper"] += maj == p
     out["share_other"] = float(np.isin(lab, ["other", "1|2", "4|5"]).mean())
     return out
+
+
+if __name__ == "__main__":
+    sys.exit(main())

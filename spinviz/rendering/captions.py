@@ -12,7 +12,6 @@ from .. import units as U
 
 # one colour per model everywhere: headings and inset of the videos, ``spinviz compare``'s plots
 MODEL_COLORS = {"reduced": (0, 128, 128), "truncated": (136, 60, 180), "free": (120, 120, 120)}
-MODEL_LABELS = {"reduced": "reduced (2.2)+(2.3)", "truncated": "truncated (2.5)", "free": "free (d = 0)"}
 
 # (heading, equation numbers) per model and register
 HEADINGS = {
@@ -94,9 +93,7 @@ def sim_time(t: float, units: str, register: str) -> str:
         return f"{_sig(t, 3) if t >= 1 else f'{t:.2g}'} τ₀"
     if register == "outreach":
         return people_time(t)
-    from ..units import human_time
-
-    return human_time(t)
+    return U.human_time(t)
 
 
 class Captions:
@@ -182,7 +179,7 @@ class Captions:
             if outreach:
                 out.append("log time: ticks 10× apart")
             else:
-                k = self.spec.log_knee or plan.t_end / 1000.0
+                k = self.spec.knee(plan.t_end)
                 out.append(f"time axis logarithmic after {sim_time(k, plan.units, 'physics')}")
         return out
 

@@ -38,9 +38,7 @@ class Mp4Writer:
     def close(self):
         self._gen.close()
 
-    def abort(self):
-        """Stop ffmpeg; the caller discards the temporary file."""
-        self._gen.close()
+    abort = close                          # stop ffmpeg; the caller discards the temporary file
 
 
 class GifWriter:

@@ -56,12 +56,6 @@ class Panel:
     angle_dL_deg: np.ndarray | None = None
     angle_dL_range_deg: np.ndarray | None = None
 
-    @property
-    def label(self) -> str:
-        from .captions import MODEL_LABELS
-
-        return MODEL_LABELS.get(self.model, self.model)
-
 
 @dataclass
 class FramePlan:
@@ -83,7 +77,6 @@ class FramePlan:
     dipole_body: np.ndarray  # unit, body frame
     spin_mode: str
     slowdown: np.ndarray | None = None      # (F,) true / shown phase rate (slowed mode)
-    time_label: str = ""
     notes: list[str] = field(default_factory=list)
     time_scale: tuple[str, float] | None = None
     phase_resolved: bool = True
@@ -102,8 +95,3 @@ class FramePlan:
 
         c = captions.Captions(self)
         return [c.heading(panel_index)[0], *c.readouts(panel_index, f), c.time_text(f), *c.notes(f)]
-
-    def footer(self) -> str:
-        from . import captions
-
-        return captions.Captions(self).footer()

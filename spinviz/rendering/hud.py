@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from PIL import Image, ImageFont
 
+from .. import units as U
 from .captions import MODEL_COLORS, Captions
 
 _FONT_DIRS = ("/usr/share/fonts/truetype/dejavu",)
@@ -194,7 +195,7 @@ def make_layout(plan, W: int, H: int, show) -> Layout:
     notes_rows = 1 if joined <= W - 2 * pad else notes_n
     wanted = {"headings": hud_on, "subtitle": hud_on, "readouts": hud_on, "legend": hud_on and bool(legend),
               "timebar": hud_on, "notes": hud_on and notes_n > 0, "title": hud_on and bool(cap.footer()),
-              "inset": "inset" in show and plan.panels[0].omega_mag is not None}
+              "inset": "inset" in show}
     sub_lines = 2
     steps = ("title", "subtitle2", "inset", "notes2", "subtitle", "notes", "legend", "timebar", "readouts", "headings")
     if not wanted["inset"]:
@@ -295,7 +296,7 @@ def bar_ticks(plan) -> list[tuple[float, str]]:
         step = _nice_step(end, 6)
         vals = np.arange(step, end * (1 + 1e-9), step)
     else:
-        k = (spec.log_knee or t_end / 1000.0) / unit
+        k = spec.knee(t_end) / unit
         lo = math.floor(math.log10(k))
         vals = np.array([10.0 ** e for e in range(lo, math.ceil(math.log10(end)) + 1) if 10.0 ** e <= end * (1 + 1e-9)])
         vals = vals[vals >= k * 0.5]
@@ -306,7 +307,7 @@ def bar_ticks(plan) -> list[tuple[float, str]]:
 
 
 def _people_unit(t_end: float) -> tuple[float, str]:
-    for unit, name in ((365.25 * 86400.0, "yr"), (86400.0, "d"), (3600.0, "h"), (60.0, "min")):
+    for unit, name in ((U.YEAR, "yr"), (U.DAY, "d"), (U.HOUR, "h"), (U.MINUTE, "min")):
         if t_end >= 2 * unit:
             return unit, name
     return 1.0, "s"
@@ -317,7 +318,7 @@ def _bar_position(plan, t: float) -> float:
     spec, t_end = plan.spec, plan.t_end
     if spec.time_map == "linear":
         return t / t_end
-    k = spec.log_knee or t_end / 1000.0
+    k = spec.knee(t_end)
     return math.log1p(t / k) / math.log1p(t_end / k)
 
 
@@ -350,7 +351,6 @@ class Hud:
         self.stamp = TextStamp()
         self.arrow_colors = arrow_colors
         self.axis_labels = list(axis_labels)
-        self.chips = []                  # (key, (x0, y0, x1, y1)) of each legend entry
         self._bar = None
         self._inset = None
         self.dirty = self._dirty_boxes()
@@ -424,7 +424,6 @@ class Hud:
             img[row.y:row.y + h, x0:x1] = color
             self.stamp.put(img, ((x0 + x1) // 2, row.y + h // 2), text, fonts.small, (255, 255, 255), anchor="mm",
                            clip=(x0, row.y, x1, row.y + h))
-            self.chips.append((key, (x0, row.y, x1, row.y + h)))
             x += w + gap
 
     def _make_bar(self, row):

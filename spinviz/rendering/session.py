@@ -226,9 +226,9 @@ class Solids:
         offsets = np.cumsum([0] + [p.points.shape[0] for p in parts])
         for p, lo, hi in zip(self.parts.values(), offsets[:-1], offsets[1:]):
             p["slice"] = slice(int(lo), int(hi))
-        tris = np.vstack([p.triangles + o for p, o in zip(parts, offsets[:-1])])
-        faces = np.c_[np.full(len(tris), 3), tris].ravel()
-        self.mesh = pv.PolyData(np.vstack([p.points for p in parts]), faces=faces)
+        joined = Part.join(parts)
+        faces = np.c_[np.full(len(joined.triangles), 3), joined.triangles].ravel()
+        self.mesh = pv.PolyData(joined.points, faces=faces)
         self.mesh.point_data["rgb"] = np.zeros((self.mesh.n_points, 3), dtype=np.uint8)
         self._rgb = self.mesh.point_data["rgb"]                  # shares memory with the VTK array
         self._vtk_rgb = self.mesh.GetPointData().GetArray("rgb")
@@ -341,6 +341,8 @@ class RenderSession:
 
     def __init__(self, plan, supersample: float = 2.0):
         self.plan = plan
+        self._d_from_x = rotation_x_to(plan.dipole_body)       # the dipole arrow in the body frame
+        self._trail_frames = int(round(plan.spec.trail_seconds * plan.spec.fps))
         spec = plan.spec
         self.size = spec.size                  # validated by the spec (RenderSpec.check_output)
         self.ss = float(supersample)
@@ -348,7 +350,6 @@ class RenderSession:
         self.show = set(spec.show)
         W, H = self.size
         self.layout = hud.make_layout(plan, W, H, self.show)
-        self.panel_width = self.layout.panel_width
         self.hodo_only = "hodograph" in self.show and not spec.needs_orientation
         self.camera = self._fit_camera()
         x0, y0, x1, y1 = self.layout.views[0]
@@ -367,6 +368,7 @@ class RenderSession:
         colors["body"] = tuple(int(round(255 * 0.6 * c)) for c in body_color(plan.body_name))
         self.hud = hud.Hud(plan, self.layout, hud.palette(spec.background), colors, self.labels)
         self.static = Image.fromarray(self.hud.static())
+        self._restore = [(self.static.crop(box), box[:2]) for box in self.hud.dirty]   # constant: crop once
         self._canvas = None
 
     # -- building ---------------------------------------------------------------------------
@@ -378,10 +380,7 @@ class RenderSession:
     def _lights(self):
         """Key light from the upper left, a weaker fill from the right and a head light, fixed
         in the world (relative to the fixed camera): adjacent faces get different tones."""
-        v = self._view_direction()
-        r = np.cross(-v, [0.0, 0.0, 1.0])
-        r /= np.linalg.norm(r)
-        u = np.cross(r, -v)
+        v, r, u = self.camera.view, self.camera.right, self.camera.up
 
         def unit(x):
             return x / np.linalg.norm(x)
@@ -543,7 +542,7 @@ class RenderSession:
             rot = matrix_from_quat(panel.q[f])
             if "body" in solids.parts:
                 solids.place("body", rot)
-            d_rot = rot @ rotation_x_to(self.plan.dipole_body)
+            d_rot = rot @ self._d_from_x
         for key in ("dipole", "L", "omega"):
             if key + "_shaft" not in solids.parts:
                 continue
@@ -622,7 +621,7 @@ class RenderSession:
             if solids.mesh is not None:
                 solids.commit()
             if "trail" in curves:
-                lo = max(0, f - int(round(plan.spec.trail_seconds * plan.spec.fps)))
+                lo = max(0, f - self._trail_frames)
                 idx = np.linspace(lo, f, TRAIL_POINTS).round().astype(int)
                 _set_points(curves["trail"], panel.dipole[idx])
             if "hodograph" in curves:
@@ -654,16 +653,12 @@ class RenderSession:
         if self._canvas is None:
             self._canvas = self.static.copy()
         else:
-            for box in self.hud.dirty:
-                self._canvas.paste(self.static.crop(box), box[:2])
+            for patch, corner in self._restore:
+                self._canvas.paste(patch, corner)
         img = self._canvas
         for (x0, y0, _, _), view in zip(self.layout.views, self.render_views()):
             img.paste(view, (x0, y0))
         return img
-
-    def render_raw(self) -> np.ndarray:
-        """The frame before the per-frame text: static layer and 3-D views, (H, W, 3) uint8."""
-        return np.asarray(self.compose())
 
     def frame(self, f: int) -> np.ndarray:
         """Frame f as an RGB uint8 array of shape (H, W, 3)."""

@@ -116,6 +116,10 @@ class RenderSpec:
     def frames(self) -> int:
         return max(2, int(round(self.duration * self.fps)))
 
+    def knee(self, t_end: float) -> float:
+        """The knee of the log time map: ``log_knee``, or t_end / 1000 by default."""
+        return self.log_knee or t_end / 1000.0
+
     # -- checks that need more than the spec ----------------------------------------------
     def check_horizon(self, t_end: float) -> None:
         """The log knee must lie inside the run, and not so far below t_end that float64

@@ -28,14 +28,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..units import format_time
 from .frameplan import FramePlan, Panel, ShapeInfo
 from .spec import RenderSpec
 
 if TYPE_CHECKING:
     from ..trajectory import Trajectory
 
-__all__ = ["FramePlan", "Panel", "frame_times", "plan_frames", "choose_spin_mode", "time_map_label", "time_scale"]
+__all__ = ["FramePlan", "Panel", "frame_times", "plan_frames", "choose_spin_mode", "time_scale"]
 
 MAX_TRUE_DEG_PER_FRAME = 30.0
 
@@ -49,19 +48,12 @@ def frame_times(spec: RenderSpec, t_end: float, frames: int | None = None):
         t = t_end * s
         slope = np.full(F, t_end / spec.duration)
     else:
-        k = spec.log_knee or t_end / 1000.0
+        k = spec.knee(t_end)
         base = 1.0 + t_end / k
         t = k * np.expm1(s * math.log(base))
         slope = k * math.log(base) * base**s / spec.duration
     t[-1] = t_end
     return v, t, slope
-
-
-def time_map_label(spec: RenderSpec, t_end: float, units: str) -> str:
-    if spec.time_map == "linear":
-        return "time: linear"
-    k = spec.log_knee or t_end / 1000.0
-    return f"time: logarithmic after {format_time(k, units)}"
 
 
 def _rotation_per_frame(trajs, sim_t) -> float:
@@ -143,8 +135,8 @@ def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = 
     body = trajs[0].body
     t_end = float(trajs[0].t[-1])
     video_t, sim_t, slope = frame_times(spec, t_end, frames)
-    mode, why = choose_spin_mode(spec, trajs, sim_t)
-    samples = [tr.sample(sim_t) for tr in trajs]
+    samples = [tr.sample(sim_t) for tr in trajs]   # once: choose_spin_mode's own sampling then returns these
+    mode, why = choose_spin_mode(spec, samples, sim_t)
     resolved = all(tr.phase_resolved for tr in trajs)
     ref = samples[0]
     w_ref = float(np.linalg.norm(ref.omega[0])) or 1.0
@@ -192,7 +184,7 @@ def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = 
     return FramePlan(
         spec=spec, video_t=video_t, sim_t=sim_t, panels=panels, units=body.units, body_name=body.name,
         shape=ShapeInfo.of(body.shape), dipole_body=np.asarray(body.dipole_direction, dtype=float), spin_mode=mode,
-        slowdown=slowdown, time_label=time_map_label(spec, t_end, body.units), notes=[f"spin: {mode} ({why})"],
+        slowdown=slowdown, notes=[f"spin: {mode} ({why})"],
         time_scale=time_scale(trajs, t_end), phase_resolved=resolved,
     )
 

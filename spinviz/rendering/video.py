@@ -186,7 +186,6 @@ class WorkerPool:
         self.stop = ctx.Event()
         self.msgs = ctx.Queue()
         self.tasks = [ctx.Queue() for _ in range(workers)]
-        self.t0 = time.perf_counter()
         self.procs = [ctx.Process(target=_pool_worker, daemon=True,
                                   args=(k, self.tasks[k], self.msgs, self.stop, os.getpid()))
                       for k in range(workers)]
@@ -254,9 +253,7 @@ def render_video(plan, out: str, workers: int | None = None, supersample: float 
     size = plan.spec.size
     supersample = supersample or SUPERSAMPLE
     F = plan.frames if max_frames is None else min(plan.frames, max_frames)
-    workers = pool.workers if pool is not None else plan_workers(plan.spec, out, workers, F)
-    if workers > 1 and F < 4 * workers:
-        workers = 1
+    workers = plan_workers(plan.spec, out, pool.workers if pool is not None else workers, F)
     poster_f = min(int(round(plan.spec.poster * (plan.frames - 1))), F - 1)
     paths = [out, poster_for(out)] if poster else [out]
     bar = _Progress(f"rendering {printable(out, 80)}", F, progress)

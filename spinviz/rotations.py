@@ -1,9 +1,10 @@
-"""Quaternion and SO(3) maths (wraps numpy-quaternion).
+"""Quaternion and SO(3) maths, in plain NumPy (numpy-quaternion for interchange, loaded lazily).
 
 Conventions (DESIGN.md, section 5):
 
 * quaternions are scalar-first float arrays, shape (..., 4), ordered (w, x, y, z);
-  numpy-quaternion's ``quaternion`` dtype is used inside for products and interpolation;
+  ``as_quaternion_array`` / ``as_float_quat`` convert to and from numpy-quaternion's
+  ``quaternion`` dtype for callers who work with it;
 * ``q`` represents O = R(q), the rotation that maps body-frame vectors to the world
   frame (r = O rho, as in section 2 of the paper), so ``world_from_body(q, v)`` = O v;
 * q and -q are the same rotation: compare rotations with ``misorientation`` or
@@ -11,13 +12,16 @@ Conventions (DESIGN.md, section 5):
 * ZXZ Euler angles (phi, theta, psi) in radians with O = Rz(phi) Rx(theta) Rz(psi), the
   convention of the Poisson equations (6.4) (checked in DESIGN.md, section 2).
 
-This module knows no physics and no rendering.
+This module knows no physics and no rendering, and imports nothing but NumPy: the products,
+matrices, exponentials and slerp below are a few vectorized lines each, while importing
+numpy-quaternion loads numba and scipy (0.3-1.2 s), which the simulation path, the render
+workers and ``import spinviz.physics`` must not pay.  numpy-quaternion is loaded only for
+interchange and for the matrix -> quaternion conversion (its branch-free Shepperd method).
 """
 
 from __future__ import annotations
 
 import numpy as np
-import quaternion as _nq
 
 __all__ = [
     "as_quaternion_array",
@@ -45,7 +49,9 @@ __all__ = [
 
 
 def as_quaternion_array(q):
-    """Float array (..., 4) (w, x, y, z) -> numpy-quaternion array (...)."""
+    """Float array (..., 4) (w, x, y, z) -> numpy-quaternion array (...) (loads numpy-quaternion)."""
+    import quaternion as _nq
+
     q = np.asarray(q, dtype=float)
     if q.shape[-1] != 4:
         raise ValueError(f"quaternion array must have last axis of length 4 (w, x, y, z); got shape {q.shape}")
@@ -54,6 +60,8 @@ def as_quaternion_array(q):
 
 def as_float_quat(qa) -> np.ndarray:
     """numpy-quaternion array (...) -> float array (..., 4), (w, x, y, z)."""
+    import quaternion as _nq
+
     return _nq.as_float_array(qa)
 
 
@@ -67,7 +75,17 @@ def normalize(q) -> np.ndarray:
 
 def multiply(a, b) -> np.ndarray:
     """Hamilton product a (x) b of float quaternions, shapes (..., 4) broadcast, (w, x, y, z)."""
-    return as_float_quat(as_quaternion_array(a) * as_quaternion_array(b))
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    for q in (a, b):
+        if q.shape[-1:] != (4,):
+            raise ValueError(f"quaternion array must have last axis of length 4 (w, x, y, z); got shape {q.shape}")
+    a0, a1, a2, a3 = np.moveaxis(a, -1, 0)
+    b0, b1, b2, b3 = np.moveaxis(b, -1, 0)
+    return np.stack([a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
+                     a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+                     a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1,
+                     a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0], axis=-1)
 
 
 def conjugate(q) -> np.ndarray:
@@ -81,10 +99,15 @@ def exp_rotvec(rotvec) -> np.ndarray:
     """Unit quaternion exp(rotvec / 2): rotation by |rotvec| rad about rotvec.
 
     rotvec : array_like, shape (..., 3), rad.  Returns shape (..., 4), (w, x, y, z).
-    Exact for any angle, including 0 (numpy-quaternion handles the small-angle limit).
+    Exact for any angle: sin(a/2)/a is taken from its Taylor series below a = 1e-4, where
+    the division would lose digits (and at a = 0 would divide by zero).
     """
     rotvec = np.asarray(rotvec, dtype=float)
-    return as_float_quat(_nq.from_rotation_vector(rotvec))
+    a = np.linalg.norm(rotvec, axis=-1)
+    small = a < 1e-4
+    safe = np.where(small, 1.0, a)
+    s = np.where(small, 0.5 - a * a / 48.0, np.sin(0.5 * safe) / safe)
+    return np.concatenate([np.cos(0.5 * a)[..., None], s[..., None] * rotvec], axis=-1)
 
 
 def quat_from_axis_angle(axis, angle) -> np.ndarray:
@@ -110,13 +133,13 @@ def quat_from_euler_zxz(angles) -> np.ndarray:
          sin(theta/2) sin((phi-psi)/2), cos(theta/2) sin((phi+psi)/2)).
     """
     a = np.asarray(angles, dtype=float)
-    if a.shape[-1] != 3:
+    if a.shape[-1:] != (3,):
         raise ValueError(f"Euler angles must have last axis of length 3 (phi, theta, psi); got shape {a.shape}")
     phi, theta, psi = a[..., 0], a[..., 1], a[..., 2]
-    qz_phi = as_quaternion_array(quat_from_axis_angle((0.0, 0.0, 1.0), phi))
-    qx_theta = as_quaternion_array(quat_from_axis_angle((1.0, 0.0, 0.0), theta))
-    qz_psi = as_quaternion_array(quat_from_axis_angle((0.0, 0.0, 1.0), psi))
-    return as_float_quat(qz_phi * qx_theta * qz_psi)
+    qz_phi = quat_from_axis_angle((0.0, 0.0, 1.0), phi)
+    qx_theta = quat_from_axis_angle((1.0, 0.0, 0.0), theta)
+    qz_psi = quat_from_axis_angle((0.0, 0.0, 1.0), psi)
+    return multiply(multiply(qz_phi, qx_theta), qz_psi)
 
 
 def euler_zxz_from_quat(q) -> np.ndarray:
@@ -162,12 +185,30 @@ def unwrap_euler_zxz(angles) -> np.ndarray:
 
 
 def matrix_from_quat(q) -> np.ndarray:
-    """Rotation matrix O = R(q), shape (..., 3, 3); q shape (..., 4), (w, x, y, z)."""
-    return _nq.as_rotation_matrix(as_quaternion_array(q))
+    """Rotation matrix O = R(q), shape (..., 3, 3); q shape (..., 4), (w, x, y, z), normalized here."""
+    q = np.asarray(q, dtype=float)
+    if q.shape[-1:] != (4,):
+        raise ValueError(f"quaternion array must have last axis of length 4 (w, x, y, z); got shape {q.shape}")
+    w, x, y, z = np.moveaxis(q, -1, 0)
+    s = 2.0 / (w * w + x * x + y * y + z * z)
+    m = np.empty(q.shape[:-1] + (3, 3))
+    m[..., 0, 0] = 1.0 - s * (y * y + z * z)
+    m[..., 0, 1] = s * (x * y - w * z)
+    m[..., 0, 2] = s * (x * z + w * y)
+    m[..., 1, 0] = s * (x * y + w * z)
+    m[..., 1, 1] = 1.0 - s * (x * x + z * z)
+    m[..., 1, 2] = s * (y * z - w * x)
+    m[..., 2, 0] = s * (x * z - w * y)
+    m[..., 2, 1] = s * (y * z + w * x)
+    m[..., 2, 2] = 1.0 - s * (x * x + y * y)
+    return m
 
 
 def quat_from_matrix(m) -> np.ndarray:
-    """Unit quaternion (w, x, y, z) of a rotation matrix, shape (..., 3, 3) -> (..., 4)."""
+    """Unit quaternion (w, x, y, z) of a rotation matrix, shape (..., 3, 3) -> (..., 4)
+    (numpy-quaternion's conversion, loaded here)."""
+    import quaternion as _nq
+
     return as_float_quat(_nq.from_rotation_matrix(np.asarray(m, dtype=float)))
 
 
@@ -239,8 +280,15 @@ def allclose_up_to_sign(q1, q2, atol: float = 1e-12) -> bool:
 
 
 def unflip(q) -> np.ndarray:
-    """Choose signs along a time series q, shape (N, 4), so that neighbours are continuous."""
-    return as_float_quat(_nq.unflip_rotors(as_quaternion_array(q), axis=-1, inplace=False))
+    """Choose signs along a time series q, shape (N, 4), so that neighbours are continuous
+    (each sample's sign flipped where its dot product with the previous one is negative)."""
+    q = np.array(q, dtype=float, copy=True)
+    if q.ndim < 2 or len(q) < 2:
+        return q
+    flips = np.sum(q[1:] * q[:-1], axis=-1) < 0.0
+    sign = np.where(np.cumsum(flips) % 2 == 1, -1.0, 1.0)
+    q[1:] *= sign[:, None]
+    return q
 
 
 def slerp_series(t_src, q_src, t_dst) -> np.ndarray:
@@ -259,6 +307,10 @@ def slerp_series(t_src, q_src, t_dst) -> np.ndarray:
     i = np.clip(np.searchsorted(t_src, t_dst, side="right") - 1, 0, t_src.size - 2)
     span = t_src[i + 1] - t_src[i]
     tau = np.clip((t_dst - t_src[i]) / np.where(span > 0, span, 1.0), 0.0, 1.0)
-    qa = as_quaternion_array(q_src[i])
-    qb = as_quaternion_array(q_src[i + 1])
-    return as_float_quat(np.slerp_vectorized(qa, qb, tau))
+    qa, qb = q_src[i], q_src[i + 1]
+    rel = multiply(conjugate(qa), qb)                       # qa^-1 qb, w >= 0 after unflip
+    ang = np.arctan2(np.linalg.norm(rel[:, 1:], axis=-1), rel[:, 0])   # half the angle between them
+    v = rel[:, 1:]
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    axis = np.divide(v, n, out=np.zeros_like(v), where=n > 0)
+    return multiply(qa, exp_rotvec(2.0 * (tau * ang)[:, None] * axis))

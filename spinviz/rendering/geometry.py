@@ -1,8 +1,5 @@
-"""Small rotation helpers in plain NumPy for the drawing side.
-
-The render workers import only what drawing needs: ``spinviz.rotations`` wraps
-numpy-quaternion, whose import pulls in numba and scipy (about 1.5 s per worker on this
-machine), so the few formulas the session uses are written out here.  Quaternions are
+"""The one rotation the drawing side needs beyond ``spinviz.rotations`` (which it uses for
+everything else): turning the +x glyph of an arrow onto a direction.  Quaternions are
 (w, x, y, z), scalar first, unit, body -> world, as everywhere in spinviz.
 """
 
@@ -10,22 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..rotations import matrix_from_quat
 
-def matrix_from_quat(q) -> np.ndarray:
-    """Rotation matrix of a unit quaternion (w, x, y, z): shape (..., 4) -> (..., 3, 3)."""
-    q = np.asarray(q, dtype=float)
-    w, x, y, z = np.moveaxis(q, -1, 0)
-    m = np.empty(q.shape[:-1] + (3, 3))
-    m[..., 0, 0] = 1 - 2 * (y * y + z * z)
-    m[..., 0, 1] = 2 * (x * y - w * z)
-    m[..., 0, 2] = 2 * (x * z + w * y)
-    m[..., 1, 0] = 2 * (x * y + w * z)
-    m[..., 1, 1] = 1 - 2 * (x * x + z * z)
-    m[..., 1, 2] = 2 * (y * z - w * x)
-    m[..., 2, 0] = 2 * (x * z - w * y)
-    m[..., 2, 1] = 2 * (y * z + w * x)
-    m[..., 2, 2] = 1 - 2 * (x * x + y * y)
-    return m
+__all__ = ["matrix_from_quat", "rotation_x_to"]
 
 
 def rotation_x_to(v) -> np.ndarray:

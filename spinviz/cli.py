@@ -239,8 +239,10 @@ def _cmd_simulate(args) -> int:
     except OSError as e:
         raise UsageError(f"{args.out}: cannot write: {e.strerror or e}") from None
     st = traj.stats
-    _out(f"{args.out}: {traj.t.size} samples, model {model}, method {st['method']}, "
-          f"{st.get('nfev', '?')} rhs evaluations, {st['runtime_s']:.3f} s")
+    cost = f"{st['nsteps']} steps" if "nsteps" in st else f"{st.get('nfev', '?')} rhs evaluations"
+    _out(f"{args.out}: {traj.t.size} samples, model {model}, method {st['method']}, {cost}, {st['runtime_s']:.3f} s")
+    for note in st.get("accuracy_notes", ()):
+        _say("note: ", note)
     return EXIT_OK
 
 

@@ -1,28 +1,40 @@
-"""The one driver: body + model + initial state -> frozen ``Trajectory``.
+"""The one driver: body + model + initial state -> frozen ``Trajectory``; problems -> solutions.
 
-Units are converted once here (``integrators.scaling``): the integrators see *spin units*,
-the dimensionless variables (4.1) with time further scaled so that |omega(0)| = 1.  The
-method is chosen by name or by ``integrators.auto``; a run that fails raises
-``SimulationError`` with one line saying why, never an array of NaN.
+Every run goes through here, single (``simulate``, ``solve``) or by the thousand (``solve_many``,
+the atlas): the integrators see typed ``Problem`` objects in *spin units* (the dimensionless
+variables (4.1) with time further scaled so that |omega(0)| = 1, see ``integrators.scaling``),
+the method is chosen by name or by ``integrators.auto``, and the guards live here once:
+
+* a truncated start on or near the singular surface of (2.5) is refused;
+* a run that runs away (the reduction (2.3) breaking down) says when;
+* nothing non-finite is handed on, and a run that fails raises ``SimulationError`` with one
+  line (``simulate``) or keeps its samples so far and its reason (``solve_many``);
+* a tolerance the method cannot honour is said, in the stats and on the command line
+  (``accuracy_notes``), never silently returned as less.
 """
 
 from __future__ import annotations
 
+import math
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
 from . import rotations as R
 from . import units as U
 from .errors import SimulationError
-from .integrators import get
+from .integrators import Problem, Solution, get
+from .integrators import status as ST
 from .integrators.auto import HARD_MAX_TURNS, check_cost, choose_method, estimated_turns
-from .integrators.scaling import body_spin_problem, check_scale
+from .integrators.scaling import body_spin_problem, check_scale, spin_problem
 from .physics.bodies import Body
-from .physics.equations import truncated_singularity
+from .physics.equations import System, truncated_singularity
 from .trajectory import Trajectory
 
-__all__ = ["simulate", "SimulationError"]
+__all__ = ["simulate", "solve", "solve_many", "SimulationError", "Run"]
+
+ATOL_FROM_RTOL = 1e-2      # atol = rtol / 100 when not given: in spin units the state is O(1), so atol >= rtol would rule
 
 
 def simulate(
@@ -37,7 +49,7 @@ def simulate(
     euler_zxz0=None,
     method: str = "auto",
     rtol: float = 1e-10,
-    atol: float = 1e-12,
+    atol: float | None = None,
     step: float | None = None,
     kinematics: str = "quaternion",
 ) -> Trajectory:
@@ -50,7 +62,8 @@ def simulate(
     t_eval : shape (N,), increasing output times from 0 (s or tau).
     q0 : shape (4,), (w, x, y, z), initial orientation; or euler_zxz0 : (phi, theta, psi) rad.
     method : a registered integrator name, or "auto".
-    rtol, atol : tolerances for adaptive methods (atol in spin units, |omega(0)| = 1).
+    rtol, atol : tolerances for adaptive methods, in spin units (|omega(0)| = 1, |q| = 1, so
+        both are relative to the initial spin); atol defaults to rtol / 100.
     step : step size for fixed-step methods, in units of t (s or tau).
     kinematics : "quaternion" (default), "euler_zxz" (the Poisson equations (6.4), for
     comparison; singular at theta = 0) or "none" (no orientation: Euler equation only).
@@ -58,36 +71,63 @@ def simulate(
     omega0 = np.asarray(omega0, dtype=float)
     check_scale(body, omega0)
     t_eval = output_times(t_end, samples, t_eval)
+    atol = rtol * ATOL_FROM_RTOL if atol is None else atol
     q_init, euler_init = initial_orientation(q0, euler_zxz0)
     problem, eps = body_spin_problem(body, model, omega0, t_eval, q_init, euler_init, kinematics)
     if model == "truncated":
-        check_truncated_solvable(body, omega0)
+        check_truncated_solvable(problem.system, problem.omega0)
     time_scale = eps / body.tau0                   # spin-unit time per unit of t
     method = str(method).lower()
     auto = method == "auto"
     horizon = float(t_eval[-1])
     if auto:
-        method, reason = choose_method(body, model, omega0, horizon, kinematics, spin=(problem, eps))
+        method, reason = choose_method(body, model, omega0, horizon, kinematics, spin=(problem, eps), rtol=rtol)
     else:
         reason = "chosen by the user"
     check_cost(body, model, omega0, horizon, "auto" if auto else method, step, spin=(problem, eps),
                kinematics=kinematics, picked=method if auto else None)
-    # a declining secular run can be handed to lie-dop853 when that one's cost check would pass
+    # a declining secular run can be handed to a resolving method when its cost check would pass
     resolvable = (auto and method == "secular"
                   and estimated_turns(body, model, omega0, horizon, (problem, eps)) <= HARD_MAX_TURNS)
-    integrator = _integrator(method, body, kinematics)
-    kw = {"rtol": rtol, "atol": atol}
-    if step is not None:
-        kw["step"] = step * time_scale
+    _check_method(method, body, kinematics)
     start = time.perf_counter()
-    sol, integrator, reason = _solve(integrator, problem, kw, auto, reason, time_scale, resolvable=resolvable)
+    sol, name, reason = solve(problem, method, rtol=rtol, atol=atol, step=None if step is None else step * time_scale,
+                              auto=auto, reason=reason, resolvable=resolvable)
     runtime = time.perf_counter() - start
+    if not sol.success:
+        raise SimulationError(_failure_message(problem, sol, name, time_scale))
     stats = _stats_in_units(sol.stats, time_scale)
-    stats.update(method=integrator.name, method_reason=reason, runtime_s=runtime, eps_rad=eps, rtol=rtol, atol=atol)
+    notes = accuracy_notes(name, rtol, atol)
+    stats.update(method=name, method_reason=reason, runtime_s=runtime, eps_rad=eps, rtol=rtol, atol=atol,
+                 tolerance_met=not notes)
+    if notes:
+        stats["accuracy_notes"] = notes
     if step is not None:
         stats["step"] = step
     return Trajectory(t=t_eval, omega=U.omega_from_dimensionless(sol.omega * eps, body.tau0), q=sol.q,
                       euler=sol.euler, body=body, model=model, stats=stats, slow=sol.slow)
+
+
+def accuracy_notes(method: str, rtol: float, atol: float) -> list[str]:
+    """What the run cannot honour of (rtol, atol), one sentence each (empty when all is well).
+
+    In spin units every state component is O(1), so the error is held to about max(rtol,
+    atol): an atol above rtol limits it; and below a method's measured floor
+    (``Integrator.rtol_floor``, ``spinviz bench``) its error stops following rtol."""
+    m = get(method)
+    out = []
+    if m.fixed_step:
+        return out
+    if atol > rtol:
+        out.append(f"atol = {atol:.2g} exceeds rtol = {rtol:.2g}: in spin units (|omega(0)| = 1) the state is O(1), "
+                   f"so the error is held to ~{atol:.2g}, not {rtol:.2g}")
+    floor = m.rtol_floor
+    if floor is not None and rtol < floor:
+        better = [n for n in ("taylor", "taylor-long") if n != method and get(n).rtol_floor < floor]
+        hint = f" (method {better[0]!r} follows it to ~{get(better[0]).rtol_floor:.0e})" if better else ""
+        out.append(f"{method} stops following the tolerance below rtol ~{floor:.0e} (measured on 400 turns of an askew "
+                   f"body, spinviz bench): asked {rtol:.2g}{hint}")
+    return out
 
 
 def _stats_in_units(stats: dict, time_scale: float) -> dict:
@@ -126,21 +166,26 @@ def initial_orientation(q0=None, euler_zxz0=None):
     return R.quat_from_euler_zxz(euler), euler
 
 
-def check_truncated_solvable(body: Body, omega0) -> None:
-    """(2.5) is linear in Omega_dot with the factor J + g (g x Omega)^T, whose determinant is
-    det J (1 + (g x Omega) . J^-1 g) (tau0 = 1).  It is 1 at rest and 1 + O(tau0 |Omega|) for
-    any real particle.  Where it is <= 0 the state is cut off from rest by the singular
-    surface, and runs started there fall into it (the stress case shows one), so say so
-    instead of integrating."""
-    s = body.system("truncated")
-    den = truncated_singularity(*U.omega_to_dimensionless(omega0, body.tau0), s.inertia, s.coupling)
-    if not den > 1e-12:
+def truncated_margin(system: System, omega) -> float:
+    """1 + (g x omega).J^-1 g for the dimensionless (tau0 = 1) or spin-unit system: (2.5) is
+    linear in Omega_dot with the factor J + g (g x Omega)^T, whose determinant is det J times
+    this.  1 at rest and 1 + O(tau0 |Omega|) for any real particle."""
+    w = np.asarray(omega, dtype=float)
+    return float(truncated_singularity(w[0], w[1], w[2], system.inertia, system.coupling))
+
+
+def check_truncated_solvable(system: System, omega, margin: float = 1e-12) -> None:
+    """Refuse a truncated start where ``truncated_margin`` <= ``margin``: such a state is cut
+    off from rest by the singular surface, and runs started there fall into it (the stress
+    case shows one)."""
+    den = truncated_margin(system, omega)
+    if not den > margin:
         raise SimulationError(
             f"the truncated equation (2.5) is singular at the initial state: 1 + (g x Omega).J^-1 g = {den:.3g} "
             f"(tau0 |Omega| ~ 1; it is 1 + O(tau0 |Omega|) for real particles)")
 
 
-def _integrator(method: str, body: Body, kinematics: str):
+def _check_method(method: str, body: Body, kinematics: str):
     """The registered method, checked against the kinematics and the body it must serve."""
     integrator = get(method)
     if kinematics not in integrator.kinematics:
@@ -150,29 +195,42 @@ def _integrator(method: str, body: Body, kinematics: str):
     return integrator
 
 
-def _solve(integrator, problem, kw, auto: bool, reason: str, time_scale: float, resolvable: bool = True):
-    """Run the method; under ``auto`` an explicit method that meets stiffness the estimate
-    from the initial state missed is replaced by radau, and a ``secular`` run that declines
-    (a resonance, the oscillating regime) by lie-dop853 when ``resolvable`` (affordable).
-    Returns (solution, integrator, reason)."""
+def solve(problem: Problem, method: str, *, rtol: float, atol: float, step: float | None = None, auto: bool = False,
+          reason: str = "chosen by the user", resolvable: bool = True) -> tuple[Solution, str, str]:
+    """Run ``method`` on ``problem`` (spin units) and return (solution, method used, why).
+
+    Under ``auto``: a ``secular`` run that declines (a resonance, the oscillating regime) is
+    resolved in full by ``taylor`` when ``resolvable`` (affordable), and an explicit method
+    that meets stiffness the estimate from the initial state missed is replaced by radau.
+    The solution is checked for non-finite values; ``success`` False keeps its samples so far."""
+    integrator = get(method)
+    kw = {"rtol": rtol, "atol": atol}
+    if step is not None:
+        kw["step"] = step
     extra = {"stop_on_stiffness": True} if auto and integrator.detects_stiffness else {}
     sol = integrator.solve(problem, **kw, **extra)
     if auto and not sol.success and integrator.name == "secular" and resolvable:
-        reason = f"{reason}; but {sol.message} -- so resolved in full by lie-dop853"
-        integrator = get("lie-dop853")
+        reason = f"{reason}; but {sol.message} -- so resolved in full by taylor"
+        integrator = get("taylor")
         sol = integrator.solve(problem, **kw, stop_on_stiffness=True)
     if auto and not sol.success and not integrator.stiff and integrator.name != "secular" and "runaway_at" not in sol.stats:
         stiff_at = sol.stats.get("stiff_at")
-        why = f"stiffness detected at t = {stiff_at / time_scale:.3g}" if stiff_at is not None else sol.message
+        why = f"stiffness detected at t = {stiff_at:.3g} (spin units)" if stiff_at is not None else sol.message
         reason = f"{integrator.name} gave up ({why}); switched to radau (implicit, exact Jacobian)"
         integrator = get("radau")
         sol = integrator.solve(problem, **kw)
+    if sol.success:
+        _check_finite(sol)
+    return sol, integrator.name, reason
+
+
+def _failure_message(problem: Problem, sol: Solution, name: str, time_scale: float) -> str:
+    """One line: why a run failed, and when."""
     if "runaway_at" in sol.stats:
-        raise SimulationError(_runaway_message(problem, sol.stats, time_scale))
-    if not sol.success:
-        raise SimulationError(f"{integrator.name}: {sol.message}")
-    _check_finite(sol, integrator.name, time_scale)
-    return sol, integrator, reason
+        return _runaway_message(problem, sol.stats, time_scale)
+    if sol.reached is not None and 0 < sol.reached < len(sol.t):
+        return f"{name}: {sol.message} (by t = {sol.t[sol.reached - 1] / time_scale:.4g})"
+    return f"{name}: {sol.message}"
 
 
 def _runaway_message(problem, stats, time_scale: float) -> str:
@@ -189,10 +247,114 @@ def _runaway_message(problem, stats, time_scale: float) -> str:
             f"by t = {t:.4g} (the reduction (2.3) assumes tau0 |Omega| << 1){blow}")
 
 
-def _check_finite(sol, name: str, time_scale: float) -> None:
-    """Never hand on a non-finite number: the first instant where one appears fails the run."""
+def _check_finite(sol: Solution) -> None:
+    """Never hand on a non-finite number: the first instant where one appears fails the run
+    (its samples before stay, ``reached`` says how many)."""
     parts = [a for a in (sol.omega, sol.q, sol.euler) if a is not None]
     ok = np.all([np.all(np.isfinite(a), axis=1) for a in parts], axis=0)
     if not np.all(ok):
         i = int(np.argmin(ok))
-        raise SimulationError(f"{name}: the solution left the finite numbers by t = {sol.t[i] / time_scale:.4g}")
+        sol.success, sol.status, sol.reached = False, ST.NOT_FINITE, i
+        sol.message = ST.MESSAGES[ST.NOT_FINITE]
+
+
+# --- many runs at once: the atlas ------------------------------------------------------------
+@dataclass
+class Run:
+    """One run of ``solve_many``, in the dimensionless units (4.1) of its request.
+
+    tau : (N,) the output grid; omega : (N, 3) body frame, NaN after ``reached`` samples;
+    status : how it ended (``integrators.status``; OK = 0); reason : one line when not OK;
+    t_stop : where it stopped (tau); nsteps : integrator steps (a batch's, for batched runs);
+    seconds : wall time of its share of the work.
+    """
+
+    tau: np.ndarray
+    omega: np.ndarray
+    status: int
+    reached: int
+    t_stop: float
+    nsteps: int
+    seconds: float
+    reason: str = ""
+
+
+SINGULAR_START = ST.SINGULAR_START
+
+
+def solve_many(model: str, inertia: list, coupling: list, omega0: list, tau, *, method: str = "taylor",
+               rtol: float = 1e-8, max_steps: int = 20_000_000, residual_eta=None, singular_margin: float = 1e-12,
+               stop=None) -> list[Run]:
+    """Euler-only runs (no orientation) of one model, dimensionless (4.1): run i has inertia
+    J_i = (1, J2, J3), unit coupling g_i and start omega0_i, all on the output grid ``tau``
+    (starting at 0).  The runs go to the integrator in spin units, in batches where it has a
+    batch mode (``taylor``: heyoka's SIMD batches), one by one otherwise.
+
+    residual_eta : per run, eta > 0 stops it at the residual rotation |d x omega| < eta |d|
+        |omega| (callers pass it where the paper proves that rotation is the end state).
+    singular_margin : a truncated start with ``truncated_margin`` below this is not run
+        (status ``SINGULAR_START``).
+    A failed run keeps its samples so far; none raises (an interrupt does, ``InterruptedError``).
+    """
+    tau = np.asarray(tau, dtype=float)
+    n = len(omega0)
+    eta = np.zeros(n) if residual_eta is None else np.asarray(residual_eta, dtype=float)
+    runs: list[Run | None] = [None] * n
+    groups: dict = {}
+    for i in range(n):
+        system = System(model, tuple(map(float, inertia[i])), tuple(map(float, coupling[i])))
+        w0 = np.asarray(omega0[i], dtype=float)
+        if model == "truncated" and not truncated_margin(system, w0) >= singular_margin:
+            runs[i] = _singular_run(tau, w0, truncated_margin(system, w0), singular_margin)
+            continue
+        prob, eps = spin_problem(system, w0, tau, kinematics="none")
+        groups.setdefault(eps, []).append((i, prob))
+    for eps, members in groups.items():
+        t0 = time.perf_counter()
+        idx = [i for i, _ in members]
+        probs = [p for _, p in members]
+        if method == "taylor" and model != "free" and all(_atlas_body(p.system) for p in probs):
+            from .integrators.taylor import solve_batch
+
+            results = [(r.omega, r.status, r.reached, r.t_stop, r.nsteps)
+                       for r in solve_batch(probs, rtol, max_steps, eta[idx], stop)]
+        else:
+            results = [_one_by_one(p, method, rtol, max_steps) for p in probs]
+        share = (time.perf_counter() - t0) / len(members)
+        for i, (w, st, reached, t_stop, nsteps) in zip(idx, results):
+            runs[i] = Run(tau, w * eps, int(st), int(reached), t_stop / eps, int(nsteps), share,
+                          _reason(st, tau, reached, t_stop / eps))
+    return runs
+
+
+def _atlas_body(s: System) -> bool:
+    """A symmetric top in the atlas's frame, J = (1, 1, 1 - delta), g = (n1, 0, n3): the
+    batch integrator's symmetric form (4.2)-(4.4) applies."""
+    return s.inertia[0] == 1.0 and s.inertia[1] == 1.0 and s.coupling[1] == 0.0
+
+
+def _one_by_one(problem: Problem, method: str, rtol: float, max_steps: int):
+    sol = get(method).solve(problem, rtol=rtol, atol=rtol * ATOL_FROM_RTOL)
+    reached = len(sol.t) if sol.success else int(sol.reached or 0)
+    w = np.array(sol.omega, dtype=float)
+    w[reached:] = np.nan
+    t_stop = float(sol.stats.get("runaway_at", sol.stats.get("stiff_at", sol.t[max(reached - 1, 0)])))
+    return w, (ST.OK if sol.success else (sol.status or ST.NOT_FINITE)), reached, t_stop, int(sol.stats.get("nsteps", 0))
+
+
+def _singular_run(tau, w0, margin: float, limit: float) -> Run:
+    w = np.full((len(tau), 3), np.nan)
+    w[0] = w0
+    return Run(tau, w, SINGULAR_START, 1, 0.0, 0, 0.0,
+               f"truncated (2.5) near-singular at the start: 1 + (g x omega).J^-1 g = {margin:.3g} < {limit:g}; "
+               f"use a smaller |omega(0)|")
+
+
+def _reason(status: int, tau, reached: int, t_stop: float) -> str:
+    if status == ST.OK:
+        return ""
+    what = ST.MESSAGES.get(status, f"status {status}")
+    if status == ST.STOPPED_RESIDUAL:
+        return f"residual rotation about d reached by tau = {t_stop:.3g} (exact end state)"
+    last = float(tau[max(reached - 1, 0)])
+    return f"{what} at tau = {t_stop:.3g} (samples kept up to tau = {last:.3g})" if math.isfinite(t_stop) else what

@@ -83,7 +83,7 @@ def test_atomic_path_that_cannot_make_its_temporary_file_leaves_no_directories(t
 
 
 def test_scene_method_needing_a_step_is_one_line(tmp_path, capsys):
-    p = scene(tmp_path, body='delta = 0.3\nchi = 0.0', sim='models = ["reduced", "truncated"]\nmethod = "lie-rk4"')
+    p = scene(tmp_path, body='delta = 0.3\nchi = 0.0', sim='models = ["reduced", "truncated"]\nmethod = "split4"')
     one_line_error(capsys, ["compare", p, "--out", tmp_path / "c"], "is fixed-step: give step > 0")
     one_line_error(capsys, ["simulate", p, "--out", tmp_path / "x.npz"], "is fixed-step: give step > 0")
 
@@ -129,7 +129,7 @@ def test_sample_keeps_the_slow_frame_with_four_samples():
 def test_method_names_are_case_insensitive_and_unknown_ones_are_value_errors():
     body = B.symmetric_top(0.3, 0.5)
     a = simulate(body, "reduced", (0.0, 0.05, 0.1), t_end=10.0, samples=3, method="AUTO")
-    assert a.stats["method"] == "lie-dop853"
+    assert a.stats["method"] == "taylor"
     with pytest.raises(ValueError, match="unknown method 'rk99'"):
         simulate(body, "reduced", (0.0, 0.05, 0.1), t_end=10.0, samples=3, method="rk99")
 

@@ -67,7 +67,7 @@ def test_secular_is_exact_for_free_symmetric_motion():
     body = B.symmetric_top(0.4, 0.3)
     kw = dict(t_end=200.0, samples=50, q0=R.quat_from_euler_zxz((0.3, 1.1, -0.2)), rtol=1e-12, atol=1e-14)
     a = simulate(body, "free", (0.2, -0.1, 0.5), method="secular", **kw)
-    b = simulate(body, "free", (0.2, -0.1, 0.5), method="lie-dop853", **kw)
+    b = simulate(body, "free", (0.2, -0.1, 0.5), method="taylor", **kw)
     np.testing.assert_allclose(a.omega, b.omega, atol=1e-11)
     assert R.misorientation(a.q, b.q).max() < 1e-10
 
@@ -93,7 +93,7 @@ def test_secular_slow_variables_are_second_order_in_tau0_omega_for_an_askew_top(
         w0 = np.array([0.0, 0.6, 0.8]) * eps_rad
         t_end = 2.0 / (0.6 * eps_rad) ** 2
         a = simulate(body, "reduced", w0, t_end=t_end, samples=41, method="secular")
-        b = simulate(body, "reduced", w0, t_end=t_end, samples=41, method="lie-dop853", rtol=1e-12, atol=1e-14)
+        b = simulate(body, "reduced", w0, t_end=t_end, samples=41, method="taylor", rtol=1e-12, atol=1e-14)
         err = max(np.max(np.abs(np.hypot(a.omega[:, 0], a.omega[:, 1]) - np.hypot(b.omega[:, 0], b.omega[:, 1]))),
                   np.max(np.abs(a.omega[:, 2] - b.omega[:, 2]))) / eps_rad
         assert err < 20 * eps_rad**2, (eps_rad, err)
@@ -122,28 +122,33 @@ def test_secular_needs_a_symmetric_top():
         simulate(body, "reduced", (0.0, 0.1, 0.1), t_end=10.0, samples=3, method="secular")
 
 
-def test_auto_picks_secular_radau_or_lie_and_says_why():
+def test_auto_picks_secular_radau_or_taylor_and_says_why():
     cube = P.dast_cube()
     m, why = choose_method(cube, "reduced", (0.0, W, W), 10.0 / (cube.tau0 * W**2))
     assert m == "secular" and "turns of a symmetric top" in why and "beyond float64" in why
     thin = B.custom((1.0, 1.0, 1e-6), (math.sin(0.5), 0.0, math.cos(0.5)), units="dimensionless")
-    m, why = choose_method(thin, "reduced", (0.0, 0.1, 0.1), 100.0)
+    m, why = choose_method(thin, "reduced", (0.0, 3.0, 3.0), 2.0)            # decay/spin 1.6e6
     assert m == "radau" and "stiff" in why
+    m, why = choose_method(thin, "reduced", (0.0, 0.1, 0.1), 100.0)          # 5e4: taylor still faster
+    assert m == "taylor" and "non-stiff" not in why
     m, why = choose_method(B.symmetric_top(0.3, 0.7), "reduced", (0.0, 0.05, 0.3), 1200.0)
-    assert m == "lie-dop853" and "non-stiff" in why
+    assert m == "taylor" and "non-stiff" in why
+    m, why = choose_method(B.symmetric_top(0.3, 0.7), "reduced", (0.0, 0.05, 0.3), 1200.0, rtol=1e-17)
+    assert m == "taylor-long" and "long double" in why
 
 
 def test_driver_switches_to_radau_when_the_explicit_method_detects_stiffness(monkeypatch):
-    """If the up-front estimate misses stiffness, lie-dop853's stiffness test (Hairer's) fires
-    and the driver reruns with radau, saying so."""
+    """If the up-front estimate misses stiffness, taylor's stiffness watch (steps below 1e-5 rad
+    of spin over 4 x 512 steps) fires and the driver reruns with radau, saying so.  The body:
+    I3/I1 = 1e-6, d at 30 deg, |omega| = 4.2: decay/spin 1.6e6, where radau is 2x faster."""
     import spinviz.driver as S
 
-    monkeypatch.setattr(S, "choose_method", lambda *a, **k: ("lie-dop853", "forced for the test"))
-    thin = B.custom((1.0, 1.0, 1e-5), (math.sin(0.5), 0.0, math.cos(0.5)), units="dimensionless")
-    tr = simulate(thin, "reduced", (0.0, 0.3, 0.3), t_end=5.0, samples=11)
+    monkeypatch.setattr(S, "choose_method", lambda *a, **k: ("taylor", "forced for the test"))
+    thin = B.custom((1.0, 1.0, 1e-6), (0.5, 0.0, math.sqrt(0.75)), units="dimensionless")
+    tr = simulate(thin, "reduced", (0.0, 3.0, 3.0), t_end=2.0, samples=11)
     assert tr.stats["method"] == "radau"
-    assert tr.stats["method_reason"].startswith("lie-dop853 gave up (stiffness detected at t = ")
-    ref = simulate(thin, "reduced", (0.0, 0.3, 0.3), t_end=5.0, samples=11, method="radau")
+    assert tr.stats["method_reason"].startswith("taylor gave up (stiffness detected at t = ")
+    ref = simulate(thin, "reduced", (0.0, 3.0, 3.0), t_end=2.0, samples=11, method="radau")
     np.testing.assert_allclose(tr.omega, ref.omega)
 
 

@@ -57,7 +57,7 @@ def test_repr_is_short_and_says_what_the_run_is():
     tr = spinviz.simulate(B.symmetric_top(0.3, 0.7), "reduced", (0.0, 0.05, 0.3), t_end=100.0, samples=200)
     r = repr(tr)
     assert len(r) < 250 and "\n" not in r
-    assert "reduced" in r and "200 samples" in r and "lie-dop853" in r and "quaternion" in r
+    assert "reduced" in r and "200 samples" in r and "taylor" in r and "quaternion" in r
 
 
 def test_to_xarray_has_labelled_dims_units_and_metadata():

@@ -5,10 +5,10 @@ Importing this package registers the built-in methods; ``get(name)`` returns one
 """
 
 from . import (
-    geometric,  # noqa: F401  (registers lie-dop853, lie-rk4, lie-rk8)
     scipy_ivp,  # noqa: F401  (registers rk45, dop853, radau, bdf, lsoda)
     secular,  # noqa: F401  (registers secular)
     splitting,  # noqa: F401  (registers split2, split4, split6, split8)
+    taylor,  # noqa: F401  (registers taylor, taylor-long; heyoka loads on first use)
 )
 from .base import KINEMATICS, Integrator, Problem, Solution, get, names, register
 

@@ -11,8 +11,11 @@ from .base import get
 from .scaling import body_spin_problem
 
 MAX_RESOLVED_TURNS = 1e6     # beyond this, resolving every turn costs more than ~10 s
-HARD_MAX_TURNS = 3e8         # a resolving method takes ~3 us per turn (lie-dop853): beyond this ~15 min
-STIFF_RATIO = 10.0           # radiation decay rate / spin rate above which explicit steps are stability-bound
+HARD_MAX_TURNS = 3e8         # a resolving method takes ~3 us per turn (taylor): beyond this ~15 min
+# radiation decay rate / spin rate above which radau beats Taylor's method (measured on thin askew
+# tops: taylor 7-400x faster than radau from 1.5e2 to 1.6e5, a tie at 5e5, radau 1.3-2x faster at
+# 1.6e6 .. 1.6e7; an explicit Runge-Kutta method was stability-bound from ~10)
+STIFF_RATIO = 5e5
 
 
 def braking_coefficient(problem) -> float:
@@ -92,21 +95,24 @@ def stiffness_ratio(body, model: str, omega0, problem=None) -> float:
 
 
 def choose_method(body, model: str, omega0, t_end: float, kinematics: str = "quaternion",
-                  spin=None) -> tuple[str, str]:
-    """The method ``method = "auto"`` picks, and why.
+                  spin=None, rtol: float = 1e-10) -> tuple[str, str]:
+    """The method ``method = "auto"`` picks, and why (from ``spinviz bench``'s table, see
+    docs/accuracy.md).
 
     * more than 1e6 turns (estimated with braking) of a symmetric top with tau0 |Omega0| <=
       1e-3: ``secular`` (the hybrid slow flow; resolving each turn is neither affordable nor,
       past 1e16 turns, representable in float64);
     * stiff (decay rate > 10 x spin rate): ``radau`` with the exact Jacobian;
-    * otherwise ``lie-dop853``; if it then detects stiffness, the driver switches to radau.
+    * otherwise ``taylor`` (``taylor-long`` for rtol below 1e-15, where float64 stops): the
+      fastest resolving method at every tolerance the bench measured, and the only one whose
+      error follows rtol below ~1e-10; if it then detects stiffness, the driver switches to radau.
 
     ``spin``: (problem, eps_rad) from ``spin_problem`` if the caller already has them.
     """
     problem, eps = spin if spin is not None else body_spin_problem(body, model, omega0)
     turns = estimated_turns(body, model, omega0, t_end, (problem, eps))
     if kinematics == "euler_zxz":
-        return "dop853", "Euler-angle kinematics (6.4) is integrated by scipy methods only"
+        return "taylor", "Euler-angle kinematics (6.4): resolved by Taylor's method (secular tracks quaternions only)"
     if turns > MAX_RESOLVED_TURNS and body.is_symmetric:
         from .secular import NotApplicable, prepare
 
@@ -122,4 +128,9 @@ def choose_method(body, model: str, omega0, t_end: float, kinematics: str = "qua
     ratio = stiffness_ratio(body, model, omega0, problem)
     if ratio > STIFF_RATIO:
         return "radau", f"stiff: decay rate {ratio:.3g} x the spin rate; implicit Radau with the exact Jacobian"
-    return "lie-dop853", f"non-stiff (decay/spin = {ratio:.2g}), ~{turns:.3g} turns resolved; |q| = 1 by construction"
+    stiff = (f"decay/spin = {ratio:.2g}: stiff for Runge-Kutta, not yet for Taylor's method (faster than radau "
+             f"below {STIFF_RATIO:g}, measured)") if ratio > 10.0 else f"non-stiff (decay/spin = {ratio:.2g})"
+    if rtol < get("taylor").rtol_floor:
+        return "taylor-long", (f"{stiff}, ~{turns:.3g} turns resolved; rtol {rtol:.2g} is below what float64 holds: "
+                               f"Taylor's method in long double")
+    return "taylor", f"{stiff}, ~{turns:.3g} turns resolved by Taylor's method"

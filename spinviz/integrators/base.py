@@ -48,6 +48,8 @@ class Solution:
     nsteps, and anything the method wants to report; success False with ``message`` when
     the method gave up (never a silently wrong array).  slow : for ``secular`` runs, the
     slow geometry (q_L: world z -> L_world, phi_L, theta_L, psi_L (N,), q_frame).
+    status : ``status`` code of how the run ended (OK = 0).  reached : samples obtained before
+    it ended (``len(t)`` on success; methods that keep partial output fill the rest with NaN).
     """
 
     t: np.ndarray
@@ -58,6 +60,8 @@ class Solution:
     message: str = ""
     stats: dict = field(default_factory=dict)
     slow: dict | None = None
+    status: int = 0
+    reached: int | None = None
 
 
 @dataclass(frozen=True)
@@ -70,6 +74,8 @@ class Integrator:
     kinematics : the kinematics it supports; symmetric_only : needs I1 = I2; stiff : an
     implicit method; detects_stiffness : accepts ``stop_on_stiffness=True``;
     description : one line for ``spinviz methods`` and the README.
+    rtol_floor : the tolerance below which its error stops following rtol (measured on the
+    benchmark's askew bodies, ``spinviz bench``), or None (fixed step, or reported per run).
     """
 
     name: str
@@ -81,6 +87,7 @@ class Integrator:
     symmetric_only: bool = False
     stiff: bool = False
     detects_stiffness: bool = False
+    rtol_floor: float | None = None
 
 
 _REGISTRY: dict[str, Integrator] = {}

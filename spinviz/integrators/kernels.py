@@ -1,26 +1,22 @@
-"""Compiled kernels (numba) for the geometric integrators.
+"""Compiled kernels (numba): the splitting integrators and the shared DOP853 pieces of the
+secular slow flow.
+
+They stay compiled where ``spinviz bench`` shows they win: the splitting (``split2`` ..
+``split8``) takes steps set by the braking, not the spin, where the torque commutes with the
+free flow ((6.10), (3.9): 1e6 turns in milliseconds, where a resolving method needs ~3e6
+steps), and ``secular`` averages the free precession over 1e6 .. 1e25 turns, which no
+resolving method can follow.  Every run that resolves each turn goes to Taylor's method
+(``taylor``, heyoka) instead.
 
 The Euler-equation rates are the functions of ``physics.equations`` themselves, compiled
-by numba: one source serves the Python paths and these loops.
-
-Lie-group Runge-Kutta (Munthe-Kaas): within a step the orientation is written
-q(t) = q_n (x) exp(u(t)) with u a rotation vector (u = 0 at the step's start), and the
-pair (Omega, u) obeys an ODE in R^6,
-
-    Omega_dot = model rate,   u_dot = dexp^-1_u(Omega) = Omega + u x Omega / 2
-                                      + (1 - (|u|/2) cot(|u|/2)) / |u|^2 u x (u x Omega),
-
-the inverse right Jacobian of SO(3), exact in closed form.  Any explicit RK tableau applied
-to that ODE keeps its order, and q_{n+1} = q_n (x) exp(u_{n+1}) is a product of unit
-quaternions: |q| = 1 by construction (up to round-off, which a renormalization per step
-keeps at the 1e-16 level instead of letting it random-walk).
+by numba: one source serves the Python paths, these loops and heyoka's expressions.
 
 Compensated summation.  Over 1e6 turns the spin phase is 6e6 rad; to hold it to 1e-8 rad,
-Omega must stay right to ~1e-15 relative over millions of updates, and so must the time.
-Plain additions lose ~1e-16 at each update and the losses random-walk into the phase
-(measured: ~5e-8 rad after 1e4 turns).  Omega and t are therefore updated by compensated
-summation (Hairer, Lubich & Wanner, Geometric Numerical Integration, VIII.5): the rounding
-error of each addition is carried into the next increment.
+the state must stay right to ~1e-15 relative over millions of updates.  Plain additions lose
+~1e-16 at each update and the losses random-walk into the phase (measured: ~5e-8 rad after
+1e4 turns), so the splitting's polar state is updated by compensated summation (Hairer,
+Lubich & Wanner, Geometric Numerical Integration, VIII.5): the rounding error of each addition
+is carried into the next increment.
 
 Set NUMBA_DISABLE_JIT=1 to run these loops as plain Python (debugging, coverage).
 """
@@ -39,12 +35,9 @@ from .status import (  # noqa: F401
     MODEL_ID,
     NOT_FINITE,
     OK,
-    RUNAWAY,
     STEP_UNDERFLOW,
-    STIFF,
     STOP_POLL,
     TOO_MANY_STEPS,
-    TURN_TOO_LARGE,
 )
 
 _jit = nb.njit(cache=True, nogil=True)    # nogil: interrupt.call_stoppable runs them in a thread
@@ -97,40 +90,6 @@ def qexp(u1, u2, u3):
 
 
 @_jit
-def dexpinv(u1, u2, u3, w1, w2, w3):
-    """u_dot = dexp^-1_u(Omega): inverse right Jacobian of SO(3) applied to Omega."""
-    t2 = u1 * u1 + u2 * u2 + u3 * u3
-    if t2 < 1e-4:
-        # (1 - x cot x)/(4 x^2) with x = |u|/2, by its Taylor series (cancellation near 0)
-        c = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0
-    else:
-        th = math.sqrt(t2)
-        c = (1.0 - 0.5 * th / math.tan(0.5 * th)) / t2
-    a1, a2, a3 = u2 * w3 - u3 * w2, u3 * w1 - u1 * w3, u1 * w2 - u2 * w1
-    b1, b2, b3 = u2 * a3 - u3 * a2, u3 * a1 - u1 * a3, u1 * a2 - u2 * a1
-    return w1 + 0.5 * a1 + c * b1, w2 + 0.5 * a2 + c * b2, w3 + 0.5 * a3 + c * b3
-
-
-@_jit
-def lie_rhs(model, J, g, y, out, with_q):
-    """out = f(y) for y = (Omega, u): model rate and dexp^-1_u(Omega)."""
-    a = rate(model, y[0], y[1], y[2], J, g)
-    out[0], out[1], out[2] = a[0], a[1], a[2]
-    if with_q:
-        d = dexpinv(y[3], y[4], y[5], y[0], y[1], y[2])
-        out[3], out[4], out[5] = d[0], d[1], d[2]
-
-
-@_jit
-def apply_u(q, u1, u2, u3):
-    """q <- q (x) exp(u), renormalized (round-off only)."""
-    e = qexp(u1, u2, u3)
-    r = qmul(q[0], q[1], q[2], q[3], e[0], e[1], e[2], e[3])
-    n = math.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3])
-    q[0], q[1], q[2], q[3] = r[0] / n, r[1] / n, r[2] / n, r[3] / n
-
-
-@_jit
 def compensated(x, increment, err):
     """(x + increment, new carry), the rounding error of the sum carried in ``err``
     (compensated summation: Omega and t over millions of steps keep ~1 ulp)."""
@@ -160,65 +119,6 @@ def substeps(dt, h):
     """Fixed-step methods cut an output interval dt into m equal steps of at most h: (m, dt/m)."""
     m = max(1, int(math.ceil(dt / h - 1e-9)))
     return m, dt / m
-
-
-# Exponential coordinates are singular where |u| = 2 pi (dexp^-1 blows up there unless u is
-# parallel to Omega), so no step may turn the body by more than half a turn.
-U_MAX = math.pi
-
-
-@_jit
-def lie_fixed(model, J, g, w0, q0, t_eval, h, A, b, with_q, max_steps, stop):
-    """Fixed-step Lie-group RK with tableau (A, b, c): each output interval is cut into
-    ceil(dt/h) equal steps, so the outputs are hit exactly.  Returns
-    (omega (N,3), q (N,4), nfev, nsteps, status)."""
-    N = t_eval.shape[0]
-    s = b.shape[0]
-    n = 6 if with_q else 3
-    out_w = np.empty((N, 3))
-    out_q = np.empty((N, 4))
-    K = np.zeros((s, 6))
-    y = np.zeros(6)
-    ys = np.zeros(6)
-    ec = np.zeros(3)                       # compensated-summation carries of Omega
-    q = q0.copy()
-    y[0], y[1], y[2] = w0[0], w0[1], w0[2]
-    out_w[0, :] = y[:3]
-    out_q[0, :] = q
-    nfev = 0
-    nsteps = 0
-    for j in range(N - 1):
-        m, hh = substeps(t_eval[j + 1] - t_eval[j], h)
-        for _ in range(m):
-            for i in range(s):
-                stage_point(A, K, y, hh, i, n, ys)
-                lie_rhs(model, J, g, ys, K[i], with_q)
-            nfev += s
-            for k in range(n):
-                acc = 0.0
-                for l in range(s):
-                    acc += b[l] * K[l, k]
-                if k < 3:
-                    add_compensated(y, k, hh * acc, ec)
-                else:
-                    y[k] += hh * acc
-            if with_q:
-                if y[3] * y[3] + y[4] * y[4] + y[5] * y[5] > U_MAX * U_MAX:
-                    return out_w, out_q, nfev, nsteps, TURN_TOO_LARGE
-                apply_u(q, y[3], y[4], y[5])
-                y[3] = 0.0
-                y[4] = 0.0
-                y[5] = 0.0
-            nsteps += 1
-            if not (math.isfinite(y[0]) and math.isfinite(y[1]) and math.isfinite(y[2])):
-                return out_w, out_q, nfev, nsteps, NOT_FINITE
-            if nsteps > max_steps:
-                return out_w, out_q, nfev, nsteps, TOO_MANY_STEPS
-            if nsteps % STOP_POLL == 0 and stop[0] != 0:
-                return out_w, out_q, nfev, nsteps, INTERRUPTED
-        out_w[j + 1, :] = y[:3]
-        out_q[j + 1, :] = q
-    return out_w, out_q, nfev, nsteps, OK
 
 
 @_jit
@@ -253,16 +153,6 @@ def second_guess(f0, f1, n, sc, h0, d1, h_max):
 
 
 @_jit
-def initial_step(model, J, g, y, K, ys, n, rtol, atol, span, h_max, with_q):
-    """First step size by Hairer, Norsett & Wanner (II.4), from f(y0) in K[0]; uses K[1] as
-    scratch (one extra evaluation).  Returns the step."""
-    sc = np.empty(6)
-    h0, d1 = first_guess(y, K[0], n, rtol, atol, span, sc, ys)
-    lie_rhs(model, J, g, ys, K[1], with_q)
-    return second_guess(K[0], K[1], n, sc, h0, d1, h_max)
-
-
-@_jit
 def error_norm(K, y, y_new, h, n, rtol, atol, E3, E5, by_increment=-1):
     """DOP853's scaled error of the step (5th- and 3rd-order embedded estimates, SciPy's norm),
     and whether y_new is finite.  Component ``by_increment`` (if >= 0), a phase that grows to
@@ -287,29 +177,6 @@ def error_norm(K, y, y_new, h, n, rtol, atol, E3, E5, by_increment=-1):
     if e5 == 0.0 and e3 == 0.0:
         return 0.0, finite
     return h * e5 / math.sqrt((e5 + 0.01 * e3) * n), finite
-
-
-@_jit
-def stiff_step(K, y_new, ys, n, h):
-    """Hairer's stiffness test for one accepted step: h |lambda| > 6.1, with |lambda|
-    estimated from the last two stages."""
-    num = 0.0
-    den = 0.0
-    for k in range(n):
-        num += (K[12, k] - K[11, k]) ** 2
-        den += (y_new[k] - ys[k]) ** 2
-    return den > 0.0 and h * math.sqrt(num / den) > 6.1
-
-
-@_jit
-def dense_coefficients(model, J, g, A, D, K, y, y_new, h, n, ys, F, with_q):
-    """DOP853's 7th-order dense output over the step just taken: three extra stages, then the
-    coefficients F (7, n).  Returns the number of evaluations (3)."""
-    for s in range(13, 16):
-        stage_point(A, K, y, h, s, n, ys)
-        lie_rhs(model, J, g, ys, K[s], with_q)
-    dense_assemble(D, K, y, y_new, h, n, F)
-    return 3
 
 
 @_jit
@@ -339,139 +206,6 @@ def dense_eval(F, y, x, n, out):
             else:
                 v *= 1.0 - x
         out[k] = y[k] + v
-
-
-@_jit
-def lie_dop853(model, J, g, w0, q0, t_eval, rtol, atol, h_max, with_q, max_steps, stop_on_stiff, w_max,
-               A, B, E3, E5, D, stop):
-    """Adaptive Lie-group DOP853 (error control and 7th-order dense output as in
-    Hairer's DOP853 / SciPy), with Hairer's stiffness detection (15 stiff steps in a row:
-    record the time, and return with status STIFF when ``stop_on_stiff``).
-
-    Returns (omega (N,3), q (N,4), nfev, nsteps, nrejected, status, t_event): t_event is where
-    stiffness was detected, or where |Omega| passed ``w_max`` (status RUNAWAY, the state kept in
-    omega[-1])."""
-    N = t_eval.shape[0]
-    n = 6 if with_q else 3
-    out_w = np.empty((N, 3))
-    out_q = np.empty((N, 4))
-    K = np.zeros((16, 6))
-    y = np.zeros(6)
-    y_new = np.zeros(6)
-    ys = np.zeros(6)
-    F = np.zeros((7, 6))
-    ec = np.zeros(3)                       # compensated-summation carries of Omega ...
-    ec_new = np.zeros(3)
-    et = 0.0                               # ... and of t
-    q = q0.copy()
-    y[0], y[1], y[2] = w0[0], w0[1], w0[2]
-    t = t_eval[0]
-    t_end = t_eval[-1]
-    out_w[0, :] = y[:3]
-    out_q[0, :] = q
-    j_out = 1
-    lie_rhs(model, J, g, y, K[0], with_q)
-    h = initial_step(model, J, g, y, K, ys, n, rtol, atol, t_end - t, h_max, with_q)
-    nfev = 2
-    nsteps = 0
-    nrej = 0
-    rejected = False
-    n_stiff = 0
-    n_nonstiff = 0
-    stiff_at = -1.0
-    err_exp = -1.0 / 8.0
-    while t < t_end:
-        if nsteps >= max_steps:
-            return out_w, out_q, nfev, nsteps, nrej, TOO_MANY_STEPS, stiff_at
-        if (nsteps + nrej) % STOP_POLL == 0 and stop[0] != 0:
-            return out_w, out_q, nfev, nsteps, nrej, INTERRUPTED, stiff_at
-        if h < 10.0 * abs(np.nextafter(t, np.inf) - t):
-            return out_w, out_q, nfev, nsteps, nrej, STEP_UNDERFLOW, stiff_at
-        if t + h > t_end:
-            h = t_end - t
-        # stages 1..11 and the new solution
-        for i in range(1, 12):
-            stage_point(A, K, y, h, i, n, ys)
-            lie_rhs(model, J, g, ys, K[i], with_q)
-        for k in range(n):
-            acc = 0.0
-            for l in range(12):
-                acc += B[l] * K[l, k]
-            if k < 3:
-                y_new[k], ec_new[k] = compensated(y[k], h * acc, ec[k])
-            else:
-                y_new[k] = y[k] + h * acc
-        lie_rhs(model, J, g, y_new, K[12], with_q)
-        nfev += 12
-        err, finite = error_norm(K, y, y_new, h, n, rtol, atol, E3, E5)
-        if not finite:
-            return out_w, out_q, nfev, nsteps, nrej, NOT_FINITE, stiff_at
-        if with_q:
-            un = math.sqrt(y_new[3] * y_new[3] + y_new[4] * y_new[4] + y_new[5] * y_new[5])
-            if un > U_MAX:
-                # more than half a turn: reject like an error, shrink to fit
-                h = h * 0.9 * U_MAX / un
-                nrej += 1
-                rejected = True
-                continue
-        if not err <= 1.0:                 # (a NaN error is a rejection too)
-            h = h * max(0.2, 0.9 * err ** err_exp)
-            nrej += 1
-            rejected = True
-            continue
-        if stiff_step(K, y_new, ys, n, h):
-            n_nonstiff = 0
-            n_stiff += 1
-            if n_stiff == 15 and stiff_at < 0.0:
-                stiff_at = t
-                if stop_on_stiff:
-                    return out_w, out_q, nfev, nsteps, nrej, STIFF, stiff_at
-        else:
-            n_nonstiff += 1
-            if n_nonstiff == 6:
-                n_stiff = 0
-        t_old = t
-        et_old = et
-        if t_old + et_old + h < t_end:
-            t, et = compensated(t_old, h, et)
-        else:
-            t = t_end
-            et = 0.0
-        # dense output for every requested time in (t_old, t]
-        if j_out < N and t_eval[j_out] <= t:
-            nfev += dense_coefficients(model, J, g, A, D, K, y, y_new, h, n, ys, F, with_q)
-            while j_out < N and t_eval[j_out] <= t:
-                dense_eval(F, y, ((t_eval[j_out] - t_old) - et_old) / h, n, ys)
-                out_w[j_out, 0] = ys[0]
-                out_w[j_out, 1] = ys[1]
-                out_w[j_out, 2] = ys[2]
-                out_q[j_out, :] = q
-                if with_q:
-                    apply_u(out_q[j_out], ys[3], ys[4], ys[5])
-                j_out += 1
-        if y_new[0] * y_new[0] + y_new[1] * y_new[1] + y_new[2] * y_new[2] > w_max * w_max:
-            out_w[N - 1, 0], out_w[N - 1, 1], out_w[N - 1, 2] = y_new[0], y_new[1], y_new[2]
-            return out_w, out_q, nfev, nsteps, nrej, RUNAWAY, t
-        # accept: advance, move the orientation, restart the chart at u = 0
-        for k in range(n):
-            y[k] = y_new[k]
-        for k in range(3):
-            ec[k] = ec_new[k]
-        if with_q:
-            apply_u(q, y[3], y[4], y[5])
-            y[3] = 0.0
-            y[4] = 0.0
-            y[5] = 0.0
-        K[0, 0], K[0, 1], K[0, 2] = K[12, 0], K[12, 1], K[12, 2]   # FSAL for Omega
-        if with_q:
-            K[0, 3], K[0, 4], K[0, 5] = y[0], y[1], y[2]          # dexp^-1_0 = identity
-        nsteps += 1
-        factor = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** err_exp)
-        if rejected:
-            factor = min(1.0, factor)
-        h = min(h * factor, h_max)
-        rejected = False
-    return out_w, out_q, nfev, nsteps, nrej, OK, stiff_at
 
 
 DOP853_ARRAYS = (T.DOP853_A, T.DOP853_B, T.DOP853_E3, T.DOP853_E5, T.DOP853_D)   # the system is autonomous: no c

@@ -17,12 +17,41 @@ the 8th-order DOP853 formula in substeps of at most 1/50 of the local decay time
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..interrupt import call_stoppable
+from . import status as ST
 from . import tableaus as T
 from .base import Integrator, Problem, Solution, register
-from .geometric import MAX_STEPS, _args, _solution
 
 RH_MAX = 0.02
+MAX_STEPS = 200_000_000
+
+
+def _args(problem: Problem):
+    """The kernel's arguments: model id, J, g, omega0, q0, t_eval, whether q is integrated."""
+    s = problem.system
+    J = tuple(float(x) for x in s.inertia)
+    g = tuple(float(x) for x in s.coupling)
+    w0 = np.asarray(problem.omega0, dtype=float)
+    q0 = np.asarray(problem.q0 if problem.q0 is not None else (1.0, 0.0, 0.0, 0.0), dtype=float)
+    t = np.asarray(problem.t_eval, dtype=float)
+    return ST.MODEL_ID[s.model], J, g, w0, q0, t, problem.kinematics == "quaternion"
+
+
+def _solution(problem, w, q, status, stats):
+    ok = status == ST.OK
+    with_q = problem.kinematics == "quaternion"
+    return Solution(
+        t=np.asarray(problem.t_eval, dtype=float),
+        omega=w if ok else np.full_like(w, np.nan),
+        q=(q if ok else np.full_like(q, np.nan)) if with_q else None,
+        success=ok,
+        message="" if ok else ST.MESSAGES.get(status, f"status {status}"),
+        stats=stats,
+        status=status,
+        reached=len(w) if ok else 0,
+    )
 
 
 def _solver(order: int):

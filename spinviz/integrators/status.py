@@ -1,6 +1,9 @@
 """Status codes shared by the compiled kernels and their Python wrappers, and what they mean."""
 
 OK, TOO_MANY_STEPS, STEP_UNDERFLOW, NOT_FINITE, STIFF, TURN_TOO_LARGE, INTERRUPTED, RUNAWAY = 0, 1, 2, 3, 4, 5, 6, 7
+# stopped by an event where the end state is known (the atlas's early stop), and a truncated
+# start refused before any step (codes as the atlas store has always written them)
+STOPPED_RESIDUAL, SINGULAR_START = 10, 11
 
 STOP_POLL = 256          # the compiled loops look at their stop flag every this many steps
 
@@ -13,6 +16,8 @@ MESSAGES = {
                     "at a full turn); use a smaller step",
     INTERRUPTED: "interrupted",
     RUNAWAY: "the solution runs away",
+    STOPPED_RESIDUAL: "stopped: residual rotation about d reached (the exact end state)",
+    SINGULAR_START: "the truncated equation (2.5) is singular or nearly so at the start",
 }
 
 # A run stops as a runaway when tau0 |Omega| exceeds RUNAWAY_FACTOR x max(tau0 |Omega0|, 1): the

@@ -118,6 +118,48 @@ def truncated_singularity(w1, w2, w3, J, g):
     return 1.0 + v1 * g1 / J1 + v2 * g2 / J2 + v3 * g3 / J3
 
 
+def symmetric_reduced_rate(w1, w2, w3, delta, n1, n3):
+    """(4.2)-(4.4): the reduced equation of the symmetric top J = (1, 1, 1 - delta) with the
+    coupling g = (n1, 0, n3) in the e1-e3 plane (dimensionless (4.1): n1 = sin chi, n3 = cos chi;
+    any |g| in spin units, the torque scaling with |g|^2), solved for omega_dot.
+
+    The paper's own form of (2.2)+(2.3) for this body (with the c^2 of (3.3)-(3.5) read as c^3),
+    written out (59 heyoka operations against 91 for ``reduced_terms`` with these J and g: the
+    atlas integrates this one); ``tests/test_equations.py`` checks it against the general rate.
+    """
+    w_sq = w1 * w1 + w2 * w2 + w3 * w3
+    wa = w_sq + delta * (delta - 2.0) * w3 * w3          # omega_a^2
+    wb = w_sq + delta * (2.0 * w1 * w1 - w2 * w2)        # omega_b^2
+    wc = w_sq + delta * (delta + 1.0) * w3 * w3          # omega_c^2
+    a1 = delta * w2 * w3 - n3 * n3 * wa * w1 + n1 * n3 * wb * w3
+    a2 = -delta * w1 * w3 - (n1 * n1 * wc + n3 * n3 * wa - 3.0 * n1 * n3 * delta * w1 * w3) * w2
+    a3 = (n1 * n3 * wa * w1 - n1 * n1 * wb * w3) / (1.0 - delta)
+    return a1, a2, a3
+
+
+def symmetric_truncated_rate(w1, w2, w3, delta, n1, n3):
+    """The truncated equation (2.5) of the same symmetric top, solved for omega_dot: the
+    analogue of (4.2)-(4.4) the paper does not print (spinviz's derivation, checked against
+    ``truncated_terms`` in ``tests/test_equations.py``).
+
+    With J = (1, 1, 1 - delta), g = (n1, 0, n3): Omega x J Omega = (-delta w2 w3, delta w1 w3, 0);
+    v = g x omega = (-n3 w2, n3 w1 - n1 w3, n1 w2); J^-1 g = (n1, 0, n3/(1 - delta)), so
+    v . J^-1 g = n1 n3 delta w2 / (1 - delta); and omega_dot = f + s - k J^-1 g with the free
+    rate f = (delta w2 w3, -delta w1 w3, 0), s = -|v|^2 J^-1 omega and
+    k = v . (f + s) / (1 + v . J^-1 g) (Sherman-Morrison, as in ``truncated_terms``).
+    """
+    e = 1.0 - delta
+    v1, v2, v3 = -n3 * w2, n3 * w1 - n1 * w3, n1 * w2
+    v_sq = v1 * v1 + v2 * v2 + v3 * v3
+    f1, f2 = delta * w2 * w3, -delta * w1 * w3
+    s1, s2, s3 = -v_sq * w1, -v_sq * w2, -v_sq * w3 / e
+    k = (v1 * (f1 + s1) + v2 * (f2 + s2) + v3 * s3) / (1.0 + n1 * n3 * delta * w2 / e)
+    return f1 + s1 - k * n1, f2 + s2, s3 - k * n3 / e
+
+
+SYMMETRIC_RATES = {"reduced": symmetric_reduced_rate, "truncated": symmetric_truncated_rate}
+
+
 _RATES = {"reduced": reduced_rate, "truncated": truncated_rate, "free": free_rate}
 _TERMS = {"reduced": reduced_terms, "truncated": truncated_terms, "free": free_terms}
 
@@ -177,16 +219,17 @@ def quat_rate(q0, q1, q2, q3, w1, w2, w3):
     )
 
 
-def euler_zxz_rate(phi, theta, psi, w1, w2, w3):
+def euler_zxz_rate(phi, theta, psi, w1, w2, w3, sin=np.sin, cos=np.cos):
     """The Poisson equations (6.4): (phi_dot, theta_dot, psi_dot) from body Omega.
 
     Singular at sin(theta) = 0 -- kept as the comparison the quaternion kinematics
     replaces; integrating it near theta = 0 blows up (see ``spinviz stress``).
+    ``sin``, ``cos``: the functions to use (NumPy's; heyoka's when building a Taylor system).
     """
-    s, c = np.sin(psi), np.cos(psi)
+    s, c = sin(psi), cos(psi)
     a = w1 * s + w2 * c
-    st = np.sin(theta)
-    return a / st, w1 * c - w2 * s, w3 - a * np.cos(theta) / st
+    st = sin(theta)
+    return a / st, w1 * c - w2 * s, w3 - a * cos(theta) / st
 
 
 def is_symmetric(inertia) -> bool:

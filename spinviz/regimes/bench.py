@@ -47,28 +47,6 @@ def task_cost(n: int = 200, workers: int = 2) -> float:
         return 1e3 * (time.perf_counter() - t0) / n
 
 
-def driver_overhead(n: int = 300) -> dict:
-    """Microseconds per call: ``simulate`` (kinematics none) vs the kernel, a short run."""
-    from ..driver import simulate
-    from ..physics.bodies import symmetric_top
-    from .runs import Settings, integrate
-
-    body = symmetric_top(0.3, 0.5)
-    w0 = np.array([0.05, 0.02, 0.04])
-    st = Settings(tau_end=10.0, tau_start=1.0, per_decade=6)
-    t_eval = st.times()
-    simulate(body, "reduced", w0, t_eval=t_eval, method="lie-dop853", kinematics="none", rtol=1e-8, atol=1e-20)
-    integrate("reduced", 0.3, 0.5, w0, st)
-    t0 = time.perf_counter()
-    for _ in range(n):
-        simulate(body, "reduced", w0, t_eval=t_eval, method="lie-dop853", kinematics="none", rtol=1e-8, atol=1e-20)
-    t1 = time.perf_counter()
-    for _ in range(n):
-        integrate("reduced", 0.3, 0.5, w0, st)
-    t2 = time.perf_counter()
-    return {"driver_us": 1e6 * (t1 - t0) / n, "kernel_us": 1e6 * (t2 - t1) / n}
-
-
 def run(spec, workers: int | None = None, progress: bool = True) -> dict:
     """All measurements (see the module docstring) as a dict of plain numbers."""
     spec = spec if isinstance(spec, AtlasSpec) else load_spec(spec)
@@ -102,7 +80,6 @@ def run(spec, workers: int | None = None, progress: bool = True) -> dict:
         rows["speedup"] = per[many]["runs_per_s"] / per[1]["runs_per_s"] if many != 1 else 1.0
         rows["task_ms"] = task_cost(workers=many)
         rows["task_overhead_share"] = rows["task_ms"] / 1e3 / per[1]["mean_task_s"]
-        rows.update(driver_overhead())
         # projections: one worker's measured seconds per run (everything included), divided
         # over n cores; on 64 the scheduler's cost per task is added as a share, and the
         # longest task as the tail while the last tasks finish
@@ -141,7 +118,6 @@ def format_table(r: dict) -> str:
         f"cost of one run (1 worker): mean {p1['mean_run_s'] * 1e3:.1f} ms, median {p1['median_run_s'] * 1e3:.1f} ms, "
         f"99th percentile {p1['p99_run_s'] * 1e3:.0f} ms, max {p1['max_run_s']:.2f} s; median {p1['median_steps']:.0f} steps",
         f"an empty Dask task: {r['task_ms']:.2f} ms = {100 * r['task_overhead_share']:.2f} % of a mean task",
-        f"per call, a short run: driver simulate() {r['driver_us']:.0f} us, kernel direct {r['kernel_us']:.0f} us",
         f"projected 64 x 64 x 32 x {len(r['models'])} model(s) = {pj['runs']} runs: {pj['1_core_h']:.2f} h on 1 core, "
         f"{pj['2_cores_h']:.2f} h on 2, {pj['64_cores_min']:.1f} min on 64 (with the longest task, "
         f"{max(p['max_task_s'] for p in r['by_workers'].values()):.0f} s, as the tail)",

@@ -190,7 +190,7 @@ def hodographs(ds, path: str):
     s = _spec(ds)
     rs = s["run"]
     st = Settings(tau_end=rs["tau_end"], tau_start=rs["tau_start"], per_decade=max(60, rs["samples_per_decade"]),
-                  rtol=rs["rtol"], atol=rs["atol"], max_steps=rs["max_steps"], window=s["classify"]["window_decades"])
+                  rtol=rs["rtol"], max_steps=rs["max_steps"], window=s["classify"]["window_decades"])
     n = max(1, len(reps))
     cols = min(n, 3)
     rows = math.ceil(n / cols)

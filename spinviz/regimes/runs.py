@@ -1,22 +1,21 @@
-"""Batches of Euler-only runs with the compiled kernel, each run classified where it ran.
+"""Batches of Euler-only runs through the one driver, each run classified where it ran.
 
-One run integrates the dimensionless Euler equation (no orientation: ``with_q = False``) of a
-symmetric top J = (1, 1, 1 - delta), d = (sin chi, 0, cos chi) from omega(0) to ``tau_end``,
-sampled at log-spaced times, with ``kernels.lie_dop853`` called directly: the driver's
-``simulate`` costs ~0.3 ms a call in checks and unit conversions and returns nothing when a
-run fails, while a batch needs the partial series of a failed run and thousands of calls.
+One run integrates the dimensionless Euler equation (no orientation) of a symmetric top
+J = (1, 1, 1 - delta), d = (sin chi, 0, cos chi) from omega(0) to ``tau_end``, sampled at
+log-spaced times.  The runs of a batch go to ``driver.solve_many`` together, which hands them
+to Taylor's method in heyoka's batch mode (``heyoka.recommended_simd_size()`` runs per SIMD
+vector, 8 here) on the scaled variable omega sqrt(1 + tau/T) (T = 1/|omega0|^2), so the
+tolerance keeps its meaning to the end of the run however far omega ~ 1/sqrt(tau) has fallen.
 
-The run goes decade by decade (one kernel call per decade of samples, ~9 us each), which
-buys three things: a step budget whose exhaustion still leaves the decades already done; a
-stop as soon as a residual rotation is reached where the paper proves it is the end state
-(reduced model at chi = 0 or pi/2 or delta = 0, (5.2), (5.6): there the explicit method is
-held at the precession period by stability and the cost grows like tau, ~1e8 steps to 1e10);
-and a stop flag looked at between decades.  The restart costs the DOP853 starting-step
-estimate, ~2 right-hand sides, per decade.
+Early stops are terminal events, not restarts: a runaway (the reduction (2.3) breaking down)
+and, where the paper proves the residual rotation about d is the end state (reduced model at
+chi = 0 or pi/2 or delta = 0, (5.2), (5.6)), reaching it: |d x omega| < ``RESIDUAL_ETA`` |d|
+|omega|.  There a resolving method would follow the steady rotation turn by turn to tau_end
+(~1e8 steps); the samples after the stop are the rotation reached, held, and the reason says
+so.  A run that fails keeps its samples so far and its reason; the batch goes on.
 
 ``run_batch`` is what a Dask task executes: a block of the atlas (one model, a few cells,
-some members), returned as small arrays; a run that fails is recorded with its reason and
-never stops the batch.
+some members), returned as small arrays.
 """
 
 from __future__ import annotations
@@ -31,17 +30,17 @@ import numpy as np
 from ..integrators import status as ST
 from . import classify as C
 
-# status of a run (int8 in the store): the kernel's codes, and these
-STOPPED_RESIDUAL = 10      # stopped early: residual rotation about d reached where it is the exact end state
-SINGULAR_START = 11        # truncated (2.5) singular or nearly so at omega(0)
+STOPPED_RESIDUAL = ST.STOPPED_RESIDUAL   # stopped early: residual rotation about d reached where it is the exact end state
+SINGULAR_START = ST.SINGULAR_START       # truncated (2.5) singular or nearly so at omega(0)
 ERROR = 12                 # an exception (its message is the reason)
 STATUS_TEXT = {ST.OK: "ok", ST.TOO_MANY_STEPS: "step budget exhausted", ST.STEP_UNDERFLOW: "step underflow",
                ST.NOT_FINITE: "not finite", ST.STIFF: "stiff", ST.TURN_TOO_LARGE: "turn too large",
-               ST.INTERRUPTED: "interrupted", STOPPED_RESIDUAL: "stopped: residual rotation reached",
+               ST.INTERRUPTED: "interrupted", ST.RUNAWAY: "runaway", STOPPED_RESIDUAL: "stopped: residual rotation reached",
                SINGULAR_START: "singular start", ERROR: "error"}
-METHOD = "lie-dop853"      # the one method used (the store's ``method`` variable names it per run)
+METHOD = "taylor"          # the one method used (the store's ``method`` variable names it per run)
 METHOD_CODE = {METHOD: 0}
 SINGULAR_MARGIN = 0.5      # truncated: refuse a start where 1 + (g x omega).J^-1 g < this
+RESIDUAL_ETA = 1e-9        # rad: |d x omega|/(|d||omega|) at which a run in an exact-residual cell stops
 
 
 @dataclass(frozen=True)
@@ -49,15 +48,14 @@ class Settings:
     """How every run of an atlas is integrated and classified (part of the spec's identity).
 
     tau_end : horizon, tau = t/tau0.  tau_start : first sample after 0.  per_decade : samples
-    a decade.  rtol, atol : DOP853 tolerances (atol absolute in omega).  max_steps : step
-    budget of one run.  window : decades the classifier analyses.
+    a decade.  rtol : Taylor tolerance on the scaled omega sqrt(1 + tau/T) / |omega0|.
+    max_steps : step budget of one run (of its SIMD batch).  window : decades the classifier analyses.
     """
 
     tau_end: float = 1e10
     tau_start: float = 1e-2
     per_decade: int = 20
     rtol: float = 1e-8
-    atol: float = 1e-20
     max_steps: int = 20_000_000
     window: float = 2.0
 
@@ -78,74 +76,27 @@ def residual_is_exact(model: str, delta: float, chi: float) -> bool:
     return model == "reduced" and (chi == 0.0 or chi == 0.5 * math.pi or delta == 0.0)
 
 
-@dataclass
-class Run:
-    """One integrated run: samples up to ``reached`` (tau, omega), why it ended, its cost."""
+def integrate_many(model: str, cells: list, omega0: list, settings: Settings, stop=None) -> list:
+    """Runs of ``model`` from omega0[i] at cells[i] = (delta, chi), through ``driver.solve_many``:
+    a list of ``driver.Run`` (tau, omega (N, 3), status, reached, t_stop, reason, ...); after a
+    residual stop the samples are the rotation reached, held."""
+    from ..driver import solve_many
 
-    tau: np.ndarray
-    omega: np.ndarray
-    status: int
-    nsteps: int
-    nfev: int
-    seconds: float
-    reason: str = ""
-    verdict: C.Verdict | None = None     # the classification already made of exactly these samples
-
-
-def integrate(model: str, delta: float, chi: float, omega0, settings: Settings, stop=None) -> Run:
-    """One Euler-only run, decade by decade (see the module docstring).
-
-    omega0 : shape (3,), body frame, dimensionless.  stop : optional int64 array of length 1;
-    a nonzero value ends the run (status INTERRUPTED) at the next poll of the kernel.
-    """
-    # numba: the kernel is compiled, or loaded from its cache, on first use
-    from ..integrators import kernels as KN
-    from ..physics.equations import truncated_singularity
-
-    J = (1.0, 1.0, 1.0 - float(delta))
-    g = (math.sin(chi), 0.0, math.cos(chi))
-    w0 = np.asarray(omega0, dtype=float)
     t = settings.times()
-    out = np.empty((len(t), 3))
-    out[0] = w0
-    t0 = time.perf_counter()
-    if model == "truncated":
-        den = truncated_singularity(w0[0], w0[1], w0[2], J, g)
-        if not den >= SINGULAR_MARGIN:
-            return Run(t[:1], out[:1], SINGULAR_START, 0, 0, time.perf_counter() - t0,
-                       f"truncated (2.5) near-singular at the start: 1 + (g x omega).J^-1 g = {den:.3g}; "
-                       f"use a smaller |omega(0)| (below (1 - delta)/2)")
-    stop = np.zeros(1, dtype=np.int64) if stop is None else stop
-    exact_res = residual_is_exact(model, delta, chi)
-    mid = KN.MODEL_ID[model]
-    q0 = np.array([1.0, 0.0, 0.0, 0.0])
-    nsteps = nfev = 0
-    a = 0                                        # index of the segment's first sample (already known)
-    status = ST.OK
-    reason = ""
-    per = settings.per_decade
-    while a < len(t) - 1:
-        b = min(len(t) - 1, (a // per + 1) * per)   # a decade of samples (the first segment adds 0 -> tau_start)
-        seg = t[a:b + 1]
-        w, _, nf, ns, _, st, _ = KN.lie_dop853(mid, J, g, out[a].copy(), q0, seg, settings.rtol, settings.atol, np.inf,
-                                               False, max(1, settings.max_steps - nsteps), False, np.inf,
-                                               *KN.DOP853_ARRAYS, stop)
-        nsteps += int(ns)
-        nfev += int(nf)
-        if st != ST.OK:
-            status = int(st)
-            what = ST.MESSAGES.get(status, STATUS_TEXT.get(status, str(status)))
-            reason = f"{what} between tau = {seg[0]:.3g} and {seg[-1]:.3g}"
-            break
-        out[a + 1:b + 1] = w[1:]
-        a = b
-        if exact_res and t[a] >= settings.tau_start * 10.0 ** (settings.window + 2):
-            v = C.classify(t[:a + 1], out[:a + 1], delta, chi, model, settings.window)
-            if v.label == "R" and v.confidence >= 0.9:
-                status, reason = STOPPED_RESIDUAL, f"residual rotation about d reached by tau = {t[a]:.3g} (exact end state)"
-                break
-    return Run(t[:a + 1], out[:a + 1], status, nsteps, nfev, time.perf_counter() - t0, reason,
-               v if status == STOPPED_RESIDUAL else None)
+    inertia = [(1.0, 1.0, 1.0 - float(d)) for d, _ in cells]
+    coupling = [(math.sin(c), 0.0, math.cos(c)) for _, c in cells]
+    eta = [RESIDUAL_ETA if residual_is_exact(model, float(d), float(c)) else 0.0 for d, c in cells]
+    runs = solve_many(model, inertia, coupling, omega0, t, rtol=settings.rtol, max_steps=settings.max_steps,
+                      residual_eta=eta, singular_margin=SINGULAR_MARGIN, stop=stop)
+    for r in runs:
+        if r.status == STOPPED_RESIDUAL and r.reached < len(t):
+            r.omega[r.reached:] = r.omega[r.reached - 1]
+    return runs
+
+
+def integrate(model: str, delta: float, chi: float, omega0, settings: Settings, stop=None):
+    """One run (``integrate_many`` of one)."""
+    return integrate_many(model, [(delta, chi)], [np.asarray(omega0, dtype=float)], settings, stop)[0]
 
 
 @dataclass
@@ -166,33 +117,30 @@ class Record:
     seconds: float
 
 
-def run_and_classify(model: str, delta: float, chi: float, omega0, settings: Settings, stop=None) -> Record:
-    """``integrate`` then ``classify``, with the honest label for every way a run can end:
+def classify_run(r, model: str, delta: float, chi: float, settings: Settings) -> Record:
+    """The honest label for every way a run can end:
 
-    * horizon reached (or the exact residual rotation reached early): the classifier's label;
+    * horizon reached (or the exact residual rotation reached early, held to the horizon):
+      the classifier's label;
     * step budget exhausted: "other", with the label the samples so far would get as the
       candidate (never a label the horizon was not reached for);
-    * the solution left the finite numbers, the step underflowed, a singular truncated start,
-      an exception: "failed" with its reason.
+    * a runaway, the solution leaving the finite numbers, a singular truncated start, an
+      exception: "failed" with its reason.
     ``label_early`` is the label of the same run cut ``window`` decades before its end: when it
     agrees with ``label`` the regime held over the last 2 x window decades."""
     nan_ev = np.full(len(C.EVIDENCE), np.nan)
-    try:
-        r = integrate(model, delta, chi, omega0, settings, stop)
-    except Exception as e:                        # recorded, never raised: the batch goes on
-        return Record("failed", "failed", "none", 0.0, ERROR, f"{type(e).__name__}: {e}", nan_ev, np.full(3, np.nan),
-                      0.0, 0, 0, 0.0)
-    if r.status == ST.INTERRUPTED:
-        raise InterruptedError("stop flag set")
-    reached = float(r.tau[-1])
-    fin = r.omega[-1].copy()
-    base = dict(omega_final=fin, tau_reached=reached, nsteps=r.nsteps, nfev=r.nfev, seconds=r.seconds)
+    held = r.status == STOPPED_RESIDUAL
+    n = len(r.tau) if held else r.reached
+    tau, omega = r.tau[:n], r.omega[:n]
+    reached = float(r.tau[n - 1]) if not held else float(r.t_stop)
+    fin = omega[n - 1].copy() if n else np.full(3, np.nan)
+    base = dict(omega_final=fin, tau_reached=reached, nsteps=r.nsteps, nfev=0, seconds=r.seconds)
     if r.status not in (ST.OK, STOPPED_RESIDUAL, ST.TOO_MANY_STEPS):
         return Record("failed", "failed", "none", 0.0, r.status, r.reason, nan_ev, **base)
     try:
-        v = r.verdict if r.verdict is not None else C.classify(r.tau, r.omega, delta, chi, model, settings.window)
-        cut = r.tau <= reached / 10.0**settings.window * (1.0 + 1e-9)
-        early = C.classify(r.tau[cut], r.omega[cut], delta, chi, model, settings.window).label
+        v = C.classify(tau, omega, delta, chi, model, settings.window)
+        cut = tau <= float(tau[-1]) / 10.0**settings.window * (1.0 + 1e-9)
+        early = C.classify(tau[cut], omega[cut], delta, chi, model, settings.window).label
     except Exception as e:
         return Record("failed", "failed", "none", 0.0, ERROR, f"classifier: {type(e).__name__}: {e}", nan_ev, **base)
     if r.status == ST.TOO_MANY_STEPS:
@@ -200,6 +148,22 @@ def run_and_classify(model: str, delta: float, chi: float, omega0, settings: Set
                       f"{r.reason}; the samples so far say {v.label} ({v.confidence:.2f})", v.vector(), **base)
     reason = r.reason + "; " + v.reason if r.reason else v.reason
     return Record(v.label, early, v.candidate, v.confidence, r.status, reason, v.vector(), **base)
+
+
+def run_and_classify(model: str, delta: float, chi: float, omega0, settings: Settings, stop=None) -> Record:
+    """``integrate`` then ``classify_run`` (an exception in the integration is a failed run)."""
+    try:
+        r = integrate(model, delta, chi, omega0, settings, stop)
+    except InterruptedError:
+        raise
+    except Exception as e:                        # recorded, never raised: the batch goes on
+        return _error_record(e)
+    return classify_run(r, model, delta, chi, settings)
+
+
+def _error_record(e: Exception) -> Record:
+    return Record("failed", "failed", "none", 0.0, ERROR, f"{type(e).__name__}: {e}", np.full(len(C.EVIDENCE), np.nan),
+                  np.full(3, np.nan), 0.0, 0, 0, 0.0)
 
 
 # --- a batch: what one Dask task computes -----------------------------------------------------
@@ -242,22 +206,30 @@ def run_batch(batch: Batch) -> dict:
         "evidence": np.empty(shape + (len(C.EVIDENCE),)), "omega_final": np.empty(shape + (3,)),
         "reason": np.empty(shape, dtype=f"<U{REASON_CHARS}"),
     }
-    for i, d in enumerate(batch.deltas):
-        for j, c in enumerate(batch.chis):
-            for k in range(nm):
-                r = run_and_classify(batch.model, float(d), float(c), batch.omega0[k], batch.settings)
-                out["regime"][i, j, k] = code(r.label)
-                out["regime_early"][i, j, k] = code(r.label_early)
-                out["candidate"][i, j, k] = code(r.candidate)
-                out["status"][i, j, k] = r.status
-                out["confidence"][i, j, k] = r.confidence
-                out["tau_reached"][i, j, k] = r.tau_reached
-                out["run_seconds"][i, j, k] = r.seconds
-                out["nsteps"][i, j, k] = r.nsteps
-                out["nfev"][i, j, k] = r.nfev
-                out["evidence"][i, j, k] = r.evidence
-                out["omega_final"][i, j, k] = r.omega_final
-                out["reason"][i, j, k] = r.reason[:REASON_CHARS]
+    cells = [(float(d), float(c)) for d in batch.deltas for c in batch.chis for _ in range(nm)]
+    starts = [np.asarray(batch.omega0[k], dtype=float) for _ in batch.deltas for _ in batch.chis for k in range(nm)]
+    try:
+        runs = integrate_many(batch.model, cells, starts, batch.settings)
+        records = [classify_run(r, batch.model, d, c, batch.settings) for r, (d, c) in zip(runs, cells)]
+    except InterruptedError:
+        raise
+    except Exception as e:                        # the whole batch failed: every run says why
+        records = [_error_record(e)] * len(cells)
+    for n, r in enumerate(records):
+        i, rest = divmod(n, nc * nm)
+        j, k = divmod(rest, nm)
+        out["regime"][i, j, k] = code(r.label)
+        out["regime_early"][i, j, k] = code(r.label_early)
+        out["candidate"][i, j, k] = code(r.candidate)
+        out["status"][i, j, k] = r.status
+        out["confidence"][i, j, k] = r.confidence
+        out["tau_reached"][i, j, k] = r.tau_reached
+        out["run_seconds"][i, j, k] = r.seconds
+        out["nsteps"][i, j, k] = r.nsteps
+        out["nfev"][i, j, k] = r.nfev
+        out["evidence"][i, j, k] = r.evidence
+        out["omega_final"][i, j, k] = r.omega_final
+        out["reason"][i, j, k] = r.reason[:REASON_CHARS]
     return {"region": batch.region, "data": out, "worker_pid": os.getpid(), "compute_s": time.perf_counter() - start,
             "cpu_s": time.process_time() - cpu0, "max_rss_mb": max_rss_mb()}
 
@@ -279,8 +251,13 @@ def max_rss_mb() -> float:
     return kb / (1024.0 * 1024.0) if sys.platform == "darwin" else kb / 1024.0
 
 
-def warm() -> float:
-    """Load (or compile, once, into numba's cache) the kernel; returns the seconds it took."""
+def warm(settings: Settings | None = None) -> float:
+    """Load (or compile, once, into heyoka's on-disk cache) the batch integrator of both models
+    at the atlas's tolerance; returns the seconds it took."""
+    from ..integrators.taylor import template, tolerance, width
+
     t0 = time.perf_counter()
-    integrate("reduced", 0.3, 0.5, (0.05, 0.05, 0.05), Settings(tau_end=1.0, tau_start=0.1, per_decade=2))
+    tol, _ = tolerance((settings or Settings()).rtol, (settings or Settings()).rtol)
+    for model in ("reduced", "truncated"):
+        template(model, "none", tol, "double", width())
     return time.perf_counter() - t0

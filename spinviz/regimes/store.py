@@ -143,7 +143,7 @@ def template(spec, chunks: tuple):
         "seed": -1 if spec.seed is None else int(spec.seed),
         "spinviz_version": __version__,
         "classifier_version": C.VERSION,
-        "method": f"{RN.METHOD} (compiled, Euler equation only), rtol {s.rtol:g}, atol {s.atol:g}, decade by decade",
+        "method": f"{RN.METHOD} (heyoka batch mode, Euler equation only, on omega sqrt(1 + tau/T)), rtol {s.rtol:g}",
         "conventions": "dimensionless (4.1): tau = t/tau0, omega = tau0 Omega; body frame; J = (1, 1, 1 - delta), "
                        "d = (sin chi, 0, cos chi)",
     }

@@ -129,28 +129,47 @@ POLL_S = 0.05
 
 def call_stoppable(kernel, *args):
     """``kernel(*args, stop)`` in a helper thread (the kernel releases the GIL and polls
-    ``stop[0]``); a stop signal sets the flag and is re-raised once the kernel returned."""
+    ``stop[0]``); a stop signal sets the flag and is re-raised once the kernel returned.
+
+    The main thread waits on an Event, not on ``Thread.join``: a signal whose handler raises
+    inside ``join`` makes CPython 3.11 mark the still-running thread as stopped (its
+    bpo-45274 clean-up releases the thread's state lock), so a second ``join`` returns at
+    once and the interpreter could exit under a kernel still in C++ (heyoka then aborts:
+    "terminate called without an active exception")."""
     stop = np.zeros(1, dtype=np.int64)
     if threading.current_thread() is not threading.main_thread():
         return kernel(*args, stop)                 # signals only reach the main thread anyway
     box: dict = {}
+    done = threading.Event()
 
     def run():
         try:
             box["value"] = kernel(*args, stop)
         except BaseException as e:                 # handed to the caller below
             box["error"] = e
+        finally:
+            done.set()
 
     t = threading.Thread(target=run, name="spinviz-kernel", daemon=True)
     try:
         t.start()
-        while t.is_alive():
-            t.join(POLL_S)
+        while not done.wait(POLL_S):
+            pass
     except BaseException:
         stop[0] = 1
         if t.ident is not None:                    # started (the signal may land inside start())
-            t.join()
+            _wait_out(done)
         raise
     if "error" in box:
         raise box["error"]
     return box["value"]
+
+
+def _wait_out(done: threading.Event) -> None:
+    """Wait for a stopped kernel to return (a poll interval of its loop), whatever else arrives."""
+    while True:
+        try:
+            if done.wait(POLL_S):
+                return
+        except BaseException:                      # a later signal: still wait, the first one is being handled
+            continue

@@ -54,3 +54,24 @@ def test_library_frames_are_judged_by_module_name(tmp_path):
     ns["__name__"] = "vtkmodules.util.something"
     exec(code, ns)
     assert ns["result"] is True
+
+
+def test_a_stopped_kernel_has_returned_before_the_signal_is_reraised():
+    """A signal landing while the main thread waits for a kernel: the exception reaches the
+    caller only after the kernel saw its stop flag and returned.  (With Thread.join, CPython
+    3.11 marks the still-running thread stopped when the handler raises inside join; the
+    process could then exit under a kernel still in C++, and heyoka aborts there.)"""
+    returned = []
+
+    def kernel(stop):
+        while stop[0] == 0:
+            threading.Event().wait(0.005)
+        threading.Event().wait(0.2)               # slow to wind down: longer than a poll interval
+        returned.append(True)
+
+    timer = threading.Timer(0.12, send)
+    with interrupt.handlers():
+        timer.start()
+        with pytest.raises(interrupt.Interrupted):
+            interrupt.call_stoppable(kernel)
+        assert returned == [True]

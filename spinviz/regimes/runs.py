@@ -174,6 +174,7 @@ def run_and_classify(model: str, delta: float, chi: float, omega0, settings: Set
       candidate (never a label the horizon was not reached for);
     * the solution left the finite numbers, the step underflowed, a singular truncated start,
       an exception: "failed" with its reason.
+
     ``label_early`` is the label of the same run cut ``window`` decades before its end: when it
     agrees with ``label`` the regime held over the last 2 x window decades."""
     nan_ev = np.full(len(C.EVIDENCE), np.nan)

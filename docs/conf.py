@@ -59,8 +59,8 @@ templates_path = ["_templates"]
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3        # README links such as (#regime-atlas) resolve
 suppress_warnings = [
-    # The included README and docs/*.md are GitHub Markdown: they start at "##" under the
-    # page's "#", and keep their own heading levels.
+    # A README section is included from below its own "##" heading (the page's "#" title
+    # replaces it), so its "###" subsections follow the "#" directly.
     "myst.header",
 ]
 

@@ -37,6 +37,7 @@ def reduced_terms(w1, w2, w3, J, g, free):
 
     J Omega_dot + Omega x J Omega = g x { g x (Omega^2 Omega - Omega_ddot)
                                         + (g . Omega_dot) Omega + 2 (g . Omega) Omega_dot },
+
     with Omega_dot, Omega_ddot on the right replaced by their free-motion values.
     ``free`` = 1 gives the whole rate; ``free`` = 0 only the radiation part J^-1 torque, which
     for real particles is 1e-16 of the free part and would drown in its round-off if the two

@@ -21,7 +21,7 @@ sample when it keeps its sign, else on half-decade RMS values.  The slopes of th
 of the window tell a settled power law from a drifting one.
 
 Phenomenological classes come first (they do not depend on the paper being right), then
-the model's name for them:
+the model's name for them::
 
     class              evidence                                             reduced  truncated
     axial-stopped      omega3 ~ tau^-1/2 dominant, omega_perp ~ 1/tau, phi stopped   "1"

@@ -126,6 +126,7 @@ def classify_run(r, model: str, delta: float, chi: float, settings: Settings) ->
       candidate (never a label the horizon was not reached for);
     * a runaway, the solution leaving the finite numbers, a singular truncated start, an
       exception: "failed" with its reason.
+
     ``label_early`` is the label of the same run cut ``window`` decades before its end: when it
     agrees with ``label`` the regime held over the last 2 x window decades."""
     nan_ev = np.full(len(C.EVIDENCE), np.nan)

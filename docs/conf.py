@@ -1,0 +1,163 @@
+"""Sphinx configuration of the spinviz documentation.
+
+Build (no network needed): ``sphinx-build -W --keep-going -b html docs docs/_build/html``.
+
+The content pages are Markdown (MyST).  Pages whose numbers other commands regenerate
+(``docs/accuracy.md`` by ``spinviz report``, ``docs/atlas.md``) are pages of this site as
+they are, and the README's sections are *included*, never copied, so the site shows what
+the repository says today.  The API reference is generated from the docstrings by
+autosummary/autodoc.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import sys
+from pathlib import Path
+
+DOCS = Path(__file__).resolve().parent
+ROOT = DOCS.parent
+sys.path.insert(0, str(ROOT))          # the checkout's spinviz, installed or not
+
+# Importing for autodoc must never need a display: pyvista is imported (not plotted) by
+# the rendering modules; keep it and VTK off-screen should anything ask for a window.
+os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+import spinviz  # noqa: E402
+
+project = "spinviz"
+author = "spinviz developers"
+copyright = "spinviz developers (MIT licence)"
+version = release = spinviz.__version__
+
+extensions = [
+    "myst_parser",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.autosummary",
+    "sphinx.ext.mathjax",
+    "sphinx.ext.viewcode",
+    "sphinx_copybutton",
+    # MathJax 3 shipped inside a PyPI package and copied into _static: the physics page's
+    # equations render with no network, at build time or when the page is read.
+    "sphinx-mathjax-offline",
+]
+
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+root_doc = "index"
+exclude_patterns = [
+    "_build",
+    "Thumbs.db",
+    ".DS_Store",
+    # a branch's notes to the owners of other files, not documentation
+    "pictures_integration.md",
+]
+templates_path = ["_templates"]
+
+# --- MyST -------------------------------------------------------------------------------
+myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
+myst_heading_anchors = 3        # README links such as (#regime-atlas) resolve
+suppress_warnings = [
+    # A README section is included from below its own "##" heading (the page's "#" title
+    # replaces it), so its "###" subsections follow the "#" directly.
+    "myst.header",
+]
+
+# --- API reference ------------------------------------------------------------------------
+autosummary_generate = True
+autosummary_imported_members = False
+autodoc_default_options = {"members": True, "show-inheritance": True, "member-order": "bysource"}
+autodoc_typehints = "signature"
+autodoc_preserve_defaults = True      # the signature shows ``method='auto'``, not a repr
+add_module_names = False
+# Heavy optional stacks are installed for the docs build (the "docs" extra pulls the render
+# and ensemble extras), so nothing is mocked: what the reference shows is what imports.
+
+# The project's docstrings (see STYLE.md) list parameters as lines ``name : meaning`` (shape,
+# units and frame on the line), not in numpydoc sections; shown as reST they would run
+# together into one paragraph.  This turns such a paragraph into a definition list.
+_PARAM = re.compile(r"^(?P<names>[A-Za-z_*][\w*]*(?:\s*,\s*[A-Za-z_*][\w*]*)*)\s+:\s+(?P<text>\S.*)$")
+
+
+def _parameter_lists(app, what, name, obj, options, lines):
+    out: list[str] = []
+    i = 0
+    while i < len(lines):
+        j = i
+        while j < len(lines) and lines[j].strip():
+            j += 1
+        block = lines[i:j]
+        if block and _PARAM.match(block[0]):         # indented blocks (literal, quoted) never match
+            for line in block:
+                m = _PARAM.match(line)
+                if m:
+                    names = ", ".join(f"``{n.strip()}``" for n in m["names"].split(","))
+                    out += [names, f"    {m['text']}"]
+                else:
+                    out.append(f"    {line.strip()}")
+        else:
+            out += block
+        if j < len(lines):
+            out.append(lines[j])
+        i = j + 1
+    lines[:] = out
+
+
+# |x| is the docstrings' notation for a magnitude (|omega(0)|, |Omega|), never a reST
+# substitution: escape the bars outside inline literals and literal blocks.
+_LITERAL = re.compile(r"(``.*?``)")
+
+
+def _magnitude_bars(app, what, name, obj, options, lines):
+    literal_indent = None                      # indentation of the "::" paragraph, inside a literal block
+    for k, line in enumerate(lines):
+        indent = len(line) - len(line.lstrip())
+        if literal_indent is not None:
+            if not line.strip() or indent > literal_indent:
+                continue
+            literal_indent = None
+        if line.lstrip().startswith(">>>"):
+            continue
+        parts = _LITERAL.split(line)
+        lines[k] = "".join(p if i % 2 else p.replace("|", "\\|") for i, p in enumerate(parts))
+        if line.rstrip().endswith("::"):
+            literal_indent = indent
+
+
+def _skip_exported(app, what, name, obj, skip, options):
+    """A public name (``spinviz.simulate``, ``spinviz.Trajectory``, ...) is documented once, on
+    its own page of the API reference, not again on its defining module's page."""
+    if what == "module" and any(obj is getattr(spinviz, n) for n in _PUBLIC):
+        return True
+    return None
+
+
+_PUBLIC = [n for n in spinviz.__all__ if not n.startswith("_") and n != "PRESETS"]
+
+
+def setup(app):
+    app.connect("autodoc-process-docstring", _parameter_lists)
+    app.connect("autodoc-process-docstring", _magnitude_bars)
+    app.connect("autodoc-skip-member", _skip_exported)
+
+
+# --- HTML -----------------------------------------------------------------------------------
+html_theme = "pydata_sphinx_theme"
+html_title = f"spinviz {release}"
+html_static_path = ["_static"]
+html_css_files = ["spinviz.css"]
+html_theme_options = {
+    "navigation_with_keys": False,
+    "header_links_before_dropdown": 7,
+    "navbar_align": "left",
+    "show_toc_level": 2,
+    "secondary_sidebar_items": ["page-toc"],
+    "footer_start": ["copyright"],
+    "footer_end": ["sphinx-version"],
+}
+# The section navigation only where there is a section to navigate: the API reference.
+html_sidebars = {page: [] for page in
+                 ("index", "getting_started", "scenes", "gallery", "physics", "integrators", "accuracy", "atlas")}
+html_show_sourcelink = False
+html_copy_source = False

@@ -1,17 +1,16 @@
 """The words and numbers on screen, in two registers: ``"outreach"`` (plain words, numbers
 for people) and ``"physics"`` (symbols, equation numbers, scientific notation).
 
-Pure Python: the HUD (``hud``) decides where text goes, this module what it says.
+Pure Python: ``layout`` and ``overlay`` decide where text goes, this module what it says.
 """
 
 from __future__ import annotations
 
 import math
 
-from .. import units as U
+import numpy as np
 
-# one colour per model everywhere: headings and inset of the videos, ``spinviz compare``'s plots
-MODEL_COLORS = {"reduced": (0, 128, 128), "truncated": (136, 60, 180), "free": (120, 120, 120)}
+from .. import units as U
 
 # (heading, equation numbers) per model and register
 HEADINGS = {
@@ -189,6 +188,51 @@ class Captions:
     def legend(self, show) -> list[tuple[str, str, str]]:
         """(key, symbol, name) of each drawn arrow."""
         return [(key, *ARROW_NAMES[key]) for key in ("dipole", "L", "omega") if key in show]
+
+    def bar_ticks(self) -> list[tuple[float, str]]:
+        """(position 0..1 along the time bar, label) of its marks: multiples of Theta or T
+        (linear map) or their decades (log map); in people's units (CGS) or tau0 without a scale."""
+        plan, spec, t_end = self.plan, self.spec, self.plan.t_end
+        if plan.time_scale is not None:
+            sym, unit = plan.time_scale
+            suffix = f" {sym}"
+        elif self.cgs:
+            unit, sym = _people_unit(t_end)
+            suffix = f" {sym}"
+        else:
+            unit, suffix = 1.0, " τ₀"
+        end = t_end / unit
+        if spec.time_map == "linear":
+            step = nice_step(end, 6)
+            vals = np.arange(step, end * (1 + 1e-9), step)
+        else:
+            k = spec.knee(t_end) / unit
+            lo = math.floor(math.log10(k))
+            vals = np.array([10.0 ** e for e in range(lo, math.ceil(math.log10(end)) + 1) if 10.0 ** e <= end * (1 + 1e-9)])
+            vals = vals[vals >= k * 0.5]
+        return [(float(spec.video_fraction(v * unit, t_end)), _fmt_tick(float(v)) + suffix) for v in vals]
+
+
+def nice_step(span: float, most: int) -> float:
+    """The smallest of 1, 2, 5 x 10^k that cuts ``span`` into at most ``most`` steps (ticks)."""
+    raw = span / max(1, most)
+    e = 10.0 ** math.floor(math.log10(raw))
+    for m in (1.0, 2.0, 5.0, 10.0):
+        if m * e >= raw:
+            return m * e
+    return 10.0 * e
+
+
+def _fmt_tick(x: float) -> str:
+    return f"{x:g}" if abs(x) >= 1e-3 or x == 0 else f"{x:.0e}"
+
+
+def _people_unit(t_end: float) -> tuple[float, str]:
+    """The largest of yr, d, h, min that t_end (s) holds twice, else s."""
+    for unit, name in ((U.YEAR, "yr"), (U.DAY, "d"), (U.HOUR, "h"), (U.MINUTE, "min")):
+        if t_end >= 2 * unit:
+            return unit, name
+    return 1.0, "s"
 
 
 def _deg(x: float) -> str:

@@ -1,10 +1,11 @@
 """The moving solids as plain arrays: points, triangles, normals and per-vertex colours.
 
 Built in NumPy rather than from pyvista sources so that each part carries exactly what the
-CPU lighting of ``session.Solids`` needs: flat normals per face, a colour per vertex, and a
+CPU lighting of ``views.Solids`` needs: flat normals per face, a colour per vertex, and a
 flag for vertices that are not lit (outlines keep their dark tone whatever the light).
-Shapes are in their own frame; arrows point along +x with unit shaft length (the session
+Shapes are in their own frame; arrows point along +x with unit shaft length (the view
 stretches the shaft and moves the head, so arrow length can follow |Omega| and |L|).
+Lengths in units of the dipole arrow; colours RGB floats in [0, 1].
 """
 
 from __future__ import annotations
@@ -14,13 +15,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-BODY_RADIUS = 0.62       # the body's bounding radius, in units of the dipole arrow (tip on the unit sphere)
+from ..rotations import matrix_from_quat
+from .style import BODY_RADIUS, ROD_SECOND_COLOR, body_color
+
 OUTLINE = 0.045          # width of a box's dark edge band, as a fraction of its shortest edge (min 0.02 radius)
 
 
 @dataclass
 class Part:
-    """points, normals (n, 3); triangles (m, 3) int; color (n, 3) in [0, 1]; lit (n,) bool."""
+    """A mesh in its own frame: points, normals (n, 3); triangles (m, 3) int; color (n, 3) in
+    [0, 1]; lit (n,) bool (False: an outline vertex, drawn in its colour whatever the light)."""
 
     points: np.ndarray
     normals: np.ndarray
@@ -30,6 +34,7 @@ class Part:
 
     @staticmethod
     def join(parts: list[Part]) -> Part:
+        """One part of all ``parts``, in order (their triangles re-indexed)."""
         offs = np.cumsum([0] + [p.points.shape[0] for p in parts])
         return Part(np.vstack([p.points for p in parts]), np.vstack([p.normals for p in parts]),
                     np.vstack([p.triangles + o for p, o in zip(parts, offs[:-1])]),
@@ -113,7 +118,7 @@ def two_tone_rod(radius, half_length, color, second_color, res=24) -> Part:
 
 
 def arrow_shaft(radius, color, res=12) -> Part:
-    """A cylinder along +x from 0 to 1 (the session stretches it), without caps."""
+    """A cylinder along +x from 0 to 1 (the view stretches it), without caps."""
     p = cylinder_z(radius, 0.5, res, color, caps=False)
     rot = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])   # z -> x, x -> y, y -> z
     return Part((p.points + [0.0, 0.0, 0.5]) @ rot.T, p.normals @ rot.T, p.triangles, p.color, p.lit)
@@ -149,3 +154,29 @@ def ball(radius, color, res=12) -> Part:
             i0, i1 = a * cols + b, (a + 1) * cols + b
             tris += [(i0, i1, i1 + 1), (i0, i1 + 1, i0 + 1)]
     return Part(radius * n, n, np.array(tris), np.tile(color, (n.shape[0], 1)), np.ones(n.shape[0], bool))
+
+
+def body_part(shape, name: str) -> Part:
+    """The body in its body frame, true proportions, bounding radius BODY_RADIUS: a two-tone
+    rod or a box with dark edges (a small sphere when the shape is unknown).
+
+    shape : ``frameplan.ShapeInfo`` or None; name : the body's name (its colour, ``style.body_color``).
+    """
+    color = np.asarray(body_color(name))
+    if shape is None:
+        return ball(0.3, color)
+    if shape.kind == "rod":
+        length, diameter = shape.dims
+        k = BODY_RADIUS / math.hypot(0.5 * length, 0.5 * diameter)
+        # a thin rod is drawn at least a sixth of its length thick, so that its painted halves
+        # -- and with them its spin about its own axis -- can be seen (the true L/D is in the title)
+        r = max(0.5 * diameter * k, 0.085 * length * k)
+        part = two_tone_rod(r, 0.5 * length * k, color, np.asarray(ROD_SECOND_COLOR))
+    else:
+        # a needle-thin box (a slender inertia-equivalent body) is drawn at least 1/8 as thick
+        # as it is long, so that it can be seen turning
+        a, b, c = np.maximum(np.asarray(shape.dims, dtype=float), 0.125 * max(shape.dims))
+        k = BODY_RADIUS / (0.5 * math.sqrt(a * a + b * b + c * c))
+        part = box(0.5 * k * np.array([a, b, c]), color, 0.35 * color)
+    m = matrix_from_quat(np.asarray(shape.q_body_from_shape, dtype=float))
+    return Part(part.points @ m.T, part.normals @ m.T, part.triangles, part.color, part.lit)

@@ -120,6 +120,14 @@ class RenderSpec:
         """The knee of the log time map: ``log_knee``, or t_end / 1000 by default."""
         return self.log_knee or t_end / 1000.0
 
+    def video_fraction(self, t: float, t_end: float) -> float:
+        """The fraction of the video (0..1) at which simulation time ``t`` is shown: the
+        inverse of the time map (t and t_end in the scene's time unit)."""
+        if self.time_map == "linear":
+            return t / t_end
+        k = self.knee(t_end)
+        return math.log1p(t / k) / math.log1p(t_end / k)
+
     # -- checks that need more than the spec ----------------------------------------------
     def check_horizon(self, t_end: float) -> None:
         """The log knee must lie inside the run, and not so far below t_end that float64

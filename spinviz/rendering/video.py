@@ -1,8 +1,9 @@
-"""The render-and-encode pipeline: a ``timeline.FramePlan`` to an MP4 or GIF and a PNG poster.
+"""The render-and-encode pipeline: a ``FramePlan`` to an MP4 or GIF and a PNG poster.
 
-``render_video(plan, out)`` draws every frame of a ``timeline.FramePlan`` and encodes it;
-``render_frames`` draws chosen frames in this process (tests, stills).  The renderer
-consumes frames planned from stored trajectories and never steps physics.
+``render_video(plan, out)`` lays the plan out on its frame once (``picture_of``: the
+planning layer's ``plan_picture`` with this stack's fonts), then draws every frame and
+encodes it; ``render_frames`` draws chosen frames in this process (tests, stills).  The
+renderer consumes frames planned from stored trajectories and never steps physics.
 
 Parallel MP4: the frames are split into contiguous segments, one per worker process (one
 per core); each worker renders its segment and encodes it with its own single-threaded
@@ -14,7 +15,7 @@ GIFs (small by nature) are rendered in-process.
 Start-up overlaps the work: ``WorkerPool`` starts the render processes before the plan
 exists (``pipeline.render`` opens it before simulating), and each worker imports only the
 drawing stack -- pyvista, the VTK modules it uses, Pillow, imageio-ffmpeg -- while the
-parent integrates; the plan reaches them as one pickled message.
+parent integrates; the picture reaches them as one pickled message.
 """
 
 from __future__ import annotations
@@ -35,12 +36,18 @@ from .. import interrupt
 from ..atomic import Outputs
 from ..errors import RenderError, printable
 from .encode import Mp4Writer, open_writer, save_png
+from .fonts import Fonts
+from .picture import Picture, plan_picture
 from .spec import poster_for
 
-__all__ = ["render_video", "render_frames", "RenderResult", "RenderError", "WorkerPool", "plan_workers"]
+__all__ = ["render_video", "render_frames", "picture_of", "RenderResult", "RenderError", "WorkerPool", "plan_workers"]
+
 
 @dataclass
 class RenderResult:
+    """What ``render_video`` wrote: paths, frames, size (width, height) px, wall-clock seconds
+    (start-up apart), worker processes, and the plan's notes."""
+
     path: str
     poster: str | None
     frames: int
@@ -62,18 +69,25 @@ class RenderResult:
 
 
 def default_workers() -> int:
+    """One render process per core, at most 4."""
     return max(1, min(4, os.cpu_count() or 1))
 
 
-SUPERSAMPLE = 2.0      # 2 x 2 supersampling: four samples per pixel (see session.py)
+SUPERSAMPLE = 2.0      # 2 x 2 supersampling: four samples per pixel (see views.py)
+
+
+def picture_of(plan) -> Picture:
+    """The plan laid out on its frame (``picture.plan_picture``), measured with this stack's fonts."""
+    return plan_picture(plan, Fonts.for_height(plan.spec.size[1]))
 
 
 def render_frames(plan, frames, supersample: float | None = None):
-    """Frames (list of indices) as RGB arrays at the plan's size, rendered in this process;
-    also returns the session so tests can project world points.  Caller closes the session."""
+    """Frames (list of indices) as RGB arrays (H, W, 3) uint8 at the plan's size, rendered in
+    this process; also returns the session (``session.picture`` holds the layout and camera,
+    ``session.project`` maps world points to pixels).  The caller closes the session."""
     from .session import RenderSession
 
-    session = RenderSession(plan, supersample or SUPERSAMPLE)
+    session = RenderSession(picture_of(plan), supersample or SUPERSAMPLE)
     return [session.frame(f) for f in frames], session
 
 
@@ -148,13 +162,13 @@ def _pool_worker(index, tasks, msgs, stop, parent):
         msgs.put(("error", index, traceback.format_exc()))
 
 
-def _render_segment(index, plan, size, supersample, lo, hi, path, poster_f, msgs, stop, parent):
-    """Render frames lo..hi-1 into the MP4 segment ``path``; report progress on ``msgs``.
-    Stops between frames when ``stop`` is set or the parent process has gone."""
+def _render_segment(index, picture, size, supersample, lo, hi, path, poster_f, msgs, stop, parent):
+    """Render frames lo..hi-1 of ``picture`` into the MP4 segment ``path``; report progress on
+    ``msgs``.  Stops between frames when ``stop`` is set or the parent process has gone."""
     from .session import RenderSession
 
-    session = RenderSession(plan, supersample)
-    writer = Mp4Writer(path, size, plan.spec.fps, threads=1)
+    session = RenderSession(picture, supersample)
+    writer = Mp4Writer(path, size, picture.plan.spec.fps, threads=1)
     msgs.put(("ready", index, None))
     done = 0
     for f in range(lo, hi):
@@ -216,7 +230,7 @@ class WorkerPool:
                 p.terminate()
                 p.join(timeout=5)
         for q in (*self.tasks, self.msgs):
-            # a task (the pickled plan, ~100 kB: more than a pipe holds) that a worker never
+            # a task (the pickled picture, ~100 kB: more than a pipe holds) that a worker never
             # read -- it failed to start, or was stopped first -- must not block us here
             q.cancel_join_thread()
             q.close()
@@ -258,14 +272,16 @@ def render_video(plan, out: str, workers: int | None = None, supersample: float 
     paths = [out, poster_for(out)] if poster else [out]
     bar = _Progress(f"rendering {printable(out, 80)}", F, progress)
     start = time.perf_counter()
+    picture = picture_of(plan)                          # laid out once, here: the workers only draw
     with Outputs(paths, inputs) as tmps:                # video and poster land together, or neither does
         if workers == 1:
-            poster_img, startup = _render_in_process(plan, tmps[0], size, supersample, F, poster_f, bar)
+            poster_img, startup = _render_in_process(picture, tmps[0], size, supersample, F, poster_f, bar)
         elif pool is not None:
-            poster_img, startup = _render_segments(plan, tmps[0], size, supersample, F, poster_f, pool, bar, start)
+            poster_img, startup = _render_segments(picture, tmps[0], size, supersample, F, poster_f, pool, bar, start)
         else:
             with WorkerPool(workers) as own:
-                poster_img, startup = _render_segments(plan, tmps[0], size, supersample, F, poster_f, own, bar, start)
+                poster_img, startup = _render_segments(picture, tmps[0], size, supersample, F, poster_f, own, bar,
+                                                       start)
         if poster:
             save_png(tmps[1], poster_img)
         interrupt.check()                               # a stop swallowed on the way still counts
@@ -274,13 +290,14 @@ def render_video(plan, out: str, workers: int | None = None, supersample: float 
                         startup_seconds=startup, workers=workers, notes=list(plan.notes))
 
 
-def _render_in_process(plan, path, size, supersample, F, poster_f, bar):
+def _render_in_process(picture, path, size, supersample, F, poster_f, bar):
+    """Render and encode frames 0..F-1 of ``picture`` here; returns (poster image, start-up seconds)."""
     from .session import RenderSession
 
     t0 = time.perf_counter()
-    session = RenderSession(plan, supersample)
+    session = RenderSession(picture, supersample)
     startup = time.perf_counter() - t0
-    writer = open_writer(path, size, plan.spec.fps)
+    writer = open_writer(path, size, picture.plan.spec.fps)
     poster_img = None
     finished = False
     try:
@@ -304,8 +321,8 @@ def _render_in_process(plan, path, size, supersample, F, poster_f, bar):
     return poster_img, startup
 
 
-def _render_segments(plan, path, size, supersample, F, poster_f, pool: WorkerPool, bar, start):
-    """Hand each worker of ``pool`` a contiguous segment, follow their progress, join the
+def _render_segments(picture, path, size, supersample, F, poster_f, pool: WorkerPool, bar, start):
+    """Hand each worker of ``pool`` a contiguous segment of ``picture``, follow their progress, join the
     segments.  Returns (poster image, start-up seconds: until every worker drew its first
     frame, counted from ``start``)."""
     if pool.used:
@@ -320,7 +337,7 @@ def _render_segments(plan, path, size, supersample, F, poster_f, pool: WorkerPoo
     counts = [0] * workers
     try:
         for k in range(workers):
-            pool.tasks[k].put((plan, size, supersample, int(bounds[k]), int(bounds[k + 1]), segs[k], poster_f))
+            pool.tasks[k].put((picture, size, supersample, int(bounds[k]), int(bounds[k + 1]), segs[k], poster_f))
         pending = set(range(workers))
         ready = 0
         while pending:

@@ -85,10 +85,11 @@ def scene_trajectories(scene: Scene, spec: RenderSpec, t_end: float | None = Non
     return [simulate(scene.body, m, **kw) for m in scene.models]
 
 
-def _check_drawable(trajs: list[Trajectory], spec: RenderSpec) -> None:
+def _check_drawable(trajs: list[Trajectory] | None, spec: RenderSpec) -> None:
     """Frames are interpolated between stored instants: orientations must be stored closely
-    enough for slerp (or carry the slow geometry of a ``secular`` run)."""
-    if not spec.needs_orientation:
+    enough for slerp (or carry the slow geometry of a ``secular`` run).  None (a scene, to be
+    simulated at the frame times) passes."""
+    if trajs is None or not spec.needs_orientation:
         return
     for tr in trajs:
         if tr.q is None:
@@ -103,24 +104,28 @@ def _check_drawable(trajs: list[Trajectory], spec: RenderSpec) -> None:
 
 
 def plan(source: Source, t: float | None = None, frames: int | None = None, **overrides) -> FramePlan:
-    """The frame plan of a video of ``source`` from 0 to ``t`` (default: the whole run)."""
+    """The frame plan of a video of ``source`` from 0 to ``t`` (scene time unit; default the
+    whole run), with ``frames`` frames (default: the spec's); keywords override ``[render]``."""
     scene, trajs, spec = resolve_spec(source, **overrides)
     return _plan(scene, trajs, spec, t, frames)
 
 
 def _plan(scene, trajs, spec: RenderSpec, t=None, frames=None) -> FramePlan:
+    """Trajectories at the frame times -- a scene simulated at them, given trajectories
+    checked and, for a shorter video, sampled at them -- and their frame plan."""
+    t_end = _within(t, scene.t_end if scene is not None else float(trajs[0].t[-1]))
+    _check_drawable(trajs, spec)
     if scene is not None:
-        t_end = scene.t_end if t is None else _within(t, scene.t_end)
         trajs = scene_trajectories(scene, spec, t_end)
-    else:
-        t_end = float(trajs[0].t[-1]) if t is None else _within(t, float(trajs[0].t[-1]))
-        _check_drawable(trajs, spec)
-        if t is not None:
-            trajs = [tr.sample(frame_times(spec, t_end, frames)[1]) for tr in trajs]
+    elif t is not None:
+        trajs = [tr.sample(frame_times(spec, t_end, frames)[1]) for tr in trajs]
     return plan_frames(spec, trajs, frames)
 
 
 def _within(t, t_end: float) -> float:
+    """The end of the video: ``t`` if given (it must lie in (0, t_end]), else ``t_end``."""
+    if t is None:
+        return t_end
     t = float(t)
     if not 0.0 < t <= t_end:
         raise UsageError(f"t must lie in (0, {t_end:g}], got {t:g}")
@@ -181,38 +186,39 @@ def render_frame(source: Source, t: float | None = None, *, size=(640, 360), **o
 
 def render(source: Source, out: str | None = None, *, size=None, fps=None, duration=None, workers=None,
            progress: bool = False, pool=None, **overrides):
-    """Render ``source`` to ``out`` (.mp4 or .gif) and a PNG poster beside it; returns a
-    ``RenderResult`` (path, poster, frames, seconds, fps).  ``out`` defaults to
-    ``renders/<scene>.mp4`` for a scene.  Other keywords override ``[render]`` settings.
+    """Render ``source`` to a video and a PNG poster beside it; returns a ``RenderResult``
+    (path, poster, frames, seconds, fps).
 
+    source : a scene (``Scene`` or path to its TOML), a ``Trajectory``, or a list of two.
+    out : the .mp4 or .gif path; default ``renders/<scene>.mp4`` for a scene.
+    size : (width, height) px; fps; duration : video seconds; other keywords override
+        ``[render]`` settings (``RenderSpec`` fields).
+    workers : render processes for an MP4 (default one per core, at most 4).
     pool : render processes started earlier (``rendering.video.WorkerPool``), e.g. before the
-        scene was even read; used for an MP4 and closed here in any case."""
+        scene was even read; used for an MP4 and closed here in any case.
+    """
+    out = default_output(source) if out is None else out
     scene, trajs, spec = resolve_spec(source, size=size, fps=fps, duration=duration, **overrides)
-    if out is None:
-        if scene is None:
-            raise UsageError("give out=... (a .mp4 or .gif path) to render trajectories")
-        out = default_output(scene)
     spec.check_output(out, len(scene.models) if scene is not None else len(trajs))
     inputs = [scene.path] if scene is not None and os.path.exists(scene.path) else []
     check_outputs([out, poster_for(out)], inputs)        # before any work: nothing to undo later
     video = require_render_stack()
-    n = video.plan_workers(spec, out, workers if pool is None else pool.workers)
-    if pool is not None and n == 1:
-        pool.close()                                     # a GIF or a very short video renders in-process
-        pool = None
-    if pool is None and n > 1:
-        # the render processes start now and import the drawing stack while this one simulates
-        pool = video.WorkerPool(n)
+    # the render processes start now and import the drawing stack while this one simulates
+    pool = video.open_pool(spec, out, workers, pool)
     try:
-        return video.render_video(_plan(scene, trajs, spec), out, workers=workers, progress=progress, inputs=inputs,
-                                  pool=pool)
+        frame_plan = _plan(scene, trajs, spec)
+        return video.render_video(frame_plan, out, workers=workers, progress=progress, inputs=inputs, pool=pool)
     finally:
         if pool is not None:
             pool.close()
 
 
-def default_output(scene: Scene, directory: str = "renders") -> str:
-    stem = os.path.splitext(os.path.basename(scene.path))[0]
+def default_output(scene: Scene | str | os.PathLike, directory: str = "renders") -> str:
+    """Where a scene's video goes by default: ``renders/<scene file's stem>.mp4``.  ``scene``: a
+    ``Scene`` or the path of its file (trajectories have no default: UsageError)."""
+    if not isinstance(scene, (Scene, str, os.PathLike)):
+        raise UsageError("give out=... (a .mp4 or .gif path) to render trajectories")
+    stem = os.path.splitext(os.path.basename(scene.path if isinstance(scene, Scene) else os.fspath(scene)))[0]
     return os.path.join(directory, f"{stem}.mp4")
 
 

@@ -327,8 +327,7 @@ def test_every_scene_keeps_its_frame_edges_clear_and_labels_its_arrows(path):
             inside = img[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]
             assert np.all(inside == 255, axis=-1).sum() > 20, (path.name, key)   # ... with white text inside
         from spinviz.rendering.fonts import Fonts
-        from spinviz.rendering.stage import ARROW_VECTORS
-        from spinviz.rendering.style import arrow_length
+        from spinviz.rendering.stage import ARROW_VECTORS, arrow_length
 
         picture = session.picture
         for k, panel in enumerate(plan.panels):
@@ -412,11 +411,11 @@ def test_rod_panels_differ_where_the_axial_spin_shows():
 def test_arrow_length_follows_the_spin_rate():
     """DAST cube, truncated panel: |Omega| falls to about a quarter over 6 Theta, and the drawn
     Omega arrow (blue pixels, tip farthest from the centre) gets shorter with it, as
-    style.arrow_length says; the dipole arrow keeps its length."""
+    stage.arrow_length says; the dipole arrow keeps its length."""
     path = SCENES[[p.stem for p in SCENES].index("dast_cube")]
     plan, imgs, session = scene_frames(path, frames=("first", "last"))
     try:
-        from spinviz.rendering.style import arrow_length
+        from spinviz.rendering.stage import arrow_length
 
         k = 1
         ratio = plan.panels[k].omega_mag[-1] / plan.panels[k].omega_mag[0]

@@ -2,8 +2,8 @@
 
 Pure NumPy.  The camera never moves during a video (the views of two panels compare
 directly, and the fixed lights stay fixed relative to it), so "the camera path" is one
-pose, solved for so that the content of every frame fills the 3-D view within a margin.
-World frame: z up; the camera looks at the origin.
+pose, solved for so that the content of every frame fills the 3-D view within a margin
+(``fit``).  World frame: z up; the camera looks at the origin.
 """
 
 from __future__ import annotations
@@ -13,12 +13,6 @@ import math
 import numpy as np
 
 from .style import VIEW_ANGLE
-
-
-def view_direction(azimuth_deg: float, elevation_deg: float) -> np.ndarray:
-    """Unit vector (3,), world frame, from the origin towards the camera."""
-    az, el = math.radians(azimuth_deg), math.radians(elevation_deg)
-    return np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
 
 
 class Camera:
@@ -92,3 +86,28 @@ class Camera:
 
         return [(unit(-0.55 * r + 0.75 * u + 0.45 * v), 0.55), (unit(0.85 * r - 0.15 * u + 0.35 * v), 0.22),
                 (v, 0.25)]
+
+
+def fit(view, points, size, border, zoom: float = 1.0) -> tuple[Camera, int]:
+    """The camera that shows ``points`` in a view of ``size`` (width, height) px, keeping
+    ``border`` (x, y) px free at its edges, and the width (px, even, at most the given one)
+    that the content needs: GL pixels are the cost of a frame, so a view narrower than its
+    panel is drawn that narrow (unless zoomed in).
+
+    view : (3,) unit, world, towards the camera; points : (N, 3) world points every frame
+    draws.  Returns (camera fitted to the returned width, that width).
+    """
+    vw, vh = size
+    cam = Camera(view, vw / vh, points, _margins(border, vw, vh), zoom)
+    lo, hi = cam.extent(points, cam.distance)
+    need = ((hi[0] - lo[0]) / 2.0 * vw + 2 * border[0]) / 0.98
+    w2 = int(min(vw, 2 * math.ceil(need / 2.0 + 1)))
+    if w2 < vw and zoom <= 1.0:
+        return Camera(view, w2 / vh, points, _margins(border, w2, vh), zoom), w2
+    return cam, vw
+
+
+def _margins(border, vw, vh) -> tuple[float, float]:
+    """A border in px as margins in units of the half-view (at most half of it)."""
+    bx, by = border
+    return (min(0.5, 0.02 + 2 * bx / vw), min(0.5, 0.02 + 2 * by / vh))

@@ -1,12 +1,15 @@
 """The words and numbers on screen, in two registers: ``"outreach"`` (plain words, numbers
 for people) and ``"physics"`` (symbols, equation numbers, scientific notation).
 
-Pure Python: ``layout`` and ``overlay`` decide where text goes, this module what it says.
+``texts_of(plan)`` says everything once, as plain data (``Texts``: the headings, the legend,
+the time bar's ticks, and per frame the panels' numbers, the time and the notes); ``layout``
+and ``overlay`` decide where it goes.  Pure Python and NumPy.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -34,6 +37,7 @@ _WORDS = ((1e12, "trillion"), (1e9, "billion"), (1e6, "million"), (1e3, "thousan
 
 
 def superscript(n: int) -> str:
+    """An integer in superscript digits: 15 -> "¹⁵"."""
     return str(int(n)).translate(_SUP)
 
 
@@ -95,6 +99,42 @@ def sim_time(t: float, units: str, register: str) -> str:
     return U.human_time(t)
 
 
+@dataclass
+class Texts:
+    """Every text of a video, F frames and n panels.
+
+    headings : per panel (heading, equation numbers); subtitles : per panel, one line (the
+    layout wraps it); legend : (key, symbol, name) per drawn arrow, and the body's entry when
+    the drawn body is a stand-in; footer : the title line; scale : what the time bar's unit is
+    ("" without one); bar_ticks : (position 0..1, label) of its marks; readouts : [panel][frame]
+    -> lines; time : per frame; notes : per frame -> lines (how time and spin are shown).
+    """
+
+    headings: list
+    subtitles: list
+    legend: list
+    footer: str
+    scale: str
+    bar_ticks: list
+    readouts: list
+    time: list
+    notes: list
+
+
+def texts_of(plan) -> Texts:
+    """All the words of ``plan`` (a ``FramePlan``) in the register of its ``[render].captions``."""
+    cap = Captions(plan)
+    n, F = len(plan.panels), plan.frames
+    show = plan.spec.show
+    legend = cap.legend(show)
+    if "body" in show and plan.shape is not None and "inertia" in plan.shape.label:
+        legend.append(("body", "box", "with the top's inertia"))      # the drawn body is not the crystal's shape
+    return Texts(headings=[cap.heading(k) for k in range(n)], subtitles=[cap.subtitle(k) for k in range(n)],
+                 legend=legend, footer=cap.footer(), scale=cap.scale_text(), bar_ticks=cap.bar_ticks(),
+                 readouts=[[cap.readouts(k, f) for f in range(F)] for k in range(n)],
+                 time=[cap.time_text(f) for f in range(F)], notes=[cap.notes(f) for f in range(F)])
+
+
 class Captions:
     """The texts of a plan's frames in the register of its ``[render].captions``."""
 
@@ -111,6 +151,7 @@ class Captions:
         return HEADINGS[self.register].get(model, (model, ""))
 
     def subtitle(self, k: int) -> str:
+        """Panel k's plain-words line: the scene's ``[render].subtitles``, or what its model predicts."""
         subs = self.spec.subtitles
         if k < len(subs):
             return subs[k]
@@ -140,6 +181,7 @@ class Captions:
 
     # -- shared ----------------------------------------------------------------------------
     def time_text(self, f: int) -> str:
+        """The simulation time of frame f: "after 9.5 days" (outreach), "t = 8.2e5 s = 3.01 Θ" (physics)."""
         t = float(self.plan.sim_t[f])
         if self.register == "outreach":
             return ("after " if t > 0 else "start, ") + sim_time(t, self.plan.units, "outreach")
@@ -183,6 +225,7 @@ class Captions:
         return out
 
     def footer(self) -> str:
+        """The title line: the scene's title, or the body's name."""
         return self.spec.title or self.plan.body_name
 
     def legend(self, show) -> list[tuple[str, str, str]]:

@@ -11,17 +11,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..rotations import matrix_from_quat
 from .spec import RenderSpec
 
 
 @dataclass(frozen=True)
 class ShapeInfo:
     """The drawn body, as plain numbers (see ``physics.bodies.Shape``): kind "rod" (dims =
-    length, diameter) or "box" (dims = a, b, c); q_body_from_shape (w, x, y, z); label."""
+    length, diameter) or "box" (dims = a, b, c); q_body_from_shape (w, x, y, z) and the same
+    rotation as a matrix, R_body_from_shape (3, 3) nested tuples; label."""
 
     kind: str
     dims: tuple[float, ...]
     q_body_from_shape: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+    R_body_from_shape: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
     label: str = ""
 
     @classmethod
@@ -29,8 +32,10 @@ class ShapeInfo:
         """The plain numbers of a ``physics.bodies.Shape`` (None stays None)."""
         if shape is None:
             return None
-        return cls(kind=str(shape.kind), dims=tuple(float(x) for x in shape.dims),
-                   q_body_from_shape=tuple(float(x) for x in shape.q_body_from_shape), label=str(shape.label))
+        q = tuple(float(x) for x in shape.q_body_from_shape)
+        return cls(kind=str(shape.kind), dims=tuple(float(x) for x in shape.dims), q_body_from_shape=q,
+                   R_body_from_shape=tuple(map(tuple, matrix_from_quat(np.asarray(q)).tolist())),
+                   label=str(shape.label))
 
 
 @dataclass
@@ -40,7 +45,8 @@ class Panel:
 
     model : "reduced", "truncated" or "free".
     omega_mag : (F,) |Omega|, rad/s (CGS) or 1/tau0 (dimensionless).
-    q : (F, 4) display orientation, body -> world, (w, x, y, z) scalar first.
+    q : (F, 4) display orientation, body -> world, (w, x, y, z) scalar first;
+        R_world_from_body : (F, 3, 3) the same as matrices.
     d_world : (F, 3) unit dipole direction, world frame.
     omega_world, L_world : (F, 3) angular velocity and angular momentum, world frame, scaled
         by |x(0)| of the reference panel (so |x(t)| / |x(0)| sets the arrow's length).
@@ -53,6 +59,7 @@ class Panel:
     model: str
     omega_mag: np.ndarray
     q: np.ndarray | None = None
+    R_world_from_body: np.ndarray | None = None
     d_world: np.ndarray | None = None
     omega_world: np.ndarray | None = None
     L_world: np.ndarray | None = None

@@ -19,8 +19,6 @@ from typing import Protocol
 
 import numpy as np
 
-from .captions import Captions
-
 NOTE_SEP = "   ·   "
 MIN_VIEW = 0.5            # the 3-D view keeps at least this fraction of the frame height
 MIN_VIEW_INSET = 0.36     # ... or this, to make room for a requested inset
@@ -140,17 +138,16 @@ class _Wants:
     sub_lines: int = 2
 
 
-def make_layout(plan, metrics: TextMetrics) -> Layout:
-    """The bands of a frame for ``plan`` (a ``FramePlan``) at its spec's size: text bands are
-    dropped, least needed first (``DROP_ORDER``), until the 3-D view keeps ``MIN_VIEW`` of the
-    height (``MIN_VIEW_INSET`` with an inset).  The views span their panels' width; the camera
-    fit may narrow them (``stage.fit_camera``)."""
+def make_layout(plan, texts, metrics: TextMetrics) -> Layout:
+    """The bands of a frame for ``plan`` (a ``FramePlan``) at its spec's size, holding
+    ``texts`` (``captions.Texts``): text bands are dropped, least needed first
+    (``DROP_ORDER``), until the 3-D view keeps ``MIN_VIEW`` of the height (``MIN_VIEW_INSET``
+    with an inset).  The views span their panels' width; the stage may narrow them."""
     W, H = plan.spec.size
     show = set(plan.spec.show)
     sizes = metrics.sizes
     pad = max(4, int(round(H * 0.012)))
-    cap = Captions(plan)
-    want = _measure(plan, cap, metrics, show, W, pad)
+    want = _measure(plan, texts, metrics, show, W, pad)
     steps = DROP_ORDER if want.wanted["inset"] else tuple(x for x in DROP_ORDER if x != "subtitle2")
     for drop in (None, *steps):
         if drop == "subtitle2":
@@ -163,26 +160,38 @@ def make_layout(plan, metrics: TextMetrics) -> Layout:
         top, rows, bottom = _bands(want, sizes, pad)
         if H - top - bottom >= (MIN_VIEW_INSET if want.wanted["inset"] else MIN_VIEW) * H:
             break
-    return _place(plan, cap, want, Layout(W=W, H=H, n=len(plan.panels), pad=pad, sizes=sizes, text="hud" in show),
-                  top, rows, bottom)
+    lay = Layout(W=W, H=H, n=len(plan.panels), pad=pad, sizes=sizes, text="hud" in show)
+    view_y1 = lay.H - bottom
+    for k in range(lay.n):
+        x0 = lay.panel_x(k)
+        lay.views.append((x0, top, x0 + lay.panel_width, view_y1))
+        lay.headings.append(_heading_lines(texts.headings[k], want.subtitles[k], want.wanted, sizes, pad))
+    lay.readout_y = view_y1
+    lay.readout_lines = want.readout_lines if want.wanted["readouts"] else 0
+    y = view_y1 + lay.readout_lines * sizes.line + (pad if rows else 0)
+    for r in rows:
+        r.y = y
+        y += r.height
+    lay.rows = rows
+    lay.divider = (pad, view_y1 + lay.readout_lines * sizes.line)
+    return lay
 
 
-def _measure(plan, cap: Captions, metrics: TextMetrics, show, W: int, pad: int) -> _Wants:
+def _measure(plan, texts, metrics: TextMetrics, show, W: int, pad: int) -> _Wants:
     """The bands a frame would hold with room for all: the notes fit on one line if their
     widest sample (24 frames) does, else one line each."""
     n = len(plan.panels)
     hud_on = "hud" in show
-    legend = cap.legend(show) + _body_chip(plan, show)
-    subtitles = [wrap(cap.subtitle(k), metrics, W // n - 2 * pad) for k in range(n)]
-    notes_n = len(cap.notes(0))
+    subtitles = [wrap(texts.subtitles[k], metrics, W // n - 2 * pad) for k in range(n)]
+    notes_n = len(texts.notes[0])
     F = plan.frames
     sample = sorted(set(np.linspace(0, F - 1, min(F, 24)).round().astype(int)))
-    joined = max(metrics.width(NOTE_SEP.join(cap.notes(f))) for f in sample) if notes_n else 0.0
-    wanted = {"headings": hud_on, "subtitle": hud_on, "readouts": hud_on, "legend": hud_on and bool(legend),
-              "timebar": hud_on, "notes": hud_on and notes_n > 0, "title": hud_on and bool(cap.footer()),
+    joined = max(metrics.width(NOTE_SEP.join(texts.notes[f])) for f in sample) if notes_n else 0.0
+    wanted = {"headings": hud_on, "subtitle": hud_on, "readouts": hud_on, "legend": hud_on and bool(texts.legend),
+              "timebar": hud_on, "notes": hud_on and notes_n > 0, "title": hud_on and bool(texts.footer),
               "inset": "inset" in show}
-    return _Wants(wanted=wanted, subtitles=subtitles, readout_lines=max(len(cap.readouts(k, 0)) for k in range(n)),
-                  notes_rows=1 if joined <= W - 2 * pad else notes_n, legend=legend)
+    return _Wants(wanted=wanted, subtitles=subtitles, readout_lines=max(len(texts.readouts[k][0]) for k in range(n)),
+                  notes_rows=1 if joined <= W - 2 * pad else notes_n, legend=texts.legend)
 
 
 def _bands(want: _Wants, sizes: TextSizes, pad: int) -> tuple[int, list[Row], int]:
@@ -211,37 +220,16 @@ def _bands(want: _Wants, sizes: TextSizes, pad: int) -> tuple[int, list[Row], in
     return top, rows, bottom
 
 
-def _place(plan, cap: Captions, want: _Wants, lay: Layout, top: int, rows: list[Row], bottom: int) -> Layout:
-    """Fill ``lay`` with the chosen bands: views, heading lines, numbers, rows, divider."""
-    sizes, pad = lay.sizes, lay.pad
-    view_y1 = lay.H - bottom
-    for k in range(lay.n):
-        x0 = lay.panel_x(k)
-        lay.views.append((x0, top, x0 + lay.panel_width, view_y1))
-        items = []
-        y = pad
-        if want.wanted["headings"]:
-            head, eq = cap.heading(k)
-            items.append((head, "main", y, eq))
-            y += sizes.heading_line
-        if want.wanted["subtitle"]:
-            for line in want.subtitles[k]:
-                items.append((line, "small", y, ""))
-                y += sizes.line
-        lay.headings.append(items)
-    lay.readout_y = view_y1
-    lay.readout_lines = want.readout_lines if want.wanted["readouts"] else 0
-    y = view_y1 + lay.readout_lines * sizes.line + (pad if rows else 0)
-    for r in rows:
-        r.y = y
-        y += r.height
-    lay.rows = rows
-    lay.divider = (pad, view_y1 + lay.readout_lines * sizes.line)
-    return lay
-
-
-def _body_chip(plan, show) -> list[tuple[str, str, str]]:
-    """A legend entry for a drawn body that is not the real crystal's shape."""
-    if "body" in show and plan.shape is not None and "inertia" in plan.shape.label:
-        return [("body", "box", "with the top's inertia")]
-    return []
+def _heading_lines(heading, subtitle, wanted, sizes: TextSizes, pad: int) -> list:
+    """A panel's heading (with its equation numbers) and subtitle lines: [(text, role, y, secondary)]."""
+    items = []
+    y = pad
+    if wanted["headings"]:
+        head, eq = heading
+        items.append((head, "main", y, eq))
+        y += sizes.heading_line
+    if wanted["subtitle"]:
+        for line in subtitle:
+            items.append((line, "small", y, ""))
+            y += sizes.line
+    return items

@@ -15,10 +15,37 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..rotations import matrix_from_quat
-from .style import BODY_RADIUS, ROD_SECOND_COLOR, body_color
+from .style import ARROW_COLORS, ARROWS, BODY_RADIUS, HODO_MARKER_COLOR, ROD_SECOND_COLOR
 
 OUTLINE = 0.045          # width of a box's dark edge band, as a fraction of its shortest edge (min 0.02 radius)
+
+
+@dataclass
+class Assembly:
+    """The solids of a panel joined into one part: ``part`` and, per solid part name ("body",
+    "dipole_shaft", "dipole_head", ..., "hodo_marker"), its vertices' ``slices`` in it."""
+
+    part: Part
+    slices: dict
+
+
+def assemble(picture) -> Assembly:
+    """The solids ``picture.stage`` lists, built and joined in its order: the body (its shape,
+    colour and axes), each arrow as a shaft and a head along +x, the hodograph's marker."""
+    stage, plan = picture.stage, picture.plan
+    named = []
+    for name in stage.solids:
+        if name == "body":
+            named.append(("body", body_part(plan.shape, picture.theme.body, stage.body_from_shape)))
+        elif name == "hodo_marker":
+            named.append(("hodo_marker", ball(stage.marker_radius, np.asarray(HODO_MARKER_COLOR))))
+        else:
+            shaft, head_len, head_r, _ = ARROWS[name]
+            color = np.asarray(ARROW_COLORS[name])
+            named += [(name + "_shaft", arrow_shaft(shaft, color)), (name + "_head", arrow_head(head_len, head_r, color))]
+    offsets = np.cumsum([0] + [p.points.shape[0] for _, p in named])
+    slices = {name: slice(int(lo), int(hi)) for (name, _), lo, hi in zip(named, offsets[:-1], offsets[1:])}
+    return Assembly(Part.join([p for _, p in named]) if named else None, slices)
 
 
 @dataclass
@@ -156,13 +183,14 @@ def ball(radius, color, res=12) -> Part:
     return Part(radius * n, n, np.array(tris), np.tile(color, (n.shape[0], 1)), np.ones(n.shape[0], bool))
 
 
-def body_part(shape, name: str) -> Part:
+def body_part(shape, color, m) -> Part:
     """The body in its body frame, true proportions, bounding radius BODY_RADIUS: a two-tone
     rod or a box with dark edges (a small sphere when the shape is unknown).
 
-    shape : ``frameplan.ShapeInfo`` or None; name : the body's name (its colour, ``style.body_color``).
+    shape : ``frameplan.ShapeInfo`` or None; color : RGB floats; m : (3, 3) the rotation from
+    the shape's own axes to the body frame.
     """
-    color = np.asarray(body_color(name))
+    color = np.asarray(color)
     if shape is None:
         return ball(0.3, color)
     if shape.kind == "rod":
@@ -178,5 +206,4 @@ def body_part(shape, name: str) -> Part:
         a, b, c = np.maximum(np.asarray(shape.dims, dtype=float), 0.125 * max(shape.dims))
         k = BODY_RADIUS / (0.5 * math.sqrt(a * a + b * b + c * c))
         part = box(0.5 * k * np.array([a, b, c]), color, 0.35 * color)
-    m = matrix_from_quat(np.asarray(shape.q_body_from_shape, dtype=float))
     return Part(part.points @ m.T, part.normals @ m.T, part.triangles, part.color, part.lit)

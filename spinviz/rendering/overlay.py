@@ -1,12 +1,15 @@
 """The text and 2-D marks over the frame, as plain data: what each says, where, in which colour.
 
-``make_overlay`` turns a layout's bands into drawing instructions: ``Text`` items (text,
-position, anchor, font role, colour, clip box) and ``Fill`` boxes, once for the static layer
-and per frame for the changing parts (the panels' numbers, the time, the notes, the axis
-labels), a ``TimeBar`` (ticks and the part filled at each frame) and an ``Inset`` (live plots
-of angle(d, L) and |Omega| against video time).  The drawing layer only stamps them.
+``make_overlay`` turns a layout's bands and a video's words (``captions.Texts``) into
+drawing instructions, for every frame at once: ``Text`` items and ``Fill`` boxes for the
+static layer (headings, divider, legend chips, title), ``Line`` items whose text changes
+from frame to frame (axis labels, the panels' numbers, the time, the notes), the
+``TimeBar`` (ticks, and how much of it is filled at each frame) and the ``Inset`` (live plots
+of angle(d, L) and |Omega| against video time, their cursor and dots at each frame).  The
+drawing layer only stamps them.
 
-Pure: widths come from the drawing layer's ``layout.TextMetrics``.  Output pixels; colours RGB 0..255.
+Pure: widths come from the drawing layer's ``layout.TextMetrics``.  Output pixels (x right,
+y down; boxes (x0, y0, x1, y1), x1 and y1 exclusive); colours RGB 0..255.
 """
 
 from __future__ import annotations
@@ -16,9 +19,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .captions import Captions
 from .layout import NOTE_SEP, Layout, TextMetrics
-from .style import MODEL_COLORS, Palette, chip_colors, palette
+from .style import MODEL_COLORS, Palette
+
+WHITE = (255, 255, 255)
 
 
 @dataclass(frozen=True)
@@ -45,25 +49,34 @@ class Fill:
 
 
 @dataclass
+class Line:
+    """Text at one place whose words change: ``texts[f]`` at frame f ("" = nothing), drawn
+    like a ``Text`` with the other fields."""
+
+    texts: list
+    xy: tuple[float, float]
+    color: tuple
+    anchor: str = "la"
+    clip: tuple | None = None
+
+
+@dataclass
 class TimeBar:
     """The time bar: its box, its two looks (``track`` before and ``fill`` after now), tick
-    marks [(x from the bar's left, label or "", label's left x or None)], and the scale text
-    ("Θ = 3.2 days") after it.  ``text_xy`` is where the time ("after 9.5 days") goes."""
+    marks [(x from the bar's left, label, label's left x)] (label "" where it would crowd the
+    previous one), and ``cuts`` (F,): the filled columns at each frame (the last one is the
+    cursor, drawn in ``cursor`` colour)."""
 
     x0: int
     x1: int
     y: int
     h: int
     ticks: list
-    scale: str
     track: tuple
     fill: tuple
     tick_color: tuple
-    text_xy: tuple[int, int]
-
-    def cut(self, video_t: np.ndarray, f: int) -> int:
-        """How many columns of the bar are filled at frame f (at least the cursor's one)."""
-        return int(round(float(video_t[f]) / float(video_t[-1]) * (self.x1 - self.x0 - 1))) + 1
+    cursor: tuple
+    cuts: np.ndarray
 
 
 @dataclass
@@ -72,115 +85,66 @@ class Inset:
     between d and L (its swing over a turn as a band where the phases are re-timed) and
     |Omega| / |Omega(0)|, one colour per model, with a cursor and a dot on each curve.
 
-    boxes : the two plot boxes, px; x : (F,) video time 0..1; series : per panel (color,
-    angle_deg (F,) or None, band_deg (F, 2) or None, |Omega|/|Omega_0| (F,)); ymax : top of
-    each plot (deg, ratio); y0, height : the row, px; labels : its static texts."""
+    y0, height : the row, px; boxes : the two plot boxes; shapes : in drawing order,
+    ("frame", colour, box), ("band", fill colour, xs, lo, hi) the swing band between two rows
+    per column, ("curve", colour, xs, ys) a polyline, all in output pixels; labels : static
+    ``Text``; cursor : (2, F) the cursor's column in each plot; dots : [(colour, plot j,
+    rows (F,))]; dot_radius, px.
+    """
 
-    boxes: list
-    x: np.ndarray
-    series: list
-    ymax: tuple[float, float]
     y0: int
     height: int
+    boxes: list
+    shapes: list = field(default_factory=list)
     labels: list = field(default_factory=list)
-
-    def xy(self, j: int, x, y) -> tuple[np.ndarray, np.ndarray]:
-        """Pixel columns and rows of points (x 0..1, y in plot j's unit) in plot j."""
-        x0, y0, x1, y1 = self.boxes[j]
-        return x0 + x * (x1 - x0 - 1), y1 - 1 - np.clip(y / self.ymax[j], 0.0, 1.0) * (y1 - y0 - 1)
-
-    def curve(self, j: int, k: int):
-        """Series k's values in plot j: the angle (deg) or the |Omega| ratio (None if not shown)."""
-        _, ang, _, ratio = self.series[k]
-        return ang if j == 0 else ratio
-
-    def marks(self, f: int, r: int, cursor_color) -> list[Fill]:
-        """The cursor line and a dot (half size ``r`` px) on each curve at frame f."""
-        out = []
-        for j, (bx0, by0, bx1, by1) in enumerate(self.boxes):
-            xc = int(round(bx0 + self.x[f] * (bx1 - bx0 - 1)))
-            out.append(Fill((xc, by0 + 1, xc + 1, by1 - 1), cursor_color))
-            for k, (color, *_rest) in enumerate(self.series):
-                y = self.curve(j, k)
-                if y is None:
-                    continue
-                _, yy = self.xy(j, self.x[f:f + 1], y[f:f + 1])
-                yc = int(round(yy[0]))
-                out.append(Fill((xc - r, yc - r, xc + r + 1, yc + r + 1), color))
-        return out
+    cursor: np.ndarray | None = None
+    cursor_color: tuple = (0, 0, 0)
+    dots: list = field(default_factory=list)
+    dot_radius: int = 2
 
 
 @dataclass
 class Overlay:
     """Everything 2-D on a frame: ``static`` marks (``Text`` and ``Fill``, in drawing order),
-    the ``bar`` and ``inset`` (None when not shown), ``dynamic`` boxes that per-frame drawing
-    touches (restored from the static layer before each frame), and ``texts(f)``."""
+    the per-frame ``lines``, the ``bar`` and ``inset`` (None when not shown), ``background``,
+    and ``dynamic``: the boxes that per-frame drawing touches outside the 3-D views (restored
+    from the static layer before each frame)."""
 
-    plan: object
-    layout: Layout
-    palette: Palette
+    background: tuple
     static: list
+    lines: list
     bar: TimeBar | None
     inset: Inset | None
-    axis_labels: list
     dynamic: list
 
-    def texts(self, f: int) -> list[Text]:
-        """The changing text of frame f: axis labels, each panel's numbers, the time (and the
-        bar's scale), the notes."""
-        lay, pal, cap = self.layout, self.palette, Captions(self.plan)
-        out = [Text(text, xy, pal.muted, anchor="mm") for text, xy in self.axis_labels]
-        if not lay.text:
-            return out
-        for k in range(lay.n):
-            x0 = lay.panel_x(k) + lay.pad
-            clip = (x0, 0, lay.panel_x(k) + lay.panel_width - lay.pad, lay.H)
-            for i, line in enumerate(cap.readouts(k, f)[:lay.readout_lines]):
-                out.append(Text(line, (x0, lay.readout_y + i * lay.sizes.line), pal.fg, clip=clip))
-        for row in lay.rows:
-            if row.kind == "timebar":
-                out += self._time(cap, row, f)
-            elif row.kind == "notes":
-                notes = cap.notes(f)
-                lines = [NOTE_SEP.join(notes)] if row.payload == 1 else notes
-                for i, text in enumerate(lines[:row.payload]):
-                    out.append(Text(text, (lay.W // 2, row.y + i * lay.sizes.line), pal.muted, anchor="ma",
-                                    clip=(lay.pad, 0, lay.W - lay.pad, lay.H)))
-        return out
 
-    def _time(self, cap: Captions, row, f: int) -> list[Text]:
-        text, bar, pal = cap.time_text(f), self.bar, self.palette
-        if bar is None:
-            return [Text(text, (self.layout.pad, row.y), pal.fg)]
-        out = [Text(text, bar.text_xy, pal.fg, anchor="lm")]
-        if bar.scale:
-            out.append(Text(bar.scale, (bar.x1 + self.layout.sizes.size // 2, bar.text_xy[1]), pal.muted, anchor="lm"))
-        return out
-
-
-def make_overlay(plan, layout: Layout, metrics: TextMetrics, axis_labels=()) -> Overlay:
-    """The overlay of ``plan`` (a ``FramePlan``) in ``layout``: static marks in drawing order
-    (headings, divider, then the rows), the time bar, the inset, the dynamic boxes."""
-    pal = palette(plan.spec.background)
-    cap = Captions(plan)
+def make_overlay(plan, layout: Layout, texts, theme, metrics: TextMetrics, axis_labels=()) -> Overlay:
+    """The overlay of ``plan`` (a ``FramePlan``) in ``layout``: its words ``texts``
+    (``captions.Texts``) in the colours of ``theme`` (``style.Theme``), measured with
+    ``metrics``; ``axis_labels`` [(text, (column, row))] from the stage."""
+    pal, F = theme.hud, plan.frames
+    labels = [Line([text] * F, xy, pal.muted, anchor="mm") for text, xy in axis_labels]
     static, bar, inset = [], None, None
-    if layout.text:
-        static += _headings(plan, layout, pal, metrics)
-        y0, y1 = layout.divider
-        static += [Fill((layout.panel_x(k), y0, layout.panel_x(k) + 1, y1), pal.divider) for k in range(1, layout.n)]
-        for row in layout.rows:
-            if row.kind == "legend":
-                static += _legend(layout, row, metrics, chip_colors(plan.body_name), pal)
-            elif row.kind == "title":
-                static.append(Text(cap.footer(), (layout.W // 2, row.y), pal.muted, anchor="ma",
-                                   clip=(layout.pad, 0, layout.W - layout.pad, layout.H)))
-            elif row.kind == "timebar":
-                bar = _time_bar(plan, cap, layout, row, metrics, pal)
-            elif row.kind == "inset":
-                inset = _inset(plan, layout, row, metrics, pal)
-    labels = list(axis_labels)
-    return Overlay(plan=plan, layout=layout, palette=pal, static=static, bar=bar, inset=inset, axis_labels=labels,
-                   dynamic=_dynamic_boxes(layout, labels))
+    if not layout.text:
+        return Overlay(pal.bg, static, labels, None, None, _dynamic_boxes(layout, axis_labels))
+    static += _headings(plan, layout, pal, metrics)
+    y0, y1 = layout.divider
+    static += [Fill((layout.panel_x(k), y0, layout.panel_x(k) + 1, y1), pal.divider) for k in range(1, layout.n)]
+    lines = labels + _readouts(layout, texts, pal)
+    for row in layout.rows:
+        if row.kind == "legend":
+            static += _legend(layout, row, metrics, theme.chips, pal)
+        elif row.kind == "title":
+            static.append(Text(texts.footer, (layout.W // 2, row.y), pal.muted, anchor="ma",
+                               clip=(layout.pad, 0, layout.W - layout.pad, layout.H)))
+        elif row.kind == "timebar":
+            bar = _time_bar(plan, texts, layout, row, metrics, pal)
+            lines += _time_lines(texts, layout, row, bar, pal)
+        elif row.kind == "notes":
+            lines += _note_lines(texts, layout, row, pal)
+        elif row.kind == "inset":
+            inset = _inset(plan, layout, row, metrics, pal)
+    return Overlay(pal.bg, static, lines, bar, inset, _dynamic_boxes(layout, axis_labels))
 
 
 def _headings(plan, lay: Layout, pal: Palette, metrics: TextMetrics) -> list[Text]:
@@ -212,48 +176,76 @@ def _legend(lay: Layout, row, metrics: TextMetrics, colors: dict, pal: Palette) 
     for (key, text), w in zip(items, widths):
         x0, x1 = int(x), int(min(lay.W - lay.pad, x + w))
         out.append(Fill((x0, row.y, x1, row.y + h), colors.get(key, pal.muted)))
-        out.append(Text(text, ((x0 + x1) // 2, row.y + h // 2), (255, 255, 255), anchor="mm",
-                        clip=(x0, row.y, x1, row.y + h)))
+        out.append(Text(text, ((x0 + x1) // 2, row.y + h // 2), WHITE, anchor="mm", clip=(x0, row.y, x1, row.y + h)))
         x += w + size
     return out
 
 
-def _time_bar(plan, cap: Captions, lay: Layout, row, metrics: TextMetrics, pal: Palette) -> TimeBar | None:
+def _readouts(lay: Layout, texts, pal: Palette) -> list[Line]:
+    """Each panel's numbers under its view, one ``Line`` per line, kept inside the panel."""
+    out = []
+    for k in range(lay.n):
+        x0 = lay.panel_x(k) + lay.pad
+        clip = (x0, 0, lay.panel_x(k) + lay.panel_width - lay.pad, lay.H)
+        for i in range(lay.readout_lines):
+            words = [lines[i] if i < len(lines) else "" for lines in texts.readouts[k]]
+            out.append(Line(words, (x0, lay.readout_y + i * lay.sizes.line), pal.fg, clip=clip))
+    return out
+
+
+def _time_lines(texts, lay: Layout, row, bar: TimeBar | None, pal: Palette) -> list[Line]:
+    """The time left of the bar (or alone on its row), and the bar's unit right of it."""
+    if bar is None:
+        return [Line(list(texts.time), (lay.pad, row.y), pal.fg)]
+    yc = row.y + bar.h // 2
+    out = [Line(list(texts.time), (lay.pad, yc), pal.fg, anchor="lm")]
+    if texts.scale:
+        out.append(Line([texts.scale] * len(texts.time), (bar.x1 + lay.sizes.size // 2, yc), pal.muted, anchor="lm"))
+    return out
+
+
+def _note_lines(texts, lay: Layout, row, pal: Palette) -> list[Line]:
+    """How time and spin are shown, centred: all on one line, or one line each."""
+    per_frame = [[NOTE_SEP.join(notes)] if row.payload == 1 else notes for notes in texts.notes]
+    clip = (lay.pad, 0, lay.W - lay.pad, lay.H)
+    return [Line([lines[i] if i < len(lines) else "" for lines in per_frame], (lay.W // 2, row.y + i * lay.sizes.line),
+                 pal.muted, anchor="ma", clip=clip) for i in range(row.payload)]
+
+
+def _time_bar(plan, texts, lay: Layout, row, metrics: TextMetrics, pal: Palette) -> TimeBar | None:
     """The bar between the time text (as wide as its widest sample) and the scale text; None
     when less than four characters' width is left for it.  A tick's label goes left of its
     mark, and only where it clears the previous label."""
     size, h = lay.sizes.size, lay.sizes.line
     F = plan.frames
     sample = sorted(set(np.linspace(0, F - 1, min(F, 40)).round().astype(int)))
-    text_w = max(metrics.width(cap.time_text(f)) for f in sample)
-    scale = cap.scale_text()
+    text_w = max(metrics.width(texts.time[f]) for f in sample)
     x0 = lay.pad + int(text_w) + size // 2
-    x1 = lay.W - lay.pad - (int(metrics.width(scale)) + size // 2 if scale else 0)
+    x1 = lay.W - lay.pad - (int(metrics.width(texts.scale)) + size // 2 if texts.scale else 0)
     if x1 - x0 < 4 * size:
         return None
     ticks, last = [], -1e9
-    for pos, label in cap.bar_ticks():
+    for pos, label in texts.bar_ticks:
         x = int(round(pos * (x1 - x0 - 1)))
         lx = x - metrics.width(label) - 3
-        if lx > last + size // 2 and lx > 2:
-            ticks.append((x, label, lx))
-            last = x
-        else:
-            ticks.append((x, "", None))
-    return TimeBar(x0=x0, x1=x1, y=row.y, h=h, ticks=ticks, scale=scale, track=pal.track, fill=pal.fill,
-                   tick_color=pal.muted, text_xy=(lay.pad, row.y + h // 2))
+        shown = lx > last + size // 2 and lx > 2
+        ticks.append((x, label if shown else "", lx))
+        last = x if shown else last
+    video_t = plan.video_t
+    cuts = np.array([int(round(float(video_t[f]) / float(video_t[-1]) * (x1 - x0 - 1))) + 1 for f in range(F)])
+    return TimeBar(x0=x0, x1=x1, y=row.y, h=h, ticks=ticks, track=pal.track, fill=pal.fill, tick_color=pal.muted,
+                   cursor=pal.fg, cuts=cuts)
 
 
 def _inset(plan, lay: Layout, row, metrics: TextMetrics, pal: Palette) -> Inset:
-    """The two plots' boxes (a label column left of each), series and scales: angles up to the
-    next 15 deg (180 at most), ratios up to max(1, highest)."""
+    """The two plots' boxes (a label column left of each), curves and scales -- angles up to
+    the next 15 deg (180 at most), ratios up to max(1, highest) -- and their marks per frame."""
     pad, line = lay.pad, lay.sizes.line
     gap = 2 * pad
     label_w = int(metrics.width("180°")) + pad
     w = (lay.W - 2 * pad - gap) // 2
     boxes = [(pad + i * (w + gap) + label_w, row.y + line, pad + i * (w + gap) + w, row.y + row.height - pad)
              for i in range(2)]
-    F = plan.frames
     w0 = float(plan.panels[0].omega_mag[0]) or 1.0
     series = []
     for p in plan.panels:
@@ -263,7 +255,8 @@ def _inset(plan, lay: Layout, row, metrics: TextMetrics, pal: Palette) -> Inset:
     angles = [a for _, a, b, _ in series if a is not None] + [b[:, 1] for _, _, b, _ in series if b is not None]
     top_deg = max([float(np.max(a)) for a in angles] + [1.0])
     ymax = (min(180.0, 15.0 * math.ceil(top_deg / 15.0)), max(1.0, float(max(np.max(s[3]) for s in series))))
-    inset = Inset(boxes=boxes, x=np.arange(F) / max(1, F - 1), series=series, ymax=ymax, y0=row.y, height=row.height)
+    inset = Inset(y0=row.y, height=row.height, boxes=boxes, cursor_color=pal.muted, dot_radius=max(2, lay.H // 180))
+    _inset_marks(inset, plan.frames, series, ymax, pal)
     names = ("∠(d, L)", "|Ω| / |Ω₀|") if plan.units == "cgs" else ("∠(d, L)", "|ω| / |ω₀|")
     tops = (f"{ymax[0]:.0f}°", f"{ymax[1]:g}")
     for (bx0, by0, _, by1), name, top in zip(boxes, names, tops):
@@ -275,6 +268,32 @@ def _inset(plan, lay: Layout, row, metrics: TextMetrics, pal: Palette) -> Inset:
         inset.labels.append(Text(p.model, (x, row.y), MODEL_COLORS.get(p.model, pal.fg), anchor="ra"))
         x -= int(metrics.width(p.model)) + lay.sizes.size
     return inset
+
+
+def _inset_marks(inset: Inset, F: int, series, ymax, pal: Palette) -> None:
+    """The inset's bands and curves in pixels, and its cursor and dots at every frame."""
+    x = np.arange(F) / max(1, F - 1)
+
+    def xy(j, xs, ys):
+        x0, y0, x1, y1 = inset.boxes[j]
+        return x0 + xs * (x1 - x0 - 1), y1 - 1 - np.clip(ys / ymax[j], 0.0, 1.0) * (y1 - y0 - 1)
+
+    cursor = []
+    for j, box in enumerate(inset.boxes):
+        inset.shapes.append(("frame", pal.divider, box))
+        cursor.append([int(round(box[0] + x[f] * (box[2] - box[0] - 1))) for f in range(F)])
+        for color, ang, band, ratio in series:
+            if j == 0 and band is not None:
+                xs, lo = xy(j, x, band[:, 0])
+                _, hi = xy(j, x, band[:, 1])
+                inset.shapes.append(("band", tuple(int(c + 0.75 * (b - c)) for c, b in zip(color, pal.bg)), xs, lo, hi))
+            y = ang if j == 0 else ratio
+            if y is None:
+                continue
+            inset.shapes.append(("curve", color) + xy(j, x, y))
+            rows = [int(round(xy(j, x[f:f + 1], y[f:f + 1])[1][0])) for f in range(F)]
+            inset.dots.append((color, j, np.array(rows)))
+    inset.cursor = np.array(cursor)
 
 
 def _dynamic_boxes(lay: Layout, axis_labels) -> list[tuple[int, int, int, int]]:

@@ -1,9 +1,9 @@
 """Off-screen drawing of a ``picture.Picture``: one 3-D view per panel, the overlay around.
 
-A thin layer: every decision -- layout, camera, what is drawn where and in which colour --
-is in the picture; this module turns it into pixels with VTK (``views``) and Pillow
-(``hud``).  Imports only the drawing stack, NumPy and the pure planning modules: a render
-worker that receives a pickled picture loads neither numba nor scipy.
+A thin layer: every decision -- layout, camera, poses, words, colours -- is in the picture;
+this module turns it into pixels with VTK (``views``) and Pillow (``hud``).  Imports only
+the drawing stack, NumPy and the plain-data planning modules: a render worker that receives
+a pickled picture loads neither numba nor scipy.
 """
 
 from __future__ import annotations
@@ -11,7 +11,10 @@ from __future__ import annotations
 import numpy as np
 from PIL import Image
 
+from ..errors import RenderError
+from .fonts import Fonts
 from .hud import Hud
+from .meshes import assemble
 from .views import PanelView
 
 
@@ -30,15 +33,16 @@ class RenderSession:
         x0, y0, x1, y1 = picture.layout.views[0]
         self.view_size = (x1 - x0, y1 - y0)
         window = (max(1, int(round(self.view_size[0] * self.ss))), max(1, int(round(self.view_size[1] * self.ss))))
-        self.views = [PanelView(picture, panel, window, self.ss) for panel in picture.plan.panels]
-        self.hud = Hud(picture)
-        self.static = Image.fromarray(self.hud.static())
+        fonts, assembly = Fonts(picture.layout.sizes), assemble(picture)
+        self.views = [PanelView(picture, k, assembly, window, self.ss) for k in range(len(picture.plan.panels))]
+        self.hud = Hud(picture, fonts)
+        self.static = Image.fromarray(self.hud.static)
         self._restore = [(self.static.crop(box), box[:2]) for box in picture.overlay.dynamic]   # constant: crop once
         self._canvas = None
 
-    def compose(self) -> Image.Image:
-        """The static layer with the 3-D views pasted in (a PIL image: the per-frame text is
-        then blended in C by Pillow, with no NumPy round trip)."""
+    def frame(self, f: int) -> np.ndarray:
+        """Frame f (0 .. F - 1) as an RGB uint8 array of shape (H, W, 3): the static layer
+        (restored where the last frame's text went), the 3-D views, this frame's text."""
         if self._canvas is None:
             self._canvas = self.static.copy()
         else:
@@ -46,14 +50,23 @@ class RenderSession:
                 self._canvas.paste(patch, corner)
         img = self._canvas
         for (x0, y0, _, _), view in zip(self.picture.layout.views, self.views):
-            img.paste(view.image(self.view_size), (x0, y0))
-        return img
-
-    def frame(self, f: int) -> np.ndarray:
-        """Frame f (0 .. F - 1) as an RGB uint8 array of shape (H, W, 3)."""
-        for view in self.views:
             view.show(f)
-        return np.asarray(self.hud.draw(self.compose(), f))
+            img.paste(view.image(self.view_size), (x0, y0))
+        return np.asarray(self.hud.draw(img, f))
+
+    def record(self, writer, frames, each=None) -> None:
+        """Draw ``frames`` in order and write each to ``writer`` (an ``encode`` writer).
+        ``each(f, img)`` runs after every frame (progress, poster); True from it stops there.
+        A VTK or OpenGL failure (RuntimeError) becomes a one-line ``RenderError`` naming the frame."""
+        for f in frames:
+            try:
+                img = self.frame(f)
+                writer.write(img)
+            except RuntimeError as e:
+                why = str(e).strip().splitlines()[-1] if str(e).strip() else type(e).__name__
+                raise RenderError(f"rendering frame {f} failed: {why}") from None
+            if each is not None and each(f, img):
+                return
 
     def project(self, panel: int, point) -> tuple[float, float]:
         """Pixel (column, row) in the output image of a world point (3,) seen in ``panel``."""

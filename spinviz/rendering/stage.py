@@ -1,10 +1,11 @@
-"""What the 3-D views hold, and where each thing is at each frame: ``Stage``, ``fit_camera``.
+"""What the 3-D views hold, and where each thing is at each frame: ``plan_stage`` -> ``Stage``.
 
 Pure NumPy.  The static lines (back half of the unit-sphere cage, the axes, or the
-hodograph's axes and ticks), the solids to build (body, arrows, the hodograph's marker), the
-camera fitted once to the content of *every* frame (``fit_camera``), the axis labels in
-output pixels, and per frame the solids' poses and the curves' points.  World frame, lengths
-in units of the dipole arrow; the hodograph is drawn in the body frame, in units of |omega(0)|.
+hodograph's axes and ticks), the solids to build (body, arrows, the hodograph's marker) and
+their poses at every frame, the camera fitted once to the content of *every* frame, the
+3-D views narrowed to that content, and the axis labels in output pixels.  World frame,
+lengths in units of the dipole arrow; the hodograph is drawn in the body frame, in units
+of |omega(0)|.
 """
 
 from __future__ import annotations
@@ -14,10 +15,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..rotations import matrix_from_quat
-from .camera import Camera, view_direction
+from .camera import Camera, fit
 from .captions import nice_step
-from .style import ARROWS, AXIS_LENGTH, BODY_RADIUS, COLORS, TRAIL_POINTS, arrow_length
+from .style import ARROW_BASE, ARROWS, AXIS_LENGTH, BODY_RADIUS, TRAIL_POINTS
 
 ARROW_KEYS = ("dipole", "L", "omega")                 # drawn in this order
 ARROW_VECTORS = {"dipole": "d_world", "L": "L_world", "omega": "omega_world"}   # the Panel field of each arrow
@@ -26,94 +26,60 @@ EDGE_PX = 5.0             # drawn pixels keep this far from a 3-D view's edge
 
 @dataclass
 class Stage:
-    """The 3-D content of the panels (the same in each panel but for the moving parts).
+    """The 3-D content of the panels, the same in each but for the poses.
 
     view : (3,) unit, world, towards the camera; lines : [(points (n, 3), RGB floats)], the
     static polylines; solids : names of the solids to build, in order ("body", "dipole", "L",
-    "omega", "hodo_marker"); marker_radius : of the hodograph's "now" ball; trail_rgb :
-    (TRAIL_POINTS, 3) uint8, oldest first, or None without a trail; hodograph : whether the
-    curve of omega_body is drawn; labels : [(text, (column, row))] axis names and tick values,
-    output pixels; lights : [(unit direction (3,), world; intensity)]; background : RGB floats.
+    "omega", "hodo_marker"); body_from_shape : (3, 3) the drawn body's own axes in the body
+    frame; marker_radius : of the hodograph's "now" ball; trail_rgb : (TRAIL_POINTS, 3) uint8,
+    oldest first, or None without a trail; trail_frames : frames the trail spans; hodograph :
+    whether the curve of omega_body is drawn; labels : [(text, (column, row))] axis names and
+    tick values, output pixels; lights : [(unit direction (3,), world; intensity)].
+    poses : per panel, per solid, at every frame (F first): "body" -> (F, 3, 3) body -> world;
+    an arrow key -> ((F, 3, 3) rotations taking +x along the arrow, (F,) drawn lengths);
+    "hodo_marker" -> (F, 3) positions in the hodograph's frame.
     """
 
     view: np.ndarray
     lines: list
     solids: tuple
+    body_from_shape: np.ndarray
     marker_radius: float
     trail_rgb: np.ndarray | None
+    trail_frames: int
     hodograph: bool
     labels: list
     lights: list
-    background: tuple
-    d_from_x: np.ndarray           # (3, 3): the dipole arrow (+x) into the body frame
-    trail_frames: int
-
-    # -- per frame ------------------------------------------------------------------------
-    def poses(self, panel, f: int) -> dict:
-        """Where each solid of ``panel`` is at frame ``f``: "body" -> rotation (3, 3), body ->
-        world; an arrow key -> (rotation (3, 3) taking +x along the arrow, drawn length);
-        "hodo_marker" -> position (3,) in the hodograph's frame."""
-        out = {}
-        if panel.q is not None:
-            rot = matrix_from_quat(panel.q[f])
-            out["body"] = rot
-            out["dipole"] = (rot @ self.d_from_x, ARROWS["dipole"][3])
-        for key in ("L", "omega"):
-            v = getattr(panel, ARROW_VECTORS[key])
-            if key in self.solids and v is not None:
-                out[key] = (rotation_x_to(v[f]), arrow_length(key, float(np.linalg.norm(v[f]))))
-        if "hodo_marker" in self.solids:
-            out["hodo_marker"] = panel.omega_body[f]
-        return out
-
-    def trail_points(self, panel, f: int) -> np.ndarray:
-        """(TRAIL_POINTS, 3) the dipole's tip over the last ``trail_seconds``, oldest first, world."""
-        lo = max(0, f - self.trail_frames)
-        idx = np.linspace(lo, f, TRAIL_POINTS).round().astype(int)
-        return panel.d_world[idx]
-
-    def hodograph_points(self, panel, f: int) -> np.ndarray:
-        """(F, 3) the hodograph up to frame f (later points wait at the current one), body frame."""
-        pts = panel.omega_body.copy()
-        pts[f + 1:] = pts[f]
-        return pts
+    poses: list
 
 
-def make_stage(plan, layout, camera: Camera) -> Stage:
-    """The stage of ``plan`` seen by ``camera`` in ``layout``'s views (see ``Stage``)."""
+def plan_stage(plan, layout, theme):
+    """The stage of ``plan`` (a ``FramePlan``), the camera fitted to it, and ``layout`` with
+    its 3-D views narrowed to what the content needs (centred in their panels).
+
+    theme : ``style.Theme`` (the scene colours).  Returns (Stage, camera.Camera, Layout).
+    """
     spec = plan.spec
     show = set(spec.show)
-    colors = COLORS[spec.background]
-    hodo = "hodograph" in show
-    lines, ticks = [], []
-    if "sphere" in show and not hodograph_only(spec):
-        lines += sphere_cage(camera.view, colors)
-    if "axes" in show:
-        if hodo or hodograph_only(spec):
-            axes, ticks = hodograph_axes(plan, colors["axes"])
-            lines += axes
-        else:
-            for i in range(3):
-                e = np.zeros(3)
-                e[i] = AXIS_LENGTH
-                lines.append((np.array([np.zeros(3), e]), colors["axes"]))
+    x0, y0, x1, y1 = layout.views[0]
     solids = (("body",) if "body" in show else ()) + tuple(k for k in ARROW_KEYS if k in show)
-    marker = 0.0
-    if hodo:
-        solids += ("hodo_marker",)
-        marker = 0.022 * hodograph_range(plan)[2]
-    trail_rgb = None
-    if "trail" in show:
-        # opaque on purpose (a translucent actor sends every frame down the depth-sorting path,
-        # ~50 ms per 1440p frame on llvmpipe): the fade is a per-point colour that runs from the
-        # background (oldest) to the trail colour (newest)
-        age = np.linspace(0.0, 1.0, TRAIL_POINTS) ** 1.5
-        bg, tc = np.asarray(colors["bg_rgb"]), np.asarray(colors["trail"])
-        trail_rgb = ((bg + (tc - bg) * (0.06 + 0.94 * age)[:, None]) * 255).astype(np.uint8)
-    return Stage(view=camera.view, lines=lines, solids=solids, marker_radius=marker, trail_rgb=trail_rgb,
-                 hodograph=hodo, labels=axis_labels(plan, layout, camera, ticks), lights=camera.lights(),
-                 background=colors["bg_rgb"], d_from_x=rotation_x_to(plan.d_body),
-                 trail_frames=int(round(spec.trail_seconds * spec.fps)))
+    solids += ("hodo_marker",) if "hodograph" in show else ()
+    d_from_x = rotation_x_to(plan.d_body)
+    stage = Stage(view=_view_direction(spec), lines=[], solids=solids,
+                  body_from_shape=np.asarray(plan.shape.R_body_from_shape if plan.shape else np.eye(3), dtype=float),
+                  marker_radius=0.022 * hodograph_range(plan)[2] if "hodograph" in show else 0.0,
+                  trail_rgb=_trail_colors(theme.scene) if "trail" in show else None,
+                  trail_frames=int(round(spec.trail_seconds * spec.fps)), hodograph="hodograph" in show,
+                  labels=[], lights=[], poses=[_poses(panel, solids, d_from_x) for panel in plan.panels])
+    points, border = content_points(plan), _border(layout, show)
+    stage.lines, ticks = static_lines(plan, stage.view, theme.scene)
+    camera, width = fit(stage.view, points, (x1 - x0, y1 - y0), border, spec.zoom)
+    stage.lights = camera.lights()
+    if width < x1 - x0:
+        views = [(a + (c - a - width) // 2, b, a + (c - a - width) // 2 + width, d) for (a, b, c, d) in layout.views]
+        layout = replace(layout, views=views)
+    stage.labels = axis_labels(plan, layout, camera, ticks)
+    return stage, camera, layout
 
 
 def hodograph_only(spec) -> bool:
@@ -121,40 +87,74 @@ def hodograph_only(spec) -> bool:
     return "hodograph" in spec.show and not spec.needs_orientation
 
 
-# --- the camera ------------------------------------------------------------------------------
-def fit_camera(plan, layout) -> tuple[Camera, object]:
-    """The camera fitted to the content of every frame, and the layout with its 3-D views
-    narrowed to the width the content needs (GL pixels are the cost; the rest of the panel
-    is static background), centred in their panels.  Both panels share the camera."""
-    x0, y0, x1, y1 = layout.views[0]
-    vw, vh = x1 - x0, y1 - y0
-    pts = content_points(plan)
-    spec = plan.spec
-    view, zoom = view_direction(spec.azimuth_deg, spec.elevation_deg), spec.zoom
-    border = _border(layout, spec.show)
-    cam = Camera(view, vw / vh, pts, _margins(border, vw, vh), zoom)
-    lo, hi = cam.extent(pts, cam.distance)
-    need = ((hi[0] - lo[0]) / 2.0 * vw + 2 * border[0]) / 0.98
-    w2 = int(min(vw, 2 * math.ceil(need / 2.0 + 1)))
-    if w2 < vw and zoom <= 1.0:
-        views = []
-        for (a, b, c, d) in layout.views:
-            left = a + (c - a - w2) // 2
-            views.append((left, b, left + w2, d))
-        layout = replace(layout, views=views)
-        cam = Camera(view, w2 / vh, pts, _margins(border, w2, vh), zoom)
-    return cam, layout
+def _view_direction(spec) -> np.ndarray:
+    """Unit vector (3,), world frame, from the origin towards the camera (``azimuth_deg``, ``elevation_deg``)."""
+    az, el = math.radians(spec.azimuth_deg), math.radians(spec.elevation_deg)
+    return np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
 
 
+def arrow_length(key: str, ratio: float) -> float:
+    """Drawn length of an arrow whose quantity is ``ratio`` times its reference magnitude.
+
+    key : "dipole", "omega" or "L"; ratio : |x(t)| / |x(0)| of the reference panel (the dipole
+    arrow keeps its length).  Returns a length in units of the dipole arrow."""
+    full = ARROWS[key][3]
+    if key == "dipole":
+        return full
+    return ARROW_BASE + (full - ARROW_BASE) * min(max(ratio, 0.0), 1.5)
+
+
+def _poses(panel, solids, d_from_x) -> dict:
+    """Every frame's pose of each solid of ``panel`` (see ``Stage.poses``).  The arrows are
+    turned frame by frame, as they were when drawn one frame at a time (same numbers)."""
+    out = {}
+    for key in ("L", "omega"):
+        v = getattr(panel, ARROW_VECTORS[key])
+        if key in solids and v is not None:
+            out[key] = (np.array([rotation_x_to(x) for x in v]),
+                        np.array([arrow_length(key, float(np.linalg.norm(x))) for x in v]))
+    if panel.R_world_from_body is not None:
+        rot = panel.R_world_from_body
+        out["body"] = rot
+        out["dipole"] = (rot @ d_from_x, np.full(rot.shape[0], ARROWS["dipole"][3]))
+    if "hodo_marker" in solids:
+        out["hodo_marker"] = panel.omega_body
+    return out
+
+
+def _trail_colors(colors) -> np.ndarray:
+    """(TRAIL_POINTS, 3) uint8, oldest first: from near the background (6 %) to the trail colour.
+    Opaque on purpose (a translucent actor sends every frame down the depth-sorting path,
+    ~50 ms per 1440p frame on llvmpipe): the fade is a per-point colour."""
+    age = np.linspace(0.0, 1.0, TRAIL_POINTS) ** 1.5
+    bg, tc = np.asarray(colors["bg_rgb"]), np.asarray(colors["trail"])
+    return ((bg + (tc - bg) * (0.06 + 0.94 * age)[:, None]) * 255).astype(np.uint8)
+
+
+def static_lines(plan, view, colors) -> tuple[list, list]:
+    """(lines [(points (n, 3), RGB floats)], hodograph ticks [(axis, value, point (3,))]): the
+    back of the sphere cage as seen from ``view`` and the axes -- or the hodograph's axes with
+    tick marks."""
+    show = set(plan.spec.show)
+    lines, ticks = [], []
+    if "sphere" in show and not hodograph_only(plan.spec):
+        lines += sphere_cage(view, colors)
+    if "axes" in show and "hodograph" not in show:
+        for i in range(3):
+            e = np.zeros(3)
+            e[i] = AXIS_LENGTH
+            lines.append((np.array([np.zeros(3), e]), colors["axes"]))
+    elif "axes" in show:
+        axes, ticks = hodograph_axes(plan, colors["axes"])
+        lines += axes
+    return lines, ticks
+
+
+# --- the camera's content ------------------------------------------------------------------
 def _border(layout, show) -> tuple[float, float]:
     """Pixels kept free at the sides and at top and bottom of a view (labels reach out there)."""
     label = layout.sizes.size * 0.9 if "axes" in show else 0.0
     return EDGE_PX + 1.4 * label, EDGE_PX + 0.6 * label
-
-
-def _margins(border, vw, vh) -> tuple[float, float]:
-    bx, by = border
-    return (min(0.5, 0.02 + 2 * bx / vw), min(0.5, 0.02 + 2 * by / vh))
 
 
 def content_points(plan) -> np.ndarray:

@@ -1,6 +1,6 @@
 """Colours and sizes of everything drawn: the 3-D theme, the arrows, the HUD palette, the models.
 
-Plain data and two small rules (``body_color``, ``arrow_length``); imports nothing.
+Plain data; ``theme(background, body_name)`` gathers the colours of one video.  Imports nothing.
 Colours of the 3-D scene are RGB floats in [0, 1]; colours of text and 2-D marks are RGB
 integers in 0..255.  Lengths of the 3-D scene are in units of the dipole arrow (its tip
 lies on the unit sphere).
@@ -73,19 +73,21 @@ def body_color(name: str) -> tuple[float, float, float]:
     return BODY_COLOR
 
 
-def chip_colors(body_name: str) -> dict[str, tuple[int, int, int]]:
-    """The legend chips' colours (RGB 0..255): each arrow's own, and a darker body colour."""
-    colors = {k: tuple(int(round(255 * c)) for c in v) for k, v in ARROW_COLORS.items()}
-    colors["body"] = tuple(int(round(255 * 0.6 * c)) for c in body_color(body_name))
-    return colors
+@dataclass(frozen=True)
+class Theme:
+    """The colours of one video: ``scene`` (the 3-D theme, ``COLORS[background]``: RGB floats
+    under "sphere", "limb", "axes", "trail", "bg_rgb"), ``body`` (RGB floats), ``hud`` (the
+    ``Palette``), ``chips`` (legend chips, RGB 0..255, per arrow key and "body")."""
+
+    scene: dict
+    body: tuple
+    hud: Palette
+    chips: dict
 
 
-def arrow_length(key: str, ratio: float) -> float:
-    """Drawn length of an arrow whose quantity is ``ratio`` times its reference magnitude.
-
-    key : "dipole", "omega" or "L"; ratio : |x(t)| / |x(0)| of the reference panel (the dipole
-    arrow keeps its length).  Returns a length in units of the dipole arrow."""
-    full = ARROWS[key][3]
-    if key == "dipole":
-        return full
-    return ARROW_BASE + (full - ARROW_BASE) * min(max(ratio, 0.0), 1.5)
+def theme(background: str, body_name: str) -> Theme:
+    """The colours for a ``[render].background`` ("white" or "black") and a body's name."""
+    body = body_color(body_name)
+    chips = {k: tuple(int(round(255 * c)) for c in v) for k, v in ARROW_COLORS.items()}
+    chips["body"] = tuple(int(round(255 * 0.6 * c)) for c in body)
+    return Theme(scene=COLORS[background], body=body, hud=palette(background), chips=chips)

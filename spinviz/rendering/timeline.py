@@ -142,6 +142,7 @@ def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = 
     samples = [tr.sample(sim_t) for tr in trajs]   # once: choose_spin_mode's own sampling then returns these
     mode, why = choose_spin_mode(spec, samples, sim_t)
     resolved = all(tr.phase_resolved for tr in trajs)
+    unit = time_scale(trajs, t_end)
     shown, slowdown = _shown_motion(spec, samples, body, mode, video_t, slope)
     ref = samples[0].omega[0]
     scale = (float(np.linalg.norm(ref)) or 1.0,
@@ -151,8 +152,7 @@ def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = 
     return FramePlan(
         spec=spec, video_t=video_t, sim_t=sim_t, panels=panels, units=body.units, body_name=body.name,
         shape=ShapeInfo.of(body.shape), d_body=np.asarray(body.dipole_direction, dtype=float), spin_mode=mode,
-        slowdown=slowdown, notes=[f"spin: {mode} ({why})"],
-        time_scale=time_scale(trajs, t_end), phase_resolved=resolved,
+        slowdown=slowdown, notes=[f"spin: {mode} ({why})"], time_scale=unit, phase_resolved=resolved,
     )
 
 
@@ -186,7 +186,7 @@ def _panel(spec: RenderSpec, s: Trajectory, motion, body, scale, exact_angle: bo
     panel = Panel(model=s.model, omega_mag=s.omega_magnitude)
     if spec.needs_orientation:
         q, omega_body = motion
-        panel.q = q
+        panel.q, panel.R_world_from_body = q, R.matrix_from_quat(q)
         if "dipole" in show or "trail" in show:
             panel.d_world = R.world_from_body(q, body.dipole_direction)
         if "omega" in show:

@@ -32,9 +32,7 @@ from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkUnsignedCharArray
 from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper, vtkRenderer, vtkRenderWindow
 
-from . import meshes
-from .meshes import Part
-from .style import AMBIENT, ARROW_COLORS, ARROWS, HODO_COLOR, HODO_MARKER_COLOR, TRAIL_POINTS, VIEW_ANGLE
+from .style import AMBIENT, ARROWS, HODO_COLOR, TRAIL_POINTS, VIEW_ANGLE
 
 
 class Window:
@@ -101,36 +99,29 @@ class Window:
 class Solids:
     """The moving solids of a panel as one mesh, turned and lit on the CPU each frame.
 
-    Parts (``meshes.Part``) are added in their own frame; ``place`` sets a part's linear map
-    (a rotation, or a rotation times a stretch along the arrow), the rotation for its
-    normals and a shift; ``commit`` writes points and colours once.  Lambert shading from
-    lights fixed in the world (the camera never moves); outline vertices are not lit.
+    Built from a ``meshes.Assembly`` (parts in their own frames, joined); ``place`` sets a
+    part's linear map (a rotation, or a rotation times a stretch along the arrow), the
+    rotation for its normals and a shift; ``commit`` writes points and colours once.
+    Lambert shading from lights fixed in the world (the camera never moves); outline
+    vertices are not lit.
     """
 
-    def __init__(self, lights):
+    def __init__(self, assembly, lights, window: Window):
         self.lights = lights
-        self.parts: dict[str, dict] = {}
+        self.part = assembly.part
+        self.parts = {name: {"slice": sl, "lin": np.eye(3), "rot": np.eye(3), "shift": np.zeros(3)}
+                      for name, sl in assembly.slices.items()}
         self.mesh = None
-
-    def add(self, name: str, part: Part):
-        self.parts[name] = {"part": part, "lin": np.eye(3), "rot": np.eye(3), "shift": np.zeros(3)}
-
-    def build(self, window: Window):
-        """One actor for all parts (none without parts)."""
-        if not self.parts:
-            return None
-        parts = [p["part"] for p in self.parts.values()]
-        offsets = np.cumsum([0] + [p.points.shape[0] for p in parts])
-        for p, lo, hi in zip(self.parts.values(), offsets[:-1], offsets[1:]):
-            p["slice"] = slice(int(lo), int(hi))
-        joined = Part.join(parts)
-        faces = np.c_[np.full(len(joined.triangles), 3), joined.triangles].ravel()
-        self.mesh = pv.PolyData(joined.points, faces=faces)
+        if self.part is None:
+            return
+        faces = np.c_[np.full(len(self.part.triangles), 3), self.part.triangles].ravel()
+        # a copy: the mesh's points are overwritten every frame, the assembly's are the parts at rest
+        self.mesh = pv.PolyData(self.part.points.copy(), faces=faces)
         self.mesh.point_data["rgb"] = np.zeros((self.mesh.n_points, 3), dtype=np.uint8)
         self._rgb = self.mesh.point_data["rgb"]                  # shares memory with the VTK array
         self._vtk_rgb = self.mesh.GetPointData().GetArray("rgb")
         self._pts = self.mesh.points                             # so do the points: updated in place
-        return window.add_mesh(self.mesh, rgb=True)
+        window.add_mesh(self.mesh, rgb=True)
 
     def place(self, name: str, rot3=None, shift=None, lin=None):
         p = self.parts[name]
@@ -144,15 +135,16 @@ class Solids:
         """Write the placed, lit points and colours into the mesh."""
         pts = np.empty((self.mesh.n_points, 3))
         rgb = np.empty((self.mesh.n_points, 3))
+        part = self.part
         for p in self.parts.values():
-            part, sl = p["part"], p["slice"]
-            pts[sl] = part.points @ p["lin"].T + p["shift"]
-            n = part.normals @ p["rot"].T
+            sl = p["slice"]
+            pts[sl] = part.points[sl] @ p["lin"].T + p["shift"]
+            n = part.normals[sl] @ p["rot"].T
             k = np.full(n.shape[0], AMBIENT)
             for direction, intensity in self.lights:
                 k += intensity * np.clip(n @ direction, 0.0, None)
-            k = np.where(part.lit, k, 1.0)
-            rgb[sl] = part.color * k[:, None]
+            k = np.where(part.lit[sl], k, 1.0)
+            rgb[sl] = part.color[sl] * k[:, None]
         self._pts[:] = pts
         self.mesh.GetPoints().Modified()
         self._rgb[:] = np.clip(rgb * 255.0, 0, 255).astype(np.uint8)
@@ -185,53 +177,60 @@ def lines_mesh(curves_rgb) -> pv.PolyData | None:
 
 class PanelView:
     """One panel's 3-D view: its window, solids and curves, built from ``picture.stage``;
-    ``show(f)`` poses them for frame f, ``image()`` renders at output resolution."""
+    ``show(f)`` poses them for frame f, ``image()`` renders at output resolution.
 
-    def __init__(self, picture, panel, window_size, supersample: float):
+    k : the panel's index; assembly : the solids (``meshes.assemble``); window_size : px
+    (the view's size times the supersampling factor ``supersample``)."""
+
+    def __init__(self, picture, k: int, assembly, window_size, supersample: float):
         stage = picture.stage
-        self.stage, self.panel, self.ss = stage, panel, float(supersample)
-        self.window = Window(window_size, stage.background)
+        self.poses, self.ss = stage.poses[k], float(supersample)
+        self.window = Window(window_size, picture.theme.scene["bg_rgb"])
         lw = max(1, int(round(self.ss)))
         mesh = lines_mesh(stage.lines)
         if mesh is not None:
             # 1-pixel lines at the supersampled size: wider GL lines are drawn as extra
             # triangles and cost ~2.5 ms per panel on llvmpipe
             self.window.add_mesh(mesh, rgb=True, line_width=1)
-        self.solids = Solids(stage.lights)
-        for name in stage.solids:
-            for part_name, part in _parts(name, picture, stage):
-                self.solids.add(part_name, part)
-        self.solids.build(self.window)
+        self.solids = Solids(assembly, stage.lights, self.window)
         self.curves = {}
+        panel = picture.plan.panels[k]
         if stage.trail_rgb is not None:
+            self.trail = (panel.d_world, stage.trail_frames)
             self.curves["trail"] = pv.lines_from_points(np.zeros((TRAIL_POINTS, 3)))
             self.curves["trail"].point_data["rgb"] = stage.trail_rgb
             self.window.add_mesh(self.curves["trail"], rgb=True, line_width=2 * lw)
         if stage.hodograph:
+            self.hodograph = panel.omega_body
             self.curves["hodograph"] = pv.lines_from_points(np.zeros((picture.frames, 3)))
             self.window.add_mesh(self.curves["hodograph"], color=HODO_COLOR, line_width=2 * lw)
         self.window.look(picture.camera)
         self._pixels = vtkUnsignedCharArray()                 # one per window: numpy views share it
 
     def show(self, f: int):
-        """Pose the solids and curves for frame f."""
+        """Pose the solids and curves for frame f (the stage's poses; the trail over its last
+        ``trail_frames`` frames; the hodograph up to f, later points waiting at the current one)."""
         solids = self.solids
-        for name, pose in self.stage.poses(self.panel, f).items():
+        for name, pose in self.poses.items():
             if name == "body" and "body" in solids.parts:
-                solids.place("body", pose)
+                solids.place("body", pose[f])
             elif name == "hodo_marker":
-                solids.place("hodo_marker", shift=pose)
+                solids.place("hodo_marker", shift=pose[f])
             elif name + "_shaft" in solids.parts:
-                r, length = pose
+                r, length = pose[0][f], pose[1][f]
                 head_len = ARROWS[name][1]
                 solids.place(name + "_shaft", r, lin=r @ np.diag([length - head_len, 1.0, 1.0]))
                 solids.place(name + "_head", r, shift=r[:, 0] * (length - head_len))
         if solids.mesh is not None:
             solids.commit()
         if "trail" in self.curves:
-            _set_points(self.curves["trail"], self.stage.trail_points(self.panel, f))
+            d_world, n = self.trail
+            idx = np.linspace(max(0, f - n), f, TRAIL_POINTS).round().astype(int)
+            _set_points(self.curves["trail"], d_world[idx])
         if "hodograph" in self.curves:
-            _set_points(self.curves["hodograph"], self.stage.hodograph_points(self.panel, f))
+            pts = self.hodograph.copy()
+            pts[f + 1:] = pts[f]
+            _set_points(self.curves["hodograph"], pts)
 
     def image(self, view_size) -> Image.Image:
         """The view at output resolution ``view_size`` (PIL RGB image), without text."""
@@ -248,14 +247,3 @@ class PanelView:
 
     def close(self):
         self.window.close()
-
-
-def _parts(name: str, picture, stage) -> list[tuple[str, Part]]:
-    """The mesh parts of one solid of the stage: the body, an arrow's shaft and head, the marker."""
-    if name == "body":
-        return [("body", meshes.body_part(picture.plan.shape, picture.plan.body_name))]
-    if name == "hodo_marker":
-        return [("hodo_marker", meshes.ball(stage.marker_radius, np.asarray(HODO_MARKER_COLOR)))]
-    shaft, head_len, head_r, _ = ARROWS[name]
-    color = np.asarray(ARROW_COLORS[name])
-    return [(name + "_shaft", meshes.arrow_shaft(shaft, color)), (name + "_head", meshes.arrow_head(head_len, head_r, color))]

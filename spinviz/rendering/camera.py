@@ -82,6 +82,7 @@ class Camera:
         v, r, u = self.view, self.right, self.up
 
         def unit(x):
+            """x / |x|."""
             return x / np.linalg.norm(x)
 
         return [(unit(-0.55 * r + 0.75 * u + 0.45 * v), 0.55), (unit(0.85 * r - 0.15 * u + 0.35 * v), 0.22),
@@ -89,13 +90,30 @@ class Camera:
 
 
 def fit(view, points, size, border, zoom: float = 1.0) -> tuple[Camera, int]:
-    """The camera that shows ``points`` in a view of ``size`` (width, height) px, keeping
-    ``border`` (x, y) px free at its edges, and the width (px, even, at most the given one)
-    that the content needs: GL pixels are the cost of a frame, so a view narrower than its
-    panel is drawn that narrow (unless zoomed in).
+    """The camera that shows ``points`` in a view, and the view width the content needs.
 
-    view : (3,) unit, world, towards the camera; points : (N, 3) world points every frame
-    draws.  Returns (camera fitted to the returned width, that width).
+    GL pixels are the cost of a frame, so a view narrower than its panel is drawn that
+    narrow (unless zoomed in).
+
+    Parameters
+    ----------
+    view : array_like, shape (3,)
+        Unit vector from the origin towards the camera, world frame.
+    points : array_like, shape (N, 3)
+        Every world point any frame draws (dipole-arrow units).
+    size : (int, int)
+        (width, height) of the view, px.
+    border : (float, float)
+        Pixels kept free at the sides and at top and bottom.
+    zoom : float
+        > 1 moves the camera closer after the fit.
+
+    Returns
+    -------
+    camera : Camera
+        Fitted to the returned width.
+    width : int
+        Even, at most ``size[0]``, px.
     """
     vw, vh = size
     cam = Camera(view, vw / vh, points, _margins(border, vw, vh), zoom)

@@ -122,7 +122,19 @@ class Texts:
 
 
 def texts_of(plan) -> Texts:
-    """All the words of ``plan`` (a ``FramePlan``) in the register of its ``[render].captions``."""
+    """All the words of ``plan``, in the register of its ``[render].captions``.
+
+    Parameters
+    ----------
+    plan : FramePlan
+        Frame times (scene unit), |Omega| per panel (rad/s or 1/tau0), angles (deg).
+
+    Returns
+    -------
+    Texts
+        Headings, subtitles, legend, footer, the time bar's scale and ticks, and per frame
+        (F of each) the panels' numbers, the time and the notes.
+    """
     cap = Captions(plan)
     n, F = len(plan.panels), plan.frames
     show = plan.spec.show

@@ -55,7 +55,9 @@ class TextMetrics(Protocol):
 
     sizes: TextSizes
 
-    def width(self, text: str, role: str = "small") -> float: ...
+    def width(self, text: str, role: str = "small") -> float:
+        """Advance width of ``text``, px, in the body ("small") or heading ("main") font."""
+        ...
 
 
 def wrap(text: str, metrics: TextMetrics, width: float, lines: int = 2) -> list[str]:
@@ -118,6 +120,7 @@ class Layout:
 
     @property
     def panel_width(self) -> int:
+        """Width of one panel, px."""
         return self.W // self.n
 
     def panel_x(self, k: int) -> int:
@@ -139,10 +142,23 @@ class _Wants:
 
 
 def make_layout(plan, texts, metrics: TextMetrics) -> Layout:
-    """The bands of a frame for ``plan`` (a ``FramePlan``) at its spec's size, holding
-    ``texts`` (``captions.Texts``): text bands are dropped, least needed first
-    (``DROP_ORDER``), until the 3-D view keeps ``MIN_VIEW`` of the height (``MIN_VIEW_INSET``
-    with an inset).  The views span their panels' width; the stage may narrow them."""
+    """The bands of a frame: text bands are dropped, least needed first (``DROP_ORDER``),
+    until the 3-D view keeps ``MIN_VIEW`` of the height (``MIN_VIEW_INSET`` with an inset).
+
+    Parameters
+    ----------
+    plan : FramePlan
+        Its spec gives the frame size (W, H) px and what is shown.
+    texts : captions.Texts
+        The words the bands must hold (subtitles are wrapped to the panel's width).
+    metrics : TextMetrics
+        Type sizes and text widths, px.
+
+    Returns
+    -------
+    Layout
+        Output pixels; the views span their panels' width (the stage may narrow them).
+    """
     W, H = plan.spec.size
     show = set(plan.spec.show)
     sizes = metrics.sizes

@@ -30,8 +30,20 @@ class Assembly:
 
 
 def assemble(picture) -> Assembly:
-    """The solids ``picture.stage`` lists, built and joined in its order: the body (its shape,
-    colour and axes), each arrow as a shaft and a head along +x, the hodograph's marker."""
+    """The solids ``picture.stage`` lists, built and joined in its order.
+
+    Parameters
+    ----------
+    picture : picture.Picture
+        Its stage names the solids ("body", arrow keys, "hodo_marker"); its plan gives the
+        body's shape, its theme the body's colour.
+
+    Returns
+    -------
+    Assembly
+        One ``Part`` (the body in its body frame, each arrow as a shaft and a head along +x,
+        the marker at the origin; dipole-arrow units) and each part's vertex slice in it.
+    """
     stage, plan = picture.stage, picture.plan
     named = []
     for name in stage.solids:
@@ -99,6 +111,7 @@ def box(half, color, edge_color) -> Part:
             iu, iv = eu * (1 - w / half[u]), ev * (1 - w / half[v])
 
             def q(a, b, c, d, c0=c0):
+                """Four corners of a quad on this face (c0 its centre)."""
                 return np.array([c0 + a, c0 + b, c0 + c, c0 + d])
 
             parts.append(_quads(q(-iu - iv, iu - iv, iu + iv, -iu + iv), n, color))

@@ -119,9 +119,27 @@ class Overlay:
 
 
 def make_overlay(plan, layout: Layout, texts, theme, metrics: TextMetrics, axis_labels=()) -> Overlay:
-    """The overlay of ``plan`` (a ``FramePlan``) in ``layout``: its words ``texts``
-    (``captions.Texts``) in the colours of ``theme`` (``style.Theme``), measured with
-    ``metrics``; ``axis_labels`` [(text, (column, row))] from the stage."""
+    """Everything 2-D on the frames of ``plan``, for every frame at once.
+
+    Parameters
+    ----------
+    plan : FramePlan
+    layout : layout.Layout
+        The bands (output px).
+    texts : captions.Texts
+        The words, per frame where they change.
+    theme : style.Theme
+        HUD palette and legend chip colours (RGB 0..255).
+    metrics : layout.TextMetrics
+        Text widths, px (headings' equation numbers, legend chips, time bar, inset).
+    axis_labels : list of (str, (float, float))
+        Axis names and tick values at output pixels (column, row), from the stage.
+
+    Returns
+    -------
+    Overlay
+        Static marks in drawing order, per-frame lines, time bar, inset, dynamic boxes.
+    """
     pal, F = theme.hud, plan.frames
     labels = [Line([text] * F, xy, pal.muted, anchor="mm") for text, xy in axis_labels]
     static, bar, inset = [], None, None
@@ -275,6 +293,7 @@ def _inset_marks(inset: Inset, F: int, series, ymax, pal: Palette) -> None:
     x = np.arange(F) / max(1, F - 1)
 
     def xy(j, xs, ys):
+        """Pixel columns and rows of points (video fraction, value in plot j's unit) in plot j."""
         x0, y0, x1, y1 = inset.boxes[j]
         return x0 + xs * (x1 - x0 - 1), y1 - 1 - np.clip(ys / ymax[j], 0.0, 1.0) * (y1 - y0 - 1)
 

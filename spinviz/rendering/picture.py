@@ -43,6 +43,7 @@ class Picture:
 
     @property
     def frames(self) -> int:
+        """F, the number of frames."""
         return self.plan.frames
 
     @property
@@ -56,8 +57,21 @@ class Picture:
 
 
 def plan_picture(plan: FramePlan, metrics: TextMetrics) -> Picture:
-    """Lay ``plan`` out on its frame.  ``metrics``: the fonts' sizes and text widths (the
-    drawing layer's ``fonts.Fonts``, built for ``layout.TextSizes.for_height(H)``)."""
+    """Lay ``plan`` out on its frame, in one pass down.
+
+    Parameters
+    ----------
+    plan : FramePlan
+        What each frame shows; its spec gives the frame size (W, H) px.
+    metrics : layout.TextMetrics
+        Type sizes and text widths, px: the drawing layer's ``fonts.Fonts`` built for
+        ``layout.TextSizes.for_height(H)``, or any stand-in (tests).
+
+    Returns
+    -------
+    Picture
+        Plain data: every frame's words, layout, camera, poses and marks.
+    """
     texts = texts_of(plan)
     colors = theme(plan.spec.background, plan.body_name)
     stage, camera, layout = plan_stage(plan, make_layout(plan, texts, metrics), colors)

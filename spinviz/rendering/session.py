@@ -74,5 +74,6 @@ class RenderSession:
         return float(xy[0]), float(xy[1])
 
     def close(self):
+        """Release the windows."""
         for view in self.views:
             view.close()

@@ -114,6 +114,7 @@ class RenderSpec:
 
     @property
     def frames(self) -> int:
+        """F = round(duration x fps), at least 2."""
         return max(2, int(round(self.duration * self.fps)))
 
     def knee(self, t_end: float) -> float:

@@ -54,10 +54,24 @@ class Stage:
 
 
 def plan_stage(plan, layout, theme):
-    """The stage of ``plan`` (a ``FramePlan``), the camera fitted to it, and ``layout`` with
-    its 3-D views narrowed to what the content needs (centred in their panels).
+    """The 3-D content of ``plan``, its poses at every frame, and the camera fitted to it.
 
-    theme : ``style.Theme`` (the scene colours).  Returns (Stage, camera.Camera, Layout).
+    Parameters
+    ----------
+    plan : FramePlan
+    layout : layout.Layout
+        The bands; its 3-D views (output px) give the viewport the camera fills.
+    theme : style.Theme
+        The scene colours (cage, axes, trail, background).
+
+    Returns
+    -------
+    stage : Stage
+        Lines, solids, poses (per panel, per frame), labels (output px), lights (world).
+    camera : camera.Camera
+        Fitted once to everything any frame draws, shared by the panels.
+    layout : layout.Layout
+        With its 3-D views narrowed to the width the content needs, centred in their panels.
     """
     spec = plan.spec
     show = set(spec.show)

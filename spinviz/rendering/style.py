@@ -86,7 +86,20 @@ class Theme:
 
 
 def theme(background: str, body_name: str) -> Theme:
-    """The colours for a ``[render].background`` ("white" or "black") and a body's name."""
+    """The colours of one video.
+
+    Parameters
+    ----------
+    background : str
+        ``[render].background``: "white" or "black".
+    body_name : str
+        The body's name (its colour: DAST orange, cellulose straw, else tan).
+
+    Returns
+    -------
+    Theme
+        3-D colours as RGB floats in [0, 1], HUD colours as RGB 0..255.
+    """
     body = body_color(body_name)
     chips = {k: tuple(int(round(255 * c)) for c in v) for k, v in ARROW_COLORS.items()}
     chips["body"] = tuple(int(round(255 * 0.6 * c)) for c in body)

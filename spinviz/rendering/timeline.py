@@ -42,8 +42,26 @@ MAX_TRUE_DEG_PER_FRAME = 30.0
 
 
 def frame_times(spec: RenderSpec, t_end: float, frames: int | None = None):
-    """(video_t, sim_t, dsim_dvideo), each shape (F,): the frame times in video seconds and in
-    the scene's time unit (0 .. t_end, the last exactly t_end), and the time map's slope."""
+    """The frame times.
+
+    Parameters
+    ----------
+    spec : RenderSpec
+        Duration, fps and the time map (linear, or log with its knee).
+    t_end : float
+        The last frame's simulation time, scene time unit.
+    frames : int, optional
+        F; default ``spec.frames``.
+
+    Returns
+    -------
+    video_t : ndarray, shape (F,)
+        Video seconds, 0 .. duration.
+    sim_t : ndarray, shape (F,)
+        Simulation time, scene unit, 0 .. t_end (the last exactly t_end).
+    dsim_dvideo : ndarray, shape (F,)
+        The time map's slope, scene time unit per video second.
+    """
     F = frames or spec.frames
     v = np.linspace(0.0, spec.duration, F)
     s = v / spec.duration
@@ -128,11 +146,24 @@ def time_scale(trajs: list[Trajectory], t_end: float) -> tuple[str, float] | Non
 
 
 def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = None) -> FramePlan:
-    """Frame times and per-panel display data for one or two trajectories of the same body
-    and initial state (one panel per trajectory, side by side).
+    """Frame times and per-panel display data: what each frame shows, independent of its size.
 
-    spec : what the video shows; trajs : one or two trajectories (any stored instants: they
-    are sampled at the frame times); frames : F, default ``spec.frames``.
+    Parameters
+    ----------
+    spec : RenderSpec
+        What the video shows; only the arrays ``spec.show`` needs are computed.
+    trajs : list of one or two Trajectory
+        Runs of the same body and initial state (one panel each, side by side), stored at
+        any instants: they are sampled at the frame times, never stepped.
+    frames : int, optional
+        F; default ``spec.frames``.
+
+    Returns
+    -------
+    FramePlan
+        Frame times (F,); per panel the shown orientation q (F, 4) and R_world_from_body
+        (F, 3, 3), world-frame d, Omega and L (F, 3), |Omega| (F,) and the d-L angle; the
+        spin mode and, in slowed mode, the slowdown (F,).
     """
     if not 1 <= len(trajs) <= 2:
         raise ValueError("a video shows one or two models")

@@ -49,6 +49,7 @@ class RenderResult:
 
     @property
     def fps(self) -> float:
+        """Frames per second, start-up and encoding included."""
         return self.frames / self.seconds if self.seconds > 0 else float("inf")
 
     @property
@@ -72,9 +73,23 @@ def picture_of(plan) -> Picture:
 
 
 def render_frames(plan, frames, supersample: float | None = None):
-    """Frames (list of indices) as RGB arrays (H, W, 3) uint8 at the plan's size, rendered in
-    this process; also returns the session (``session.picture`` holds the layout and camera,
-    ``session.project`` maps world points to pixels).  The caller closes the session."""
+    """Chosen frames of ``plan``, drawn in this process.
+
+    Parameters
+    ----------
+    plan : FramePlan
+    frames : sequence of int
+        Frame indices, 0 .. F - 1.
+    supersample : float, optional
+        Samples per pixel and axis of the 3-D views (default 2).
+
+    Returns
+    -------
+    images : list of ndarray, shape (H, W, 3), uint8
+    session : session.RenderSession
+        Still open (``session.picture`` holds the layout and camera, ``session.project`` maps
+        world points to output pixels); the caller closes it.
+    """
     from .session import RenderSession
 
     session = RenderSession(picture_of(plan), supersample or SUPERSAMPLE)
@@ -90,6 +105,7 @@ class _Progress:
         self.next_mark = 0.25
 
     def update(self, done: int):
+        """``done`` of the frames are drawn: a bar (terminal) or a line at each quarter (log)."""
         if not self.enabled:
             return
         now = time.perf_counter()
@@ -136,13 +152,31 @@ def open_pool(spec, out: str, workers: int | None = None, pool: WorkerPool | Non
 def render_video(plan, out: str, workers: int | None = None, supersample: float | None = None,
                  progress: bool = True, poster: bool = True, max_frames: int | None = None,
                  inputs=(), pool: WorkerPool | None = None) -> RenderResult:
-    """Render ``plan`` to ``out`` (.mp4 or .gif) and a PNG poster beside it; atomically, as a
-    group (``atomic.Outputs``: neither lands unless both are complete).
+    """Render ``plan`` to ``out`` and a PNG poster beside it; atomically, as a group
+    (``atomic.Outputs``: neither lands unless both are complete).
 
-    workers : render processes for MP4 (default: one per core, at most 4); 1 renders in-process.
-    max_frames : stop after this many frames (benchmarks).
-    inputs : files the outputs must not overwrite (the scene).
-    pool : render processes already started (``WorkerPool``); closed by the caller.
+    Parameters
+    ----------
+    plan : FramePlan
+        What each frame shows; laid out here once (``plan_picture``) at ``plan.spec.size``.
+    out : str
+        The .mp4 or .gif path.
+    workers : int, optional
+        Render processes for MP4 (default: one per core, at most 4); 1 renders in-process.
+    supersample : float, optional
+        Samples per pixel and axis of the 3-D views (default 2: four per pixel).
+    progress, poster : bool
+        A progress bar on stderr; the PNG poster at ``spec.poster`` of the video.
+    max_frames : int, optional
+        Stop after this many frames (benchmarks).
+    inputs : sequence of str
+        Files the outputs must not overwrite (the scene).
+    pool : WorkerPool, optional
+        Render processes already started; closed by the caller.
+
+    Returns
+    -------
+    RenderResult
     """
     size = plan.spec.size
     supersample = supersample or SUPERSAMPLE

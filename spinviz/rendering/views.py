@@ -53,6 +53,7 @@ class Window:
 
     @property
     def camera(self):
+        """VTK's camera of the window's renderer."""
         return self.renderer.GetActiveCamera()
 
     def add_mesh(self, mesh, rgb: bool = False, color=None, line_width: float = 1.0):
@@ -89,9 +90,11 @@ class Window:
                              camera.distance + 2.0 * camera.rmax + 1.0)
 
     def render(self):
+        """Draw the window (off-screen)."""
         self.render_window.Render()
 
     def close(self):
+        """Release the window and its actors."""
         self.renderer.RemoveAllViewProps()
         self.render_window.Finalize()
 
@@ -124,6 +127,8 @@ class Solids:
         window.add_mesh(self.mesh, rgb=True)
 
     def place(self, name: str, rot3=None, shift=None, lin=None):
+        """Set a part's rotation (3, 3) -- its normals turn with it --, its linear map (3, 3;
+        default the rotation) and its shift (3,), world frame; None keeps a value."""
         p = self.parts[name]
         if rot3 is not None:
             p["rot"] = rot3
@@ -246,4 +251,5 @@ class PanelView:
         return im
 
     def close(self):
+        """Release the window."""
         self.window.close()

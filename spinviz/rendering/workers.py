@@ -40,6 +40,7 @@ def render_here(picture, path, size, supersample, F, poster_f, bar):
     shot = {}
 
     def each(f, img) -> bool:
+        """Keep the poster, show progress, honour a pending stop."""
         if f == poster_f:
             shot["poster"] = img
         bar.update(f + 1)
@@ -71,6 +72,7 @@ def _worker_signals(parent: int) -> None:
     signal.signal(signal.SIGHUP, signal.SIG_IGN)
 
     def leave(signum, frame):
+        """Unwind through the worker's clean-up."""
         raise SystemExit(128 + signum)
 
     signal.signal(signal.SIGTERM, leave)
@@ -114,6 +116,7 @@ def _render_segment(index, picture, size, supersample, lo, hi, path, poster_f, m
     done = 0
 
     def each(f, img) -> bool:
+        """Report the poster and progress; True when told to stop."""
         nonlocal done
         if f == poster_f:
             msgs.put(("poster", index, img.tobytes()))
@@ -156,6 +159,7 @@ class WorkerPool:
             raise
 
     def close(self):
+        """Stop the workers (each finishes its frame and closes its encoder) and release the queues."""
         if self._closed:
             return
         self._closed = True

@@ -177,7 +177,7 @@ class WorkerPool:
                 p.terminate()
                 p.join(timeout=5)
         for q in (*self.tasks, self.msgs):
-            # a task (the pickled picture, ~100 kB: more than a pipe holds) that a worker never
+            # a task (the pickled picture, ~0.4-0.6 MB at 360-480 frames: more than a pipe holds) that a worker never
             # read -- it failed to start, or was stopped first -- must not block us here
             q.cancel_join_thread()
             q.close()

@@ -34,10 +34,16 @@ class MissingRenderStack(UsageError, ImportError):
 
 
 def require_render_stack():
-    """Import ``spinviz.rendering.video``, or explain in one line which optional package is missing.
+    """The drawing layer's front door, ``spinviz.rendering.video``, imported.
 
     The drawing stack itself (pyvista, VTK) is only looked up here, not imported: with
-    worker processes the parent never draws, and importing VTK would cost it a second."""
+    worker processes the parent never draws, and importing VTK would cost it a second.
+
+    Raises
+    ------
+    MissingRenderStack
+        An optional package of the ``render`` extra is missing; the message says which.
+    """
     import importlib.util
 
     try:
@@ -69,8 +75,21 @@ def _as_source(source: Source):
 
 
 def resolve_spec(source: Source, **overrides) -> tuple[Scene | None, list[Trajectory] | None, RenderSpec]:
-    """The source and its render spec with ``overrides`` (size, fps, duration, show, ...):
-    a scene's ``[render]`` table, or the defaults for trajectories."""
+    """The source and its render spec.
+
+    Parameters
+    ----------
+    source : Scene, path, Trajectory or list of one or two Trajectories
+        A scene (loaded here if a path) or stored trajectories (one panel each).
+    **overrides
+        ``RenderSpec`` fields (size, fps, duration, show, ...) replacing a scene's
+        ``[render]`` table, or the defaults for trajectories; None keeps a field.
+
+    Returns
+    -------
+    (scene or None, trajectories or None, RenderSpec)
+        The spec is validated, including its log knee against the run's horizon.
+    """
     scene, trajs = _as_source(source)
     base = scene.render if scene is not None else RenderSpec()
     spec = base.with_(**overrides)
@@ -79,16 +98,19 @@ def resolve_spec(source: Source, **overrides) -> tuple[Scene | None, list[Trajec
 
 
 def scene_trajectories(scene: Scene, spec: RenderSpec, t_end: float | None = None) -> list[Trajectory]:
-    """One trajectory per model, stored at the frame times (kinematics only if shown)."""
+    """One trajectory per model of ``scene``, stored at the frame times of ``spec`` over
+    [0, t_end] (scene time unit, default the scene's horizon); the orientation is integrated
+    only when something shown needs it (quaternion kinematics, else none)."""
     _, sim_t, _ = frame_times(spec, scene.t_end if t_end is None else t_end)
     kw = scene.simulation_kwargs(kinematics="quaternion" if spec.needs_orientation else "none", t_eval=sim_t)
     return [simulate(scene.body, m, **kw) for m in scene.models]
 
 
-def _check_drawable(trajs: list[Trajectory], spec: RenderSpec) -> None:
+def _check_drawable(trajs: list[Trajectory] | None, spec: RenderSpec) -> None:
     """Frames are interpolated between stored instants: orientations must be stored closely
-    enough for slerp (or carry the slow geometry of a ``secular`` run)."""
-    if not spec.needs_orientation:
+    enough for slerp (or carry the slow geometry of a ``secular`` run).  None (a scene, to be
+    simulated at the frame times) passes."""
+    if trajs is None or not spec.needs_orientation:
         return
     for tr in trajs:
         if tr.q is None:
@@ -103,24 +125,45 @@ def _check_drawable(trajs: list[Trajectory], spec: RenderSpec) -> None:
 
 
 def plan(source: Source, t: float | None = None, frames: int | None = None, **overrides) -> FramePlan:
-    """The frame plan of a video of ``source`` from 0 to ``t`` (default: the whole run)."""
+    """The frame plan of a video of ``source``: what each frame shows, independent of the
+    frame size (a scene is simulated at the frame times; no drawing library is loaded).
+
+    Parameters
+    ----------
+    source : Scene, path, Trajectory or list of one or two Trajectories
+    t : float, optional
+        The video ends at this simulation time (scene time unit); default the whole run.
+    frames : int, optional
+        Number of frames F; default ``duration * fps`` of the spec.
+    **overrides
+        ``RenderSpec`` fields replacing ``[render]`` settings.
+
+    Returns
+    -------
+    FramePlan
+        Frame times (F,), and per panel the shown orientation (F, 4), world-frame vectors
+        (F, 3) and readouts; see ``rendering.frameplan``.
+    """
     scene, trajs, spec = resolve_spec(source, **overrides)
     return _plan(scene, trajs, spec, t, frames)
 
 
 def _plan(scene, trajs, spec: RenderSpec, t=None, frames=None) -> FramePlan:
+    """Trajectories at the frame times -- a scene simulated at them, given trajectories
+    checked and, for a shorter video, sampled at them -- and their frame plan."""
+    t_end = _within(t, scene.t_end if scene is not None else float(trajs[0].t[-1]))
+    _check_drawable(trajs, spec)
     if scene is not None:
-        t_end = scene.t_end if t is None else _within(t, scene.t_end)
         trajs = scene_trajectories(scene, spec, t_end)
-    else:
-        t_end = float(trajs[0].t[-1]) if t is None else _within(t, float(trajs[0].t[-1]))
-        _check_drawable(trajs, spec)
-        if t is not None:
-            trajs = [tr.sample(frame_times(spec, t_end, frames)[1]) for tr in trajs]
+    elif t is not None:
+        trajs = [tr.sample(frame_times(spec, t_end, frames)[1]) for tr in trajs]
     return plan_frames(spec, trajs, frames)
 
 
 def _within(t, t_end: float) -> float:
+    """The end of the video: ``t`` if given (it must lie in (0, t_end]), else ``t_end``."""
+    if t is None:
+        return t_end
     t = float(t)
     if not 0.0 < t <= t_end:
         raise UsageError(f"t must lie in (0, {t_end:g}], got {t:g}")
@@ -135,7 +178,14 @@ class Renderer:
         with spinviz.Renderer("scenes/default.toml", size=(640, 360)) as r:
             img = r.frame(r.frames - 1)        # (360, 640, 3) uint8
 
-    ``source``: a scene (object or path), a Trajectory, or a list of two (one per panel).
+    Parameters
+    ----------
+    source : Scene, path, Trajectory or list of one or two Trajectories
+        One panel per model or trajectory.
+    t : float, optional
+        The video ends at this simulation time (scene time unit); default the whole run.
+    **overrides
+        ``RenderSpec`` fields (size, fps, duration, show, ...).
     """
 
     def __init__(self, source: Source, t: float | None = None, **overrides):
@@ -146,10 +196,11 @@ class Renderer:
 
     @property
     def frames(self) -> int:
+        """F, the number of frames of the plan."""
         return self.plan.frames
 
     def frame(self, f: int) -> np.ndarray:
-        """Frame ``f`` (0 .. frames - 1) as an RGB array (H, W, 3), uint8."""
+        """Frame ``f`` (0 .. frames - 1) as an RGB array, shape (H, W, 3), uint8."""
         if not 0 <= f < self.frames:
             raise UsageError(f"frame must lie in 0..{self.frames - 1}, got {f}")
         if self._session is None:
@@ -158,6 +209,7 @@ class Renderer:
         return self._session.frame(f)
 
     def close(self) -> None:
+        """Release the off-screen windows (the next ``frame`` opens new ones)."""
         if self._session is not None:
             self._session.close()
             self._session = None
@@ -170,49 +222,78 @@ class Renderer:
 
 
 def render_frame(source: Source, t: float | None = None, *, size=(640, 360), **overrides) -> np.ndarray:
-    """The picture at time ``t`` (scene units; default the end), as an RGB array (H, W, 3).
+    """The picture at time ``t`` as an RGB array, shape (H, W, 3), uint8.
 
     It is the last frame of the video of [0, t] (the trail and, for a slowed spin, the shown
     phase depend on what came before).  Shows nicely in Jupyter with
-    ``PIL.Image.fromarray(img)`` or ``matplotlib.pyplot.imshow(img)``."""
+    ``PIL.Image.fromarray(img)`` or ``matplotlib.pyplot.imshow(img)``.
+
+    Parameters
+    ----------
+    source : Scene, path, Trajectory or list of one or two Trajectories
+    t : float, optional
+        Simulation time (scene time unit); default the end of the run.
+    size : (int, int)
+        (width, height) px.
+    **overrides
+        ``RenderSpec`` fields.
+    """
     with Renderer(source, t=t, size=tuple(size), **overrides) as r:
         return r.frame(r.frames - 1)
 
 
 def render(source: Source, out: str | None = None, *, size=None, fps=None, duration=None, workers=None,
            progress: bool = False, pool=None, **overrides):
-    """Render ``source`` to ``out`` (.mp4 or .gif) and a PNG poster beside it; returns a
-    ``RenderResult`` (path, poster, frames, seconds, fps).  ``out`` defaults to
-    ``renders/<scene>.mp4`` for a scene.  Other keywords override ``[render]`` settings.
+    """Render ``source`` to a video and a PNG poster beside it, atomically.
 
-    pool : render processes started earlier (``rendering.video.WorkerPool``), e.g. before the
-        scene was even read; used for an MP4 and closed here in any case."""
+    Parameters
+    ----------
+    source : Scene, path, Trajectory or list of one or two Trajectories
+        A scene (``Scene`` or the path of its TOML) is simulated at the frame times.
+    out : str, optional
+        The .mp4 or .gif path; default ``renders/<scene>.mp4`` for a scene.
+    size : (int, int), optional
+        (width, height) px.
+    fps : int, optional
+    duration : float, optional
+        Video seconds.
+    workers : int, optional
+        Render processes for an MP4 (default one per core, at most 4).
+    progress : bool
+        A progress bar on stderr.
+    pool : rendering.video.WorkerPool, optional
+        Render processes started earlier (e.g. before the scene was even read); used for an
+        MP4 and closed here in any case.
+    **overrides
+        Other ``RenderSpec`` fields (show, time_map, captions, ...).
+
+    Returns
+    -------
+    rendering.video.RenderResult
+        Path, poster, frames, size, seconds, fps.
+    """
+    out = default_output(source) if out is None else out
     scene, trajs, spec = resolve_spec(source, size=size, fps=fps, duration=duration, **overrides)
-    if out is None:
-        if scene is None:
-            raise UsageError("give out=... (a .mp4 or .gif path) to render trajectories")
-        out = default_output(scene)
     spec.check_output(out, len(scene.models) if scene is not None else len(trajs))
     inputs = [scene.path] if scene is not None and os.path.exists(scene.path) else []
     check_outputs([out, poster_for(out)], inputs)        # before any work: nothing to undo later
     video = require_render_stack()
-    n = video.plan_workers(spec, out, workers if pool is None else pool.workers)
-    if pool is not None and n == 1:
-        pool.close()                                     # a GIF or a very short video renders in-process
-        pool = None
-    if pool is None and n > 1:
-        # the render processes start now and import the drawing stack while this one simulates
-        pool = video.WorkerPool(n)
+    # the render processes start now and import the drawing stack while this one simulates
+    pool = video.open_pool(spec, out, workers, pool)
     try:
-        return video.render_video(_plan(scene, trajs, spec), out, workers=workers, progress=progress, inputs=inputs,
-                                  pool=pool)
+        frame_plan = _plan(scene, trajs, spec)
+        return video.render_video(frame_plan, out, workers=workers, progress=progress, inputs=inputs, pool=pool)
     finally:
         if pool is not None:
             pool.close()
 
 
-def default_output(scene: Scene, directory: str = "renders") -> str:
-    stem = os.path.splitext(os.path.basename(scene.path))[0]
+def default_output(scene: Scene | str | os.PathLike, directory: str = "renders") -> str:
+    """Where a scene's video goes by default: ``renders/<scene file's stem>.mp4``.  ``scene``: a
+    ``Scene`` or the path of its file (trajectories have no default: UsageError)."""
+    if not isinstance(scene, (Scene, str, os.PathLike)):
+        raise UsageError("give out=... (a .mp4 or .gif path) to render trajectories")
+    stem = os.path.splitext(os.path.basename(scene.path if isinstance(scene, Scene) else os.fspath(scene)))[0]
     return os.path.join(directory, f"{stem}.mp4")
 
 

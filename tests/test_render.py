@@ -78,7 +78,7 @@ def test_dipole_arrow_tip_follows_the_simulated_orientation():
         for f, img in zip(frames, imgs):
             q = trajs[0].sample(plan.sim_t[f:f + 1]).q[0]
             d_world = R.world_from_body(q, sc.body.dipole_direction)
-            np.testing.assert_allclose(plan.panels[0].dipole[f], d_world, atol=1e-12)
+            np.testing.assert_allclose(plan.panels[0].d_world[f], d_world, atol=1e-12)
             want = np.array(session.project(0, d_world))
             origin = session.project(0, (0.0, 0.0, 0.0))
             got = tip_pixel(dipole_mask(img), origin)
@@ -116,10 +116,10 @@ show = ["dipole", "hud"]
         tips = []
         for k in range(2):
             view = np.zeros(img.shape[:2], dtype=bool)           # the panel's 3-D view: not its red legend chip
-            x0, y0, x1, y1 = session.layout.views[k]
+            x0, y0, x1, y1 = session.picture.layout.views[k]
             view[y0:y1, x0:x1] = True
             mask = dipole_mask(img) & view
-            want = np.array(session.project(k, plan.panels[k].dipole[f]))
+            want = np.array(session.project(k, plan.panels[k].d_world[f]))
             got = tip_pixel(mask, session.project(k, (0.0, 0.0, 0.0)))
             assert np.linalg.norm(got - want) < 2.5, (k, got, want)
             tips.append(got - [k * 240, 0])
@@ -192,11 +192,12 @@ def test_only_listed_actors_are_built():
     plan = pipeline.plan(sc)
     _, session = render_frames(plan, [0])
     try:
-        assert set(session.solids[0].parts) == {"dipole_shaft", "dipole_head"}
-        assert session.curves[0] == {}
-        assert len(session.plotters[0].actors) == 1                   # no sphere, axes, trail, body
-        assert session.plotters[0].renderer.GetActors().GetNumberOfItems() == 1
-        assert plan.panels[0].omega is None and plan.panels[0].L is None   # not computed either
+        view = session.views[0]
+        assert set(view.solids.parts) == {"dipole_shaft", "dipole_head"}
+        assert view.curves == {}
+        assert len(view.window.actors) == 1                           # no sphere, axes, trail, body
+        assert view.window.renderer.GetActors().GetNumberOfItems() == 1
+        assert plan.panels[0].omega_world is None and plan.panels[0].L_world is None   # not computed either
     finally:
         session.close()
 
@@ -286,7 +287,7 @@ SCENES = sorted(p for p in (pathlib.Path(__file__).resolve().parents[1] / "scene
 
 def arrow_rgb(key):
     """The legend chip's colour: the arrow's colour, in 8 bits."""
-    from spinviz.rendering.session import ARROW_COLORS
+    from spinviz.rendering.style import ARROW_COLORS
 
     return tuple(int(round(255 * c)) for c in ARROW_COLORS[key])
 
@@ -325,24 +326,27 @@ def test_every_scene_keeps_its_frame_edges_clear_and_labels_its_arrows(path):
             cols = np.nonzero(box[rows].any(axis=0))[0]
             inside = img[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]
             assert np.all(inside == 255, axis=-1).sum() > 20, (path.name, key)   # ... with white text inside
+        from spinviz.rendering.fonts import Fonts
+        from spinviz.rendering.stage import ARROW_VECTORS, arrow_length
+
+        picture = session.picture
         for k, panel in enumerate(plan.panels):
-            x0, y0, x1, y1 = session.layout.views[k]
+            x0, y0, x1, y1 = picture.layout.views[k]
             for key in ("dipole", "L", "omega"):
-                v = getattr(panel, key)
+                v = getattr(panel, ARROW_VECTORS[key])
                 if v is None:
                     continue
                 n = np.linalg.norm(v, axis=1)
-                from spinviz.rendering.session import arrow_length
-
                 tips = v / np.maximum(n, 1e-300)[:, None] * np.array([arrow_length(key, x) for x in n])[:, None]
-                px = session.camera.to_pixels(tips, session.layout.views[k])
+                px = picture.project(k, tips)
                 assert (px[:, 0] >= x0).all() and (px[:, 0] <= x1).all(), (path.name, key)
                 assert (px[:, 1] >= y0).all() and (px[:, 1] <= y1).all(), (path.name, key)
-        font = session.layout.fonts.small
-        for text, (x, y) in session.labels:                  # axis names and values stay inside a 3-D view
+        font = Fonts(picture.layout.sizes).small
+        views = picture.layout.views
+        for text, (x, y) in picture.stage.labels:            # axis names and values stay inside a 3-D view
             l, t, r, b = font.getbbox(text, anchor="mm")
             assert any(v[0] <= x + l and x + r <= v[2] and v[1] <= y + t and y + b <= v[3]
-                       for v in session.layout.views), (path.name, text, (x, y), session.layout.views)
+                       for v in views), (path.name, text, (x, y), views)
     finally:
         session.close()
 
@@ -356,12 +360,12 @@ def test_text_bands_never_overlap_and_type_scales_with_the_frame(size):
     plan, imgs, session = scene_frames(SCENES[[p.stem for p in SCENES].index("default")], frames=("middle",),
                                        size=size)
     try:
-        lay = session.layout
+        lay = session.picture.layout
         W, H = size
-        bands = [(0, max(y + (lay.fonts.heading_line if w == "main" else lay.fonts.line)
+        bands = [(0, max(y + (lay.sizes.heading_line if w == "main" else lay.sizes.line)
                          for items in lay.headings for _, w, y, _ in items))]
         bands += [(lay.views[0][1], lay.views[0][3])]
-        bands += [(lay.readout_y, lay.readout_y + lay.readout_lines * lay.fonts.line)]
+        bands += [(lay.readout_y, lay.readout_y + lay.readout_lines * lay.sizes.line)]
         bands += [(r.y, r.y + r.height) for r in lay.rows]
         for (a0, a1), (b0, b1) in zip(bands, bands[1:]):
             assert a0 < a1 <= b0 < b1 <= H, bands
@@ -369,11 +373,11 @@ def test_text_bands_never_overlap_and_type_scales_with_the_frame(size):
         assert lay.divider[1] <= lay.rows[0].y
         img = imgs["middle"]
         bar = next(r for r in lay.rows if r.kind == "timebar")
-        text_w = session.hud._bar["x0"]
+        text_w = session.picture.overlay.bar.x0
         band = img[bar.y:bar.y + bar.height, lay.pad:text_w]
         dark = np.nonzero((band.max(axis=-1) < 120).any(axis=1))[0]
         ink = dark[-1] - dark[0] + 1
-        assert ink >= 14 * H / 360, (ink, session.hud.cap.time_text(plan.frames // 2))
+        assert ink >= 14 * H / 360, (ink, plan.hud_lines(0, plan.frames // 2))
     finally:
         session.close()
 
@@ -392,7 +396,7 @@ def test_rod_panels_differ_where_the_axial_spin_shows():
     after = [int(np.searchsorted(plan.sim_t, k * T)) for k in (1.0, 1.5, 2.0, 2.5)]
     imgs, session = render_frames(plan, [0, *after])
     try:
-        views = session.layout.views
+        views = session.picture.layout.views
         diffs = []
         for img in imgs:
             a, b = (img[y0:y1, x0:x1].astype(int) for x0, y0, x1, y1 in views)
@@ -407,16 +411,16 @@ def test_rod_panels_differ_where_the_axial_spin_shows():
 def test_arrow_length_follows_the_spin_rate():
     """DAST cube, truncated panel: |Omega| falls to about a quarter over 6 Theta, and the drawn
     Omega arrow (blue pixels, tip farthest from the centre) gets shorter with it, as
-    session.arrow_length says; the dipole arrow keeps its length."""
+    stage.arrow_length says; the dipole arrow keeps its length."""
     path = SCENES[[p.stem for p in SCENES].index("dast_cube")]
     plan, imgs, session = scene_frames(path, frames=("first", "last"))
     try:
-        from spinviz.rendering.session import arrow_length
+        from spinviz.rendering.stage import arrow_length
 
         k = 1
         ratio = plan.panels[k].omega_mag[-1] / plan.panels[k].omega_mag[0]
         assert ratio < 0.4
-        x0, y0, x1, y1 = session.layout.views[k]
+        x0, y0, x1, y1 = session.picture.layout.views[k]
         origin = np.array(session.project(k, (0.0, 0.0, 0.0)))
         lengths = []
         for name in ("first", "last"):
@@ -473,21 +477,23 @@ def test_captions_key_is_validated():
 
 
 def test_render_workers_import_no_simulation_stack():
-    """A render worker imports the drawing stack and unpickles a plan without loading numba,
+    """A render worker imports the drawing stack and unpickles a picture without loading numba,
     scipy or numpy-quaternion (about 1.5 s), nor pyvista's plotting module and matplotlib
     (about 0.9 s): start-up is VTK, pyvista's meshes, Pillow and imageio-ffmpeg only."""
     import pickle
     import subprocess
     import sys
 
-    plan = pipeline.plan(askew(w=64, h=48))
+    from spinviz.rendering.video import picture_of
+
+    picture = picture_of(pipeline.plan(askew(w=64, h=48)))
     code = ("import pickle, sys\n"
             "from spinviz.rendering import encode, session\n"
-            "plan = pickle.loads(sys.stdin.buffer.read())\n"
-            "session.RenderSession(plan).frame(0)\n"
+            "picture = pickle.loads(sys.stdin.buffer.read())\n"
+            "session.RenderSession(picture).frame(0)\n"
             "print(sorted(m for m in ('numba', 'scipy', 'quaternion', 'matplotlib', 'pyvista.plotting')"
             " if m in sys.modules))")
-    r = subprocess.run([sys.executable, "-c", code], input=pickle.dumps(plan), capture_output=True)
+    r = subprocess.run([sys.executable, "-c", code], input=pickle.dumps(picture), capture_output=True)
     assert r.returncode == 0, r.stderr.decode()
     assert r.stdout.decode().strip() == "[]"
 

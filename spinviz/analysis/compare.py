@@ -152,8 +152,8 @@ DIFF_STYLES = {"misorientation": ("0.6", "-."), "dipoles": ("0.35", "--"), "cone
 
 
 def model_color(model: str) -> str:
-    """The model's colour in the videos (``rendering.captions.MODEL_COLORS``), as matplotlib hex."""
-    from ..rendering.captions import MODEL_COLORS
+    """The model's colour in the videos (``rendering.style.MODEL_COLORS``), as matplotlib hex."""
+    from ..rendering.style import MODEL_COLORS
 
     r, g, b = MODEL_COLORS.get(model, (90, 90, 90))
     return f"#{r:02x}{g:02x}{b:02x}"

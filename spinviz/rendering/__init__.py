@@ -1,11 +1,25 @@
-"""Off-screen rendering: from trajectories to frames to video.  Depends only on trajectories
-(never on the integrators or the scene layer).
+"""Off-screen rendering: from trajectories to frames to video, in two layers.  Depends only
+on trajectories (never on the integrators or the scene layer).
 
-* ``spec`` -- ``RenderSpec``, the validated description of a video (pure Python);
-* ``timeline`` -- frame times and what each panel shows at each frame (pure NumPy);
-* ``session`` -- the pyvista windows that draw a frame; ``hud`` -- text on the frame;
-* ``encode`` -- MP4/GIF/PNG writers; ``video`` -- the parallel render-and-encode pipeline.
+Planning -- what each frame shows and where; plain data and NumPy, tested without GL
+(no drawing library is imported; ``pyproject.toml`` has the contract):
+
+* ``spec`` -- ``RenderSpec``, the validated description of a video, and the time map;
+* ``timeline`` -- frame times, spin mode and each panel's arrays, sampled from trajectories
+  (``FramePlan``, ``Panel``: plain data in ``frameplan``);
+* ``picture`` -- ``plan_picture`` lays a frame plan out on its frame, in one pass down:
+  ``captions`` (every word, per frame too), ``style`` (colours and sizes), ``layout``
+  (bands and type sizes), ``stage`` (3-D content, poses at every frame, the ``camera``
+  fitted to all of them, axis labels), ``overlay`` (text items and marks, per frame too).
+
+Drawing -- a ``Picture`` into pixels; decides nothing:
+
+* ``video`` -- the front door: plans the picture, hands the frames to ``workers`` (this
+  process, or a pool of render processes that each encode a segment), writes atomically;
+* ``session`` -- one frame: ``views`` (VTK windows; ``meshes`` builds the solids) and
+  ``hud`` (Pillow; ``fonts`` measures text for the layout and draws it); ``encode`` --
+  MP4/GIF/PNG writers.
 
 Importing this package loads nothing heavy: pyvista, vtk, imageio and Pillow are imported
-by ``session``, ``hud``, ``encode`` and ``video`` only.
+by the drawing modules only.
 """

@@ -1,17 +1,19 @@
 """The words and numbers on screen, in two registers: ``"outreach"`` (plain words, numbers
 for people) and ``"physics"`` (symbols, equation numbers, scientific notation).
 
-Pure Python: the HUD (``hud``) decides where text goes, this module what it says.
+``texts_of(plan)`` says everything once, as plain data (``Texts``: the headings, the legend,
+the time bar's ticks, and per frame the panels' numbers, the time and the notes); ``layout``
+and ``overlay`` decide where it goes.  Pure Python and NumPy.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+
+import numpy as np
 
 from .. import units as U
-
-# one colour per model everywhere: headings and inset of the videos, ``spinviz compare``'s plots
-MODEL_COLORS = {"reduced": (0, 128, 128), "truncated": (136, 60, 180), "free": (120, 120, 120)}
 
 # (heading, equation numbers) per model and register
 HEADINGS = {
@@ -35,6 +37,7 @@ _WORDS = ((1e12, "trillion"), (1e9, "billion"), (1e6, "million"), (1e3, "thousan
 
 
 def superscript(n: int) -> str:
+    """An integer in superscript digits: 15 -> "¹⁵"."""
     return str(int(n)).translate(_SUP)
 
 
@@ -96,6 +99,54 @@ def sim_time(t: float, units: str, register: str) -> str:
     return U.human_time(t)
 
 
+@dataclass
+class Texts:
+    """Every text of a video, F frames and n panels.
+
+    headings : per panel (heading, equation numbers); subtitles : per panel, one line (the
+    layout wraps it); legend : (key, symbol, name) per drawn arrow, and the body's entry when
+    the drawn body is a stand-in; footer : the title line; scale : what the time bar's unit is
+    ("" without one); bar_ticks : (position 0..1, label) of its marks; readouts : [panel][frame]
+    -> lines; time : per frame; notes : per frame -> lines (how time and spin are shown).
+    """
+
+    headings: list
+    subtitles: list
+    legend: list
+    footer: str
+    scale: str
+    bar_ticks: list
+    readouts: list
+    time: list
+    notes: list
+
+
+def texts_of(plan) -> Texts:
+    """All the words of ``plan``, in the register of its ``[render].captions``.
+
+    Parameters
+    ----------
+    plan : FramePlan
+        Frame times (scene unit), |Omega| per panel (rad/s or 1/tau0), angles (deg).
+
+    Returns
+    -------
+    Texts
+        Headings, subtitles, legend, footer, the time bar's scale and ticks, and per frame
+        (F of each) the panels' numbers, the time and the notes.
+    """
+    cap = Captions(plan)
+    n, F = len(plan.panels), plan.frames
+    show = plan.spec.show
+    legend = cap.legend(show)
+    if "body" in show and plan.shape is not None and "inertia" in plan.shape.label:
+        legend.append(("body", "box", "with the top's inertia"))      # the drawn body is not the crystal's shape
+    return Texts(headings=[cap.heading(k) for k in range(n)], subtitles=[cap.subtitle(k) for k in range(n)],
+                 legend=legend, footer=cap.footer(), scale=cap.scale_text(), bar_ticks=cap.bar_ticks(),
+                 readouts=[[cap.readouts(k, f) for f in range(F)] for k in range(n)],
+                 time=[cap.time_text(f) for f in range(F)], notes=[cap.notes(f) for f in range(F)])
+
+
 class Captions:
     """The texts of a plan's frames in the register of its ``[render].captions``."""
 
@@ -112,6 +163,7 @@ class Captions:
         return HEADINGS[self.register].get(model, (model, ""))
 
     def subtitle(self, k: int) -> str:
+        """Panel k's plain-words line: the scene's ``[render].subtitles``, or what its model predicts."""
         subs = self.spec.subtitles
         if k < len(subs):
             return subs[k]
@@ -141,6 +193,7 @@ class Captions:
 
     # -- shared ----------------------------------------------------------------------------
     def time_text(self, f: int) -> str:
+        """The simulation time of frame f: "after 9.5 days" (outreach), "t = 8.2e5 s = 3.01 Θ" (physics)."""
         t = float(self.plan.sim_t[f])
         if self.register == "outreach":
             return ("after " if t > 0 else "start, ") + sim_time(t, self.plan.units, "outreach")
@@ -184,11 +237,57 @@ class Captions:
         return out
 
     def footer(self) -> str:
+        """The title line: the scene's title, or the body's name."""
         return self.spec.title or self.plan.body_name
 
     def legend(self, show) -> list[tuple[str, str, str]]:
         """(key, symbol, name) of each drawn arrow."""
         return [(key, *ARROW_NAMES[key]) for key in ("dipole", "L", "omega") if key in show]
+
+    def bar_ticks(self) -> list[tuple[float, str]]:
+        """(position 0..1 along the time bar, label) of its marks: multiples of Theta or T
+        (linear map) or their decades (log map); in people's units (CGS) or tau0 without a scale."""
+        plan, spec, t_end = self.plan, self.spec, self.plan.t_end
+        if plan.time_scale is not None:
+            sym, unit = plan.time_scale
+            suffix = f" {sym}"
+        elif self.cgs:
+            unit, sym = _people_unit(t_end)
+            suffix = f" {sym}"
+        else:
+            unit, suffix = 1.0, " τ₀"
+        end = t_end / unit
+        if spec.time_map == "linear":
+            step = nice_step(end, 6)
+            vals = np.arange(step, end * (1 + 1e-9), step)
+        else:
+            k = spec.knee(t_end) / unit
+            lo = math.floor(math.log10(k))
+            vals = np.array([10.0 ** e for e in range(lo, math.ceil(math.log10(end)) + 1) if 10.0 ** e <= end * (1 + 1e-9)])
+            vals = vals[vals >= k * 0.5]
+        return [(float(spec.video_fraction(v * unit, t_end)), _fmt_tick(float(v)) + suffix) for v in vals]
+
+
+def nice_step(span: float, most: int) -> float:
+    """The smallest of 1, 2, 5 x 10^k that cuts ``span`` into at most ``most`` steps (ticks)."""
+    raw = span / max(1, most)
+    e = 10.0 ** math.floor(math.log10(raw))
+    for m in (1.0, 2.0, 5.0, 10.0):
+        if m * e >= raw:
+            return m * e
+    return 10.0 * e
+
+
+def _fmt_tick(x: float) -> str:
+    return f"{x:g}" if abs(x) >= 1e-3 or x == 0 else f"{x:.0e}"
+
+
+def _people_unit(t_end: float) -> tuple[float, str]:
+    """The largest of yr, d, h, min that t_end (s) holds twice, else s."""
+    for unit, name in ((U.YEAR, "yr"), (U.DAY, "d"), (U.HOUR, "h"), (U.MINUTE, "min")):
+        if t_end >= 2 * unit:
+            return unit, name
+    return 1.0, "s"
 
 
 def _deg(x: float) -> str:

@@ -33,9 +33,11 @@ class Mp4Writer:
         self._gen.send(None)
 
     def write(self, img: np.ndarray):
+        """Encode one frame: RGB, shape (H, W, 3), uint8."""
         self._gen.send(np.ascontiguousarray(img))
 
     def close(self):
+        """Finish the file (ffmpeg exits)."""
         self._gen.close()
 
     abort = close                          # stop ffmpeg; the caller discards the temporary file
@@ -53,6 +55,7 @@ class GifWriter:
         self.path, self.fps, self.frames, self.colors = path, fps, [], colors
 
     def write(self, img: np.ndarray):
+        """Keep one frame: RGB, shape (H, W, 3), uint8."""
         self.frames.append(Image.fromarray(np.ascontiguousarray(img)))
 
     def abort(self):
@@ -60,6 +63,7 @@ class GifWriter:
         self.frames = []
 
     def close(self):
+        """Quantize all frames to one palette and write the GIF."""
         if self.frames:
             picks = [self.frames[0], self.frames[len(self.frames) // 2], self.frames[-1]]
             w, h = picks[0].size
@@ -73,6 +77,7 @@ class GifWriter:
 
 
 def open_writer(path: str, size, fps: int):
+    """An ``Mp4Writer`` or ``GifWriter`` by the extension of ``path``; size (width, height) px."""
     ext = os.path.splitext(path)[1].lower()
     if ext == ".mp4":
         return Mp4Writer(path, size, fps)

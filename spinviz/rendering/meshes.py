@@ -1,10 +1,11 @@
 """The moving solids as plain arrays: points, triangles, normals and per-vertex colours.
 
 Built in NumPy rather than from pyvista sources so that each part carries exactly what the
-CPU lighting of ``session.Solids`` needs: flat normals per face, a colour per vertex, and a
+CPU lighting of ``views.Solids`` needs: flat normals per face, a colour per vertex, and a
 flag for vertices that are not lit (outlines keep their dark tone whatever the light).
-Shapes are in their own frame; arrows point along +x with unit shaft length (the session
+Shapes are in their own frame; arrows point along +x with unit shaft length (the view
 stretches the shaft and moves the head, so arrow length can follow |Omega| and |L|).
+Lengths in units of the dipole arrow; colours RGB floats in [0, 1].
 """
 
 from __future__ import annotations
@@ -14,13 +15,55 @@ from dataclasses import dataclass
 
 import numpy as np
 
-BODY_RADIUS = 0.62       # the body's bounding radius, in units of the dipole arrow (tip on the unit sphere)
+from .style import ARROW_COLORS, ARROWS, BODY_RADIUS, HODO_MARKER_COLOR, ROD_SECOND_COLOR
+
 OUTLINE = 0.045          # width of a box's dark edge band, as a fraction of its shortest edge (min 0.02 radius)
 
 
 @dataclass
+class Assembly:
+    """The solids of a panel joined into one part: ``part`` and, per solid part name ("body",
+    "dipole_shaft", "dipole_head", ..., "hodo_marker"), its vertices' ``slices`` in it."""
+
+    part: Part
+    slices: dict
+
+
+def assemble(picture) -> Assembly:
+    """The solids ``picture.stage`` lists, built and joined in its order.
+
+    Parameters
+    ----------
+    picture : picture.Picture
+        Its stage names the solids ("body", arrow keys, "hodo_marker"); its plan gives the
+        body's shape, its theme the body's colour.
+
+    Returns
+    -------
+    Assembly
+        One ``Part`` (the body in its body frame, each arrow as a shaft and a head along +x,
+        the marker at the origin; dipole-arrow units) and each part's vertex slice in it.
+    """
+    stage, plan = picture.stage, picture.plan
+    named = []
+    for name in stage.solids:
+        if name == "body":
+            named.append(("body", body_part(plan.shape, picture.theme.body, stage.body_from_shape)))
+        elif name == "hodo_marker":
+            named.append(("hodo_marker", ball(stage.marker_radius, np.asarray(HODO_MARKER_COLOR))))
+        else:
+            shaft, head_len, head_r, _ = ARROWS[name]
+            color = np.asarray(ARROW_COLORS[name])
+            named += [(name + "_shaft", arrow_shaft(shaft, color)), (name + "_head", arrow_head(head_len, head_r, color))]
+    offsets = np.cumsum([0] + [p.points.shape[0] for _, p in named])
+    slices = {name: slice(int(lo), int(hi)) for (name, _), lo, hi in zip(named, offsets[:-1], offsets[1:])}
+    return Assembly(Part.join([p for _, p in named]) if named else None, slices)
+
+
+@dataclass
 class Part:
-    """points, normals (n, 3); triangles (m, 3) int; color (n, 3) in [0, 1]; lit (n,) bool."""
+    """A mesh in its own frame: points, normals (n, 3); triangles (m, 3) int; color (n, 3) in
+    [0, 1]; lit (n,) bool (False: an outline vertex, drawn in its colour whatever the light)."""
 
     points: np.ndarray
     normals: np.ndarray
@@ -30,6 +73,7 @@ class Part:
 
     @staticmethod
     def join(parts: list[Part]) -> Part:
+        """One part of all ``parts``, in order (their triangles re-indexed)."""
         offs = np.cumsum([0] + [p.points.shape[0] for p in parts])
         return Part(np.vstack([p.points for p in parts]), np.vstack([p.normals for p in parts]),
                     np.vstack([p.triangles + o for p, o in zip(parts, offs[:-1])]),
@@ -67,6 +111,7 @@ def box(half, color, edge_color) -> Part:
             iu, iv = eu * (1 - w / half[u]), ev * (1 - w / half[v])
 
             def q(a, b, c, d, c0=c0):
+                """Four corners of a quad on this face (c0 its centre)."""
                 return np.array([c0 + a, c0 + b, c0 + c, c0 + d])
 
             parts.append(_quads(q(-iu - iv, iu - iv, iu + iv, -iu + iv), n, color))
@@ -113,7 +158,7 @@ def two_tone_rod(radius, half_length, color, second_color, res=24) -> Part:
 
 
 def arrow_shaft(radius, color, res=12) -> Part:
-    """A cylinder along +x from 0 to 1 (the session stretches it), without caps."""
+    """A cylinder along +x from 0 to 1 (the view stretches it), without caps."""
     p = cylinder_z(radius, 0.5, res, color, caps=False)
     rot = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])   # z -> x, x -> y, y -> z
     return Part((p.points + [0.0, 0.0, 0.5]) @ rot.T, p.normals @ rot.T, p.triangles, p.color, p.lit)
@@ -149,3 +194,29 @@ def ball(radius, color, res=12) -> Part:
             i0, i1 = a * cols + b, (a + 1) * cols + b
             tris += [(i0, i1, i1 + 1), (i0, i1 + 1, i0 + 1)]
     return Part(radius * n, n, np.array(tris), np.tile(color, (n.shape[0], 1)), np.ones(n.shape[0], bool))
+
+
+def body_part(shape, color, m) -> Part:
+    """The body in its body frame, true proportions, bounding radius BODY_RADIUS: a two-tone
+    rod or a box with dark edges (a small sphere when the shape is unknown).
+
+    shape : ``frameplan.ShapeInfo`` or None; color : RGB floats; m : (3, 3) the rotation from
+    the shape's own axes to the body frame.
+    """
+    color = np.asarray(color)
+    if shape is None:
+        return ball(0.3, color)
+    if shape.kind == "rod":
+        length, diameter = shape.dims
+        k = BODY_RADIUS / math.hypot(0.5 * length, 0.5 * diameter)
+        # a thin rod is drawn at least a sixth of its length thick, so that its painted halves
+        # -- and with them its spin about its own axis -- can be seen (the true L/D is in the title)
+        r = max(0.5 * diameter * k, 0.085 * length * k)
+        part = two_tone_rod(r, 0.5 * length * k, color, np.asarray(ROD_SECOND_COLOR))
+    else:
+        # a needle-thin box (a slender inertia-equivalent body) is drawn at least 1/8 as thick
+        # as it is long, so that it can be seen turning
+        a, b, c = np.maximum(np.asarray(shape.dims, dtype=float), 0.125 * max(shape.dims))
+        k = BODY_RADIUS / (0.5 * math.sqrt(a * a + b * b + c * c))
+        part = box(0.5 * k * np.array([a, b, c]), color, 0.35 * color)
+    return Part(part.points @ m.T, part.normals @ m.T, part.triangles, part.color, part.lit)

@@ -24,7 +24,7 @@ VIDEO_FORMATS = (".mp4", ".gif")
 MIN_SIZE, MAX_SIZE = 16, 7680
 MAX_FPS = 240
 MAX_DURATION_S = 3600.0
-MAX_FRAMES = 100_000            # ~55 min at 30 fps; the frame plan holds ~300 bytes per frame and panel
+MAX_FRAMES = 100_000            # ~55 min at 30 fps; the frame plan holds ~300 bytes per frame and panel (its picture ~1 kB)
 MAX_GIF_BYTES = 1_000_000_000   # a GIF's frames are kept in memory (RGB, 3 bytes per pixel) until it is written
 ZOOM_RANGE = (0.05, 20.0)       # outside it the body is a dot or fills the frame far beyond its edges
 MAX_KNEE_RATIO = 1e15           # t_end / log_knee: float64 must still tell neighbouring frame times apart
@@ -114,11 +114,20 @@ class RenderSpec:
 
     @property
     def frames(self) -> int:
+        """F = round(duration x fps), at least 2."""
         return max(2, int(round(self.duration * self.fps)))
 
     def knee(self, t_end: float) -> float:
         """The knee of the log time map: ``log_knee``, or t_end / 1000 by default."""
         return self.log_knee or t_end / 1000.0
+
+    def video_fraction(self, t: float, t_end: float) -> float:
+        """The fraction of the video (0..1) at which simulation time ``t`` is shown: the
+        inverse of the time map (t and t_end in the scene's time unit)."""
+        if self.time_map == "linear":
+            return t / t_end
+        k = self.knee(t_end)
+        return math.log1p(t / k) / math.log1p(t_end / k)
 
     # -- checks that need more than the spec ----------------------------------------------
     def check_horizon(self, t_end: float) -> None:

@@ -28,6 +28,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .. import rotations as R
+from ..physics.free_top import pose_about_L
 from .frameplan import FramePlan, Panel, ShapeInfo
 from .spec import RenderSpec
 
@@ -40,7 +42,26 @@ MAX_TRUE_DEG_PER_FRAME = 30.0
 
 
 def frame_times(spec: RenderSpec, t_end: float, frames: int | None = None):
-    """(video_t, sim_t, dsim_dvideo), each shape (F,): frame times and the map's slope."""
+    """The frame times.
+
+    Parameters
+    ----------
+    spec : RenderSpec
+        Duration, fps and the time map (linear, or log with its knee).
+    t_end : float
+        The last frame's simulation time, scene time unit.
+    frames : int, optional
+        F; default ``spec.frames``.
+
+    Returns
+    -------
+    video_t : ndarray, shape (F,)
+        Video seconds, 0 .. duration.
+    sim_t : ndarray, shape (F,)
+        Simulation time, scene unit, 0 .. t_end (the last exactly t_end).
+    dsim_dvideo : ndarray, shape (F,)
+        The time map's slope, scene time unit per video second.
+    """
     F = frames or spec.frames
     v = np.linspace(0.0, spec.duration, F)
     s = v / spec.duration
@@ -125,11 +146,25 @@ def time_scale(trajs: list[Trajectory], t_end: float) -> tuple[str, float] | Non
 
 
 def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = None) -> FramePlan:
-    """Frame times and per-panel display data for one or two trajectories of the same body
-    and initial state (one panel per trajectory)."""
-    from .. import rotations as R
-    from ..physics.free_top import pose_about_L
+    """Frame times and per-panel display data: what each frame shows, independent of its size.
 
+    Parameters
+    ----------
+    spec : RenderSpec
+        What the video shows; only the arrays ``spec.show`` needs are computed.
+    trajs : list of one or two Trajectory
+        Runs of the same body and initial state (one panel each, side by side), stored at
+        any instants: they are sampled at the frame times, never stepped.
+    frames : int, optional
+        F; default ``spec.frames``.
+
+    Returns
+    -------
+    FramePlan
+        Frame times (F,); per panel the shown orientation q (F, 4) and R_world_from_body
+        (F, 3, 3), world-frame d, Omega and L (F, 3), |Omega| (F,) and the d-L angle; the
+        spin mode and, in slowed mode, the slowdown (F,).
+    """
     if not 1 <= len(trajs) <= 2:
         raise ValueError("a video shows one or two models")
     body = trajs[0].body
@@ -138,55 +173,68 @@ def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = 
     samples = [tr.sample(sim_t) for tr in trajs]   # once: choose_spin_mode's own sampling then returns these
     mode, why = choose_spin_mode(spec, samples, sim_t)
     resolved = all(tr.phase_resolved for tr in trajs)
-    ref = samples[0]
-    w_ref = float(np.linalg.norm(ref.omega[0])) or 1.0
-    J = np.asarray(body.inertia, dtype=float)
-    L_ref = float(np.linalg.norm(J * ref.omega[0])) or 1.0
-    show = set(spec.show)
-    slowdown = None
-    panels = []
-    if mode == "slowed":
-        geo = [_slow_geometry(s, body) for s in samples]
-        rate_ref = geo[0]["phidot"][0] or 1.0
-        two_pi_r0 = 2.0 * math.pi * spec.spin_turns_per_second
-        # true rad per video second / shown rad per video second (the same for every panel)
-        slowdown = rate_ref * slope / two_pi_r0
-    for k, s in enumerate(samples):
-        panel = Panel(model=s.model, omega_mag=s.omega_magnitude)
-        if spec.needs_orientation:
-            if mode == "slowed":
-                g = geo[k]
-                scale = two_pi_r0 / rate_ref
-                phi = g["phi0"] + _cumtrapz(scale * g["phidot"], video_t)
-                psi = g["psi0"] + _cumtrapz(scale * g["psidot"], video_t)
-                omega_body, q = pose_about_L(g["q_L"], phi, g["theta_L"], psi, g["wp"], g["w3"], g["q_frame"])
-            else:
-                q = s.q
-                omega_body = s.omega
-            panel.q = q
-            if "dipole" in show or "trail" in show:
-                panel.dipole = R.world_from_body(q, body.dipole_direction)
-            if "omega" in show:
-                panel.omega = R.world_from_body(q, omega_body) / w_ref
-            if "L" in show:
-                panel.L = R.world_from_body(q, J * omega_body) / L_ref
-        if "hud" in show or "inset" in show:
-            # body-frame quantities from the simulated Omega (no orientation needed): the true
-            # angle where the shown phase is the true one, its swing over a turn otherwise
-            if mode == "true" and resolved:
-                panel.angle_dL_deg = np.degrees(s.angle_d_L())
-            else:
-                lo, hi = s.angle_d_L_range()
-                panel.angle_dL_range_deg = np.degrees(np.stack([lo, hi], axis=-1))
-        if "hodograph" in show:
-            panel.omega_body = s.omega / w_ref
-        panels.append(panel)
+    unit = time_scale(trajs, t_end)
+    shown, slowdown = _shown_motion(spec, samples, body, mode, video_t, slope)
+    ref = samples[0].omega[0]
+    scale = (float(np.linalg.norm(ref)) or 1.0,
+             float(np.linalg.norm(np.asarray(body.inertia, dtype=float) * ref)) or 1.0)
+    panels = [_panel(spec, s, motion, body, scale, exact_angle=mode == "true" and resolved)
+              for s, motion in zip(samples, shown)]
     return FramePlan(
         spec=spec, video_t=video_t, sim_t=sim_t, panels=panels, units=body.units, body_name=body.name,
-        shape=ShapeInfo.of(body.shape), dipole_body=np.asarray(body.dipole_direction, dtype=float), spin_mode=mode,
-        slowdown=slowdown, notes=[f"spin: {mode} ({why})"],
-        time_scale=time_scale(trajs, t_end), phase_resolved=resolved,
+        shape=ShapeInfo.of(body.shape), d_body=np.asarray(body.dipole_direction, dtype=float), spin_mode=mode,
+        slowdown=slowdown, notes=[f"spin: {mode} ({why})"], time_scale=unit, phase_resolved=resolved,
     )
+
+
+def _shown_motion(spec: RenderSpec, samples, body, mode: str, video_t, slope):
+    """Per panel (q (F, 4), Omega_body (F, 3)) as shown, and the slowdown (F,) or None.
+
+    As simulated, except in slowed mode: there the slow geometry is kept and the precession
+    and spin phases advance at ``spin_turns_per_second`` x (their true rate) / (|L|/I1 at
+    t = 0 of the first panel) turns per video second."""
+    if mode != "slowed":
+        return [(s.q, s.omega) for s in samples], None
+    geo = [_slow_geometry(s, body) for s in samples]
+    rate_ref = geo[0]["phidot"][0] or 1.0
+    two_pi_r0 = 2.0 * math.pi * spec.spin_turns_per_second
+    shown = []
+    for g in geo:
+        scale = two_pi_r0 / rate_ref
+        phi = g["phi0"] + _cumtrapz(scale * g["phidot"], video_t)
+        psi = g["psi0"] + _cumtrapz(scale * g["psidot"], video_t)
+        omega_body, q = pose_about_L(g["q_L"], phi, g["theta_L"], psi, g["wp"], g["w3"], g["q_frame"])
+        shown.append((q, omega_body))
+    # true rad per video second / shown rad per video second (the same for every panel)
+    return shown, rate_ref * slope / two_pi_r0
+
+
+def _panel(spec: RenderSpec, s: Trajectory, motion, body, scale, exact_angle: bool) -> Panel:
+    """One panel's arrays from its sampled trajectory ``s`` and shown motion (q, Omega_body):
+    only what ``spec.show`` needs.  scale : (|Omega(0)|, |L(0)|) of the reference panel."""
+    show = set(spec.show)
+    w_ref, L_ref = scale
+    panel = Panel(model=s.model, omega_mag=s.omega_magnitude)
+    if spec.needs_orientation:
+        q, omega_body = motion
+        panel.q, panel.R_world_from_body = q, R.matrix_from_quat(q)
+        if "dipole" in show or "trail" in show:
+            panel.d_world = R.world_from_body(q, body.dipole_direction)
+        if "omega" in show:
+            panel.omega_world = R.world_from_body(q, omega_body) / w_ref
+        if "L" in show:
+            panel.L_world = R.world_from_body(q, np.asarray(body.inertia, dtype=float) * omega_body) / L_ref
+    if "hud" in show or "inset" in show:
+        # body-frame quantities from the simulated Omega (no orientation needed): the true
+        # angle where the shown phase is the true one, its swing over a turn otherwise
+        if exact_angle:
+            panel.angle_dL_deg = np.degrees(s.angle_d_L())
+        else:
+            lo, hi = s.angle_d_L_range()
+            panel.angle_dL_range_deg = np.degrees(np.stack([lo, hi], axis=-1))
+    if "hodograph" in show:
+        panel.omega_body = s.omega / w_ref
+    return panel
 
 
 def _cumtrapz(y, x):
@@ -201,8 +249,6 @@ def _slow_geometry(s: Trajectory, body) -> dict:
     From the ``secular`` slow geometry when present (its phases may be unresolved: only the
     starting phases are used), otherwise from q and Omega.
     """
-    from .. import rotations as R
-
     J3 = body.I3 / body.I1
     delta = 1.0 - J3
     w = s.omega

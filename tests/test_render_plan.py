@@ -1,0 +1,307 @@
+"""The render plan, checked without OpenGL: frame times, the camera fitted over the whole video,
+the layout of text (disjoint, inside the frame, legible at 360 rows), the words, the colours
+and the poses.  A hand-made frame plan gives exact expected values; the shipped scenes give
+real content.  Pillow measures text (the fonts are the drawing layer's); nothing here opens a
+GL window."""
+
+import math
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from spinviz import pipeline
+from spinviz import units as U
+from spinviz.rendering.camera import Camera
+from spinviz.rendering.captions import texts_of
+from spinviz.rendering.fonts import Fonts
+from spinviz.rendering.frameplan import FramePlan, Panel, ShapeInfo
+from spinviz.rendering.layout import TextSizes
+from spinviz.rendering.overlay import Fill, Text
+from spinviz.rendering.picture import plan_picture
+from spinviz.rendering.spec import RenderSpec
+from spinviz.rendering.stage import ARROW_VECTORS, EDGE_PX, arrow_length, content_points
+from spinviz.rendering.style import theme
+from spinviz.rendering.timeline import frame_times
+from spinviz.rotations import matrix_from_quat
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+SCENES = sorted(p for p in (ROOT / "scenes").glob("*.toml") if not p.name.startswith("atlas_"))
+ALL_SHOWN = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud")
+
+
+def made_plan(size=(640, 360), show=ALL_SHOWN, captions="outreach", background="white", time_map="linear",
+              fps=10, duration=2.0) -> FramePlan:
+    """Two panels over 10 days: the body (a stand-in box) turns once about z, |Omega| =
+    2 pi 5e9 rad/s in the first panel and falls linearly to half in the second; d-L at
+    30 deg; spin slowed 1.3e15 x; the time bar's unit is Theta = 3.2 days."""
+    spec = RenderSpec(duration=duration, fps=fps, size=size, show=show, captions=captions, background=background,
+                      time_map=time_map, title="a test crystal")
+    video_t, sim_t, _ = frame_times(spec, 10 * U.DAY)
+    F = sim_t.size
+    a = np.linspace(0.0, 2 * np.pi, F)
+    q = np.stack([np.cos(a / 2), 0 * a, 0 * a, np.sin(a / 2)], axis=-1)
+    R = matrix_from_quat(q)
+    d_body = np.array([1.0, 0.0, 1.0]) / math.sqrt(2)
+    panels = []
+    for k, model in enumerate(("reduced", "truncated")):
+        ratio = 1.0 - 0.5 * k * sim_t / sim_t[-1]
+        panels.append(Panel(model=model, omega_mag=2 * np.pi * 5e9 * ratio, q=q, R_world_from_body=R,
+                            d_world=R @ d_body, omega_world=np.c_[0 * a, 0 * a, ratio],
+                            L_world=np.c_[0.3 * ratio, 0 * a, ratio], angle_dL_deg=np.full(F, 30.0)))
+    shape = ShapeInfo(kind="box", dims=(1.0, 1.0, 1.0), label="box with the top's inertia")
+    return FramePlan(spec=spec, video_t=video_t, sim_t=sim_t, panels=panels, units="cgs", body_name="DAST cube",
+                     shape=shape, d_body=d_body, spin_mode="slowed", slowdown=np.full(F, 1.3e15),
+                     time_scale=("Θ", 3.2 * U.DAY), phase_resolved=False)
+
+
+def picture_of(plan):
+    return plan_picture(plan, Fonts.for_height(plan.spec.size[1]))
+
+
+@pytest.fixture(scope="module")
+def scene_pictures():
+    """Every shipped scene planned at 640x360 (simulated once; no GL)."""
+    return {p.stem: picture_of(pipeline.plan(p, size=(640, 360))) for p in SCENES}
+
+
+# --- frame times -----------------------------------------------------------------------------
+def test_frame_times_follow_the_time_map_and_its_inverse():
+    """Linear: t = t_end v / duration; log: t = k ((1 + t_end/k)^(v/duration) - 1) with the knee
+    k = t_end / 1000; the last frame is exactly t_end, and spec.video_fraction inverts the map."""
+    t_end = 7.3e5
+    lin = RenderSpec(duration=3.0, fps=20)
+    v, t, slope = frame_times(lin, t_end)
+    assert v.size == 60 and t[-1] == t_end
+    np.testing.assert_allclose(t, t_end * v / 3.0, rtol=1e-15)
+    np.testing.assert_allclose(slope, t_end / 3.0)
+    log = RenderSpec(duration=3.0, fps=20, time_map="log")
+    v, t, slope = frame_times(log, t_end)
+    k = t_end / 1000
+    assert t[0] == 0.0 and t[-1] == t_end and np.all(np.diff(t) > 0)
+    np.testing.assert_allclose(t[:-1], k * ((1 + t_end / k) ** (v[:-1] / 3.0) - 1), rtol=1e-12)
+    np.testing.assert_allclose(slope[1:-1], np.gradient(t, v)[1:-1], rtol=0.02)
+    frac = np.array([log.video_fraction(x, t_end) for x in t])
+    np.testing.assert_allclose(frac, v / 3.0, atol=1e-12)
+    assert lin.video_fraction(t_end / 4, t_end) == 0.25
+
+
+# --- the camera ------------------------------------------------------------------------------
+@pytest.mark.parametrize("stem", [p.stem for p in SCENES])
+def test_the_camera_keeps_every_frame_in_view_and_fills_it(scene_pictures, stem):
+    """Every frame's drawn content -- arrow tips from the planned poses, the body's bounding
+    sphere, the cage and the axes -- projects inside the 3-D view with EDGE_PX free at each
+    side; and the fit is tight: the content stays within the margin it was fitted to, and
+    along the limiting axis reaches it within a pixel (a camera merely far away would not)."""
+    pic = scene_pictures[stem]
+    cam, lay = pic.camera, pic.layout
+    for k, poses in enumerate(pic.stage.poses):
+        x0, y0, x1, y1 = lay.views[k]
+        tips = [rot[:, :, 0] * length[:, None] for key, (rot, length) in
+                ((key, p) for key, p in poses.items() if key in ("dipole", "L", "omega"))]
+        pts = np.vstack(tips + [content_points(pic.plan)])
+        px = pic.project(k, pts)
+        assert px[:, 0].min() >= x0 + EDGE_PX - 0.5 and px[:, 0].max() <= x1 - EDGE_PX + 0.5, stem
+        assert px[:, 1].min() >= y0 + EDGE_PX - 0.5 and px[:, 1].max() <= y1 - EDGE_PX + 0.5, stem
+    if pic.plan.spec.zoom == 1.0:
+        w, h = lay.views[0][2] - lay.views[0][0], lay.views[0][3] - lay.views[0][1]
+        lo, hi = cam.extent(content_points(pic.plan), cam.distance)
+        fill = np.array([(hi[0] - lo[0]) / 2, (hi[1] - lo[1]) / 2])
+        border = np.array([EDGE_PX + 1.4 * 0.9 * lay.sizes.size, EDGE_PX + 0.6 * 0.9 * lay.sizes.size]) \
+            if "axes" in pic.plan.spec.show else np.array([EDGE_PX, EDGE_PX])
+        target = 1.0 - np.minimum(0.5, 0.02 + 2 * border / np.array([w, h]))
+        slack_px = (target - fill) * np.array([w, h]) / 2
+        assert np.all(slack_px > -0.5) and slack_px.min() < 1.0, (stem, fill, target)
+
+
+def test_narrowed_views_are_even_centred_and_share_one_camera(scene_pictures):
+    """A view narrower than its panel (GL pixels cost) is centred in it, and both panels of a
+    two-model scene use one camera, so the same world point lands at the same place in each."""
+    pic = scene_pictures["default"]
+    lay = pic.layout
+    for k, (x0, _, x1, _) in enumerate(lay.views):
+        assert (x1 - x0) % 2 == 0 and x1 - x0 <= lay.panel_width
+        assert abs((x0 - lay.panel_x(k)) - (lay.panel_x(k) + lay.panel_width - x1)) <= 1
+    a, b = pic.project(0, [0.3, -0.2, 0.5])[0], pic.project(1, [0.3, -0.2, 0.5])[0]
+    np.testing.assert_allclose(b - a, [lay.views[1][0] - lay.views[0][0], 0.0], atol=1e-9)
+
+
+def test_camera_fit_is_solved_not_guessed():
+    """Points on a ring seen edge-on fit the view's width to the margin asked for."""
+    ring = np.c_[np.cos(np.linspace(0, 2 * np.pi, 50)), np.sin(np.linspace(0, 2 * np.pi, 50)), np.zeros(50)]
+    cam = Camera([1.0, 0.0, 0.0], 16 / 9, ring, (0.1, 0.1))
+    lo, hi = cam.extent(ring, cam.distance)
+    assert max((hi - lo) / 2 / 0.9) == pytest.approx(1.0, abs=2e-4)
+
+
+# --- the layout of text ----------------------------------------------------------------------
+def _ink(fonts, text, xy, role, anchor):
+    """The box Pillow's glyphs of ``text`` cover when stamped at ``xy`` (as the HUD stamps it)."""
+    l, t, r, b = fonts.font(role).getbbox(text, anchor=anchor)
+    x, y = int(xy[0]), int(xy[1])
+    return (x + l, y + t, x + r, y + b)
+
+
+def _texts_at(pic, f):
+    """(text, ink box, clip) of every text on frame f: static, inset labels, per-frame lines."""
+    fonts = Fonts(pic.layout.sizes)
+    items = [t for t in pic.overlay.static if isinstance(t, Text)]
+    items += pic.overlay.inset.labels if pic.overlay.inset is not None else []
+    items += [Text(line.texts[f], line.xy, line.color, line.anchor, "small", line.clip) for line in pic.overlay.lines]
+    return [(t.text, _ink(fonts, t.text, t.xy, t.role, t.anchor), t.clip) for t in items if t.text]
+
+
+def _overlap(a, b):
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+@pytest.mark.parametrize("stem", [p.stem for p in SCENES])
+def test_text_boxes_are_disjoint_and_whole_inside_the_frame(scene_pictures, stem):
+    """At 640x360, on the first, middle and last frames: no two texts' ink overlaps, and no text
+    is cut -- each lies whole inside its clip box (a panel, a legend chip) and the frame."""
+    pic = scene_pictures[stem]
+    W, H = pic.size
+    F = pic.frames
+    for f in (0, F // 2, F - 1):
+        boxes = _texts_at(pic, f)
+        for text, box, clip in boxes:
+            cx0, cy0, cx1, cy1 = clip or (0, 0, W, H)
+            assert max(0, cx0) <= box[0] and box[2] <= min(W, cx1), (stem, f, text, box, clip)
+            assert max(0, cy0) <= box[1] and box[3] <= min(H, cy1), (stem, f, text, box, clip)
+        for i, (ta, a, _) in enumerate(boxes):
+            for tb, b, _ in boxes[i + 1:]:
+                assert not _overlap(a, b), (stem, f, ta, a, tb, b)
+
+
+@pytest.mark.parametrize("stem", [p.stem for p in SCENES])
+def test_the_time_never_runs_into_its_bar(scene_pictures, stem):
+    """The bar starts after the widest time text of 40 sampled frames: every frame's time text
+    ends left of it, and the scale text starts right of it; the fill grows from one column at
+    the first frame to the whole bar at the last."""
+    pic = scene_pictures[stem]
+    bar = pic.overlay.bar
+    if bar is None:
+        pytest.skip("no time bar at this size")
+    fonts = Fonts(pic.layout.sizes)
+    time_line = next(line for line in pic.overlay.lines if line.xy == (pic.layout.pad, bar.y + bar.h // 2))
+    right = max(_ink(fonts, t, time_line.xy, "small", "lm")[2] for t in time_line.texts)
+    assert right <= bar.x0, (stem, right, bar.x0)
+    assert bar.cuts[0] == 1 and bar.cuts[-1] == bar.x1 - bar.x0 and np.all(np.diff(bar.cuts) >= 0)
+
+
+def test_type_is_legible_at_360_rows_and_scales_with_the_frame():
+    """15 px body text and 18 px headings at 360 rows, twice that at 720; never below 8 px.  At
+    640x360 the subtitles take two lines and the title goes (the 3-D view keeps half the
+    height); at 960x360 they fit on one and the title stays."""
+    assert TextSizes.for_height(360) == TextSizes(size=15, heading_size=18, line=19, heading_line=24)
+    assert TextSizes.for_height(720) == TextSizes(size=30, heading_size=36, line=38, heading_line=47)
+    assert TextSizes.for_height(96).size == 8
+    pic = picture_of(made_plan())
+    lay = pic.layout
+    assert lay.sizes.size >= 14 and lay.text
+    assert [r.kind for r in lay.rows] == ["legend", "timebar", "notes"]
+    assert [len(items) for items in lay.headings] == [3, 3]                # heading and two subtitle lines
+    wide = picture_of(made_plan(size=(960, 360))).layout
+    assert [r.kind for r in wide.rows] == ["legend", "timebar", "notes", "title"]
+    assert [len(items) for items in wide.headings] == [2, 2]
+    assert lay.views[0][3] - lay.views[0][1] >= 0.5 * 360                 # the 3-D view keeps half the height
+
+
+def test_small_frames_drop_the_least_needed_bands_first():
+    """At 320x120 the title, subtitles, notes and legend go; the time bar, the numbers and the
+    headings stay, and the 3-D view keeps half the height."""
+    lay = picture_of(made_plan(size=(320, 120))).layout
+    assert [r.kind for r in lay.rows] == ["timebar"]
+    assert [[role for _, role, _, _ in items] for items in lay.headings] == [["main"], ["main"]]
+    assert lay.readout_lines == 2
+    assert lay.views[0][3] - lay.views[0][1] >= 0.5 * 120
+
+
+# --- words, colours, poses -------------------------------------------------------------------
+def test_the_words_of_each_frame():
+    """Outreach register: the time in people's units, the spin rate in words, the angle, the
+    slowed spin's factor, a bar marked in whole Theta; physics register: symbols and powers."""
+    plan = made_plan()
+    texts = texts_of(plan)
+    F = plan.frames
+    assert texts.time[0] == "start, 0 s" and texts.time[-1] == "after 10 days"
+    assert texts.readouts[0][0] == ["turns 5 billion times a second", "angle d–L = 30°"]
+    assert texts.readouts[1][-1][0] == "turns 2.5 billion times a second"
+    assert texts.notes[F // 2] == ["spin shown 1.3 × 10¹⁵ times slower"]
+    assert texts.scale == "Θ = 3.2 days"
+    np.testing.assert_allclose([p for p, _ in texts.bar_ticks], [1 / 3.125, 2 / 3.125, 3 / 3.125])
+    assert [label for _, label in texts.bar_ticks] == ["1 Θ", "2 Θ", "3 Θ"]
+    assert texts.headings == [("Reduced equation", "(2.2)+(2.3)"), ("Truncated equation", "(2.5)")]
+    assert texts.legend == [("dipole", "d", "dipole"), ("L", "L", "angular momentum"), ("omega", "Ω", "rotation"),
+                            ("body", "box", "with the top's inertia")]
+    phys = texts_of(made_plan(captions="physics"))
+    assert phys.readouts[0][0] == ["|Ω| = 3.14 × 10¹⁰ rad/s", "∠(d, L) = 30°"]
+    assert phys.time[-1] == "t = 10 days = 3.12 Θ" and phys.notes[0] == ["spin shown slowed 1.3 × 10¹⁵×"]
+    log = texts_of(made_plan(time_map="log"))
+    assert log.notes[0] == ["spin shown 1.3 × 10¹⁵ times slower", "log time: ticks 10× apart"]
+    assert [label for _, label in log.bar_ticks] == ["0.01 Θ", "0.1 Θ", "1 Θ"]        # decades from the knee
+
+
+def test_colours_of_chips_headings_and_trail():
+    """Legend chips carry each arrow's colour (and a darker body colour); headings the model's
+    colour on white and the foreground on black; the trail fades from near the background
+    to the dipole's red."""
+    th = theme("white", "DAST cube")
+    assert th.chips == {"dipole": (219, 20, 61), "omega": (31, 89, 217), "L": (26, 148, 64), "body": (147, 80, 24)}
+    white, black = picture_of(made_plan()), picture_of(made_plan(background="black"))
+    heads = [t for t in white.overlay.static if isinstance(t, Text) and t.role == "main"]
+    assert [h.color for h in heads] == [(0, 128, 128), (136, 60, 180)]
+    heads = [t for t in black.overlay.static if isinstance(t, Text) and t.role == "main"]
+    assert [h.color for h in heads] == [(235, 235, 235)] * 2
+    chips = [m for m in white.overlay.static if isinstance(m, Fill) and m.color in th.chips.values()]
+    assert [c.color for c in chips] == [(219, 20, 61), (26, 148, 64), (31, 89, 217), (147, 80, 24)]
+    assert all(a.box[2] < b.box[0] for a, b in zip(chips, chips[1:]))          # side by side, apart
+    trail = white.stage.trail_rgb
+    assert tuple(trail[-1]) == (219, 20, 61) and tuple(trail[0]) == (252, 240, 243)
+    assert tuple(black.stage.trail_rgb[0]) == (15, 4, 6)
+
+
+def test_poses_point_the_arrows_along_their_vectors():
+    """The planned rotation of each arrow takes +x onto its vector; the body's rotation is the
+    display orientation; Omega's arrow shortens as |Omega| falls (half at the end here)."""
+    pic = picture_of(made_plan())
+    for k, panel in enumerate(pic.plan.panels):
+        poses = pic.stage.poses[k]
+        R = poses["body"]
+        np.testing.assert_allclose(R @ np.swapaxes(R, 1, 2), np.broadcast_to(np.eye(3), R.shape), atol=1e-12)
+        np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=1e-12)
+        for key in ("dipole", "L", "omega"):
+            rot, length = poses[key]
+            v = getattr(panel, ARROW_VECTORS[key])
+            np.testing.assert_allclose(rot[:, :, 0], v / np.linalg.norm(v, axis=1, keepdims=True), atol=1e-12)
+    _, length = pic.stage.poses[1]["omega"]
+    assert length[0] == arrow_length("omega", 1.0) == 1.6
+    assert length[-1] == pytest.approx(arrow_length("omega", 0.5)) == pytest.approx(0.55 + 1.05 * 0.5)
+    _, length = pic.stage.poses[1]["dipole"]
+    assert np.all(length == 1.0)
+
+
+def test_planning_needs_no_drawing_library():
+    """A picture is planned -- words, layout, camera, poses -- in a process that never loads
+    Pillow, VTK, pyvista, imageio or matplotlib (text widths from a stand-in metrics)."""
+    code = f"""
+import sys
+sys.path.insert(0, {str(ROOT)!r})
+from spinviz import pipeline
+from spinviz.rendering.layout import TextSizes
+from spinviz.rendering.picture import plan_picture
+
+class Mono:
+    sizes = TextSizes.for_height(360)
+    def width(self, text, role="small"):
+        return 0.6 * (self.sizes.heading_size if role == "main" else self.sizes.size) * len(text)
+
+pic = plan_picture(pipeline.plan("scenes/default.toml", size=(640, 360)), Mono())
+assert pic.overlay.bar is not None and len(pic.stage.labels) == 6
+print(sorted(m for m in ("PIL", "vtk", "vtkmodules", "pyvista", "imageio", "matplotlib") if m in sys.modules))
+"""
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "[]"

@@ -40,7 +40,7 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("target", help="a preset name (cellulose_rod, dast_cube, dast_family1) or a scene file")
     i.add_argument("--json", action="store_true")
 
-    s = sub.add_parser("simulate", help="integrate a scene and write the trajectory (.npz)")
+    s = sub.add_parser("simulate", help="integrate a scene and write the trajectory and its radiation observables (.npz)")
     s.add_argument("scene")
     s.add_argument("--out", required=True, help="output .npz path")
     s.add_argument("--model", help="which of the scene's models (default: the first)")
@@ -235,7 +235,7 @@ def _cmd_simulate(args) -> int:
     except ValueError as e:
         raise UsageError(f"{args.scene}: {e}") from None
     try:
-        traj.save(args.out)
+        traj.save(args.out, radiation=True)
     except OSError as e:
         raise UsageError(f"{args.out}: cannot write: {e.strerror or e}") from None
     st = traj.stats

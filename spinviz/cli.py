@@ -68,6 +68,20 @@ def _parser() -> argparse.ArgumentParser:
     c2.add_argument("--samples", type=_positive, default=800, help="evenly spaced plus as many log-spaced output times")
     c2.add_argument("--json", action="store_true", help="print the results as JSON")
 
+    o = sub.add_parser("observe", help="what a detector records from both models of a scene, and when the two part "
+                                       "(power, frequency, polarization); plots")
+    o.add_argument("scene")
+    o.add_argument("--out", help="prefix of the PNG plots (default renders/<scene>): <prefix>_observe.png, "
+                                 "<prefix>_detector.png")
+    o.add_argument("--los", type=_vector, help="line of sight X,Y,Z in the world frame (default: the scene's [observe], "
+                                              "else across L(0))")
+    o.add_argument("--distance-cm", type=_real, help="where the field is given (default 1 cm)")
+    o.add_argument("--power-factor", type=_real, help="power resolution, a ratio (default 2)")
+    o.add_argument("--frequency-resolution", type=_real, help="relative frequency resolution (default 0.01)")
+    o.add_argument("--polarization-deg", type=_real, help="polarization-angle resolution, degrees (default 5)")
+    o.add_argument("--samples", type=_positive, default=800, help="evenly spaced plus as many log-spaced instants")
+    o.add_argument("--json", action="store_true", help="print the results as JSON")
+
     b = sub.add_parser("bench", help="work-precision benchmark: error against run time, per method and horizon")
     b.add_argument("--quick", action="store_true", help="two problems, 1e2 and 1e4 turns, fewer settings (~2 min)")
     b.add_argument("--json", metavar="PATH", help="also write rows and summary as JSON")
@@ -107,6 +121,16 @@ def _positive(text: str) -> int:
     v = _whole(text)
     if v < 1:
         raise argparse.ArgumentTypeError(f"must be at least 1, got {v}")
+    return v
+
+
+def _vector(text: str):
+    try:
+        v = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected X,Y,Z, got {text!r}") from None
+    if len(v) != 3:
+        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z, got {text!r}")
     return v
 
 
@@ -338,6 +362,62 @@ def _cmd_compare(args) -> int:
     return EXIT_OK
 
 
+def _observe_args(args):
+    """The observe/listen overrides, checked: (line of sight, distance, resolution)."""
+    from .analysis.observe import Resolution
+
+    checks = (("--distance-cm", args.distance_cm, 1e-4, 1e30), ("--power-factor", getattr(args, "power_factor", None), 1.0001, 1e6),
+              ("--frequency-resolution", getattr(args, "frequency_resolution", None), 1e-12, 0.5),
+              ("--polarization-deg", getattr(args, "polarization_deg", None), 0.01, 89.0))
+    for name, v, lo, hi in checks:
+        if v is not None and not lo <= v <= hi:
+            raise UsageError(f"{name}: must lie in [{lo:g}, {hi:g}], got {v:g}")
+    if args.los is not None and not any(x != 0.0 for x in args.los) or (args.los is not None and
+                                                                          not all(x == x and abs(x) < float("inf") for x in args.los)):
+        raise UsageError(f"--los: must be a finite, non-zero vector, got {args.los}")
+    return args.los, args.distance_cm, Resolution
+
+
+def _cmd_observe(args) -> int:
+    from .analysis import observe as OB
+    from .atomic import Outputs
+    from .scene import load_scene
+
+    los, dist, _ = _observe_args(args)
+    sc = load_scene(args.scene)
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        raise UsageError("observe's plots need matplotlib: pip install 'spinviz[render]'") from None
+    if args.samples > OB_MAX_SAMPLES:
+        raise UsageError(f"--samples: at most {OB_MAX_SAMPLES}, got {args.samples}")
+    prefix = args.out or os.path.join("renders", os.path.splitext(os.path.basename(args.scene))[0])
+    paths = [f"{prefix}_observe.png", f"{prefix}_detector.png"]
+    group = Outputs(paths, [args.scene])
+    res = OB.scene_resolution(sc, args.power_factor, args.frequency_resolution, args.polarization_deg)
+    try:
+        obs, _ = OB.run_scene(sc, args.samples, los, dist, res)
+    except SimulationError as e:
+        raise SimulationError(f"{args.scene}: {e}") from None
+    except ValueError as e:
+        raise UsageError(f"{args.scene}: {e}") from None
+    try:
+        with group as tmps:
+            OB.plot(obs, tmps[0])
+            OB.plot_detector(obs, tmps[1])
+    except OSError as e:
+        raise UsageError(f"{prefix}: cannot write the plots: {e.strerror or e}") from None
+    if args.json:
+        print(json.dumps({**obs.record(), "plots": list(paths)}, indent=2, default=float))
+    else:
+        _out(OB.format_table(obs))
+        _out(f"\nplots: {paths[0]}, {paths[1]}")
+    return EXIT_OK
+
+
+OB_MAX_SAMPLES = 100_000
+
+
 def _cmd_bench(args) -> int:
     from .atomic import write_json
     from .validation import bench
@@ -380,7 +460,7 @@ def _cmd_atlas(args) -> int:
 
 _COMMANDS = {"check": _cmd_check, "info": _cmd_info, "simulate": _cmd_simulate, "methods": _cmd_methods,
              "render": _cmd_render, "compare": _cmd_compare, "bench": _cmd_bench, "stress": _cmd_stress,
-             "report": _cmd_report, "atlas": _cmd_atlas}
+             "report": _cmd_report, "atlas": _cmd_atlas, "observe": _cmd_observe}
 
 
 def entry() -> None:

@@ -82,6 +82,23 @@ def _parser() -> argparse.ArgumentParser:
     o.add_argument("--samples", type=_positive, default=800, help="evenly spaced plus as many log-spaced instants")
     o.add_argument("--json", action="store_true", help="print the results as JSON")
 
+    li = sub.add_parser("listen", help="hear the crystal spin down: the detector's signal of both models as a stereo "
+                                       "WAV (left one model, right the other), with its spectrogram")
+    li.add_argument("scene")
+    li.add_argument("--out", required=True, help="output .wav")
+    li.add_argument("--png", help="spectrogram of the WAV (default: beside it, .png)")
+    li.add_argument("--duration", type=_real, default=20.0, help="seconds of sound (default 20)")
+    li.add_argument("--f0", type=_real, default=440.0, help="pitch of the initial rotation frequency, Hz (default 440)")
+    li.add_argument("--time-map", choices=("log", "linear"), default="log", help="how sound time maps to the run's")
+    li.add_argument("--pitch", choices=("auto", "linear"), default="auto",
+                    help="linear: every frequency times one factor; auto: that, unless the frequency falls more than "
+                         "16x, which is then compressed into 16x (default)")
+    li.add_argument("--dynamic-range-db", type=_real, default=60.0,
+                    help="the field's range in dB is compressed into this many dB of sound when larger (default 60)")
+    li.add_argument("--los", type=_vector, help="line of sight X,Y,Z, world frame")
+    li.add_argument("--distance-cm", type=_real, help=argparse.SUPPRESS)
+    li.add_argument("--samples", type=_positive, default=800, help="evenly spaced plus as many log-spaced instants")
+
     b = sub.add_parser("bench", help="work-precision benchmark: error against run time, per method and horizon")
     b.add_argument("--quick", action="store_true", help="two problems, 1e2 and 1e4 turns, fewer settings (~2 min)")
     b.add_argument("--json", metavar="PATH", help="also write rows and summary as JSON")
@@ -363,19 +380,20 @@ def _cmd_compare(args) -> int:
 
 
 def _observe_args(args):
-    """The observe/listen overrides, checked: (line of sight, distance, resolution)."""
-    from .analysis.observe import Resolution
+    """The observe/listen overrides, checked: (line of sight, distance)."""
+    import math
 
-    checks = (("--distance-cm", args.distance_cm, 1e-4, 1e30), ("--power-factor", getattr(args, "power_factor", None), 1.0001, 1e6),
+    checks = (("--distance-cm", args.distance_cm, 1e-4, 1e30),
+              ("--power-factor", getattr(args, "power_factor", None), 1.0001, 1e6),
               ("--frequency-resolution", getattr(args, "frequency_resolution", None), 1e-12, 0.5),
               ("--polarization-deg", getattr(args, "polarization_deg", None), 0.01, 89.0))
     for name, v, lo, hi in checks:
         if v is not None and not lo <= v <= hi:
-            raise UsageError(f"{name}: must lie in [{lo:g}, {hi:g}], got {v:g}")
-    if args.los is not None and not any(x != 0.0 for x in args.los) or (args.los is not None and
-                                                                          not all(x == x and abs(x) < float("inf") for x in args.los)):
-        raise UsageError(f"--los: must be a finite, non-zero vector, got {args.los}")
-    return args.los, args.distance_cm, Resolution
+            raise UsageError(f"--{name.lstrip('-')}: must lie in [{lo:g}, {hi:g}], got {v:g}")
+    los = args.los
+    if los is not None and (not all(math.isfinite(x) for x in los) or not any(x != 0.0 for x in los)):
+        raise UsageError(f"--los: must be a finite, non-zero vector, got {','.join(f'{x:g}' for x in los)}")
+    return los, args.distance_cm
 
 
 def _cmd_observe(args) -> int:
@@ -383,7 +401,7 @@ def _cmd_observe(args) -> int:
     from .atomic import Outputs
     from .scene import load_scene
 
-    los, dist, _ = _observe_args(args)
+    los, dist = _observe_args(args)
     sc = load_scene(args.scene)
     try:
         import matplotlib  # noqa: F401
@@ -416,6 +434,52 @@ def _cmd_observe(args) -> int:
 
 
 OB_MAX_SAMPLES = 100_000
+
+
+def _cmd_listen(args) -> int:
+    from .analysis import sonify
+    from .atomic import Outputs
+    from .scene import load_scene
+
+    los, dist = _observe_args(args)
+    if os.path.splitext(args.out)[1].lower() != ".wav":
+        raise UsageError(f"--out: {args.out}: the sound is written as WAV; give a path ending in .wav")
+    png = args.png or os.path.splitext(args.out)[0] + ".png"
+    if os.path.splitext(png)[1].lower() != ".png":
+        raise UsageError(f"--png: {png}: give a path ending in .png")
+    if not 0.5 <= args.duration <= sonify.MAX_SECONDS:
+        raise UsageError(f"--duration: must lie in [0.5, {sonify.MAX_SECONDS:g}] s, got {args.duration:g}")
+    if not 20.0 <= args.f0 <= 5000.0:
+        raise UsageError(f"--f0: must lie in [20, 5000] Hz (audible, well under the Nyquist frequency), got {args.f0:g}")
+    if not 1.0 <= args.dynamic_range_db <= 120.0:
+        raise UsageError(f"--dynamic-range-db: must lie in [1, 120], got {args.dynamic_range_db:g}")
+    if args.samples > OB_MAX_SAMPLES:
+        raise UsageError(f"--samples: at most {OB_MAX_SAMPLES}, got {args.samples}")
+    sc = load_scene(args.scene)
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        raise UsageError("listen's spectrogram needs matplotlib: pip install 'spinviz[render]'") from None
+    group = Outputs([args.out, png], [args.scene])
+    try:
+        with group as (tmp_wav, tmp_png):
+            mapping = sonify.listen_scene(sc, tmp_wav, tmp_png, args.duration, args.f0, args.time_map, args.samples,
+                                          los, dist, args.dynamic_range_db, args.pitch)
+    except SimulationError as e:
+        raise SimulationError(f"{args.scene}: {e}") from None
+    except ValueError as e:
+        raise UsageError(f"{args.scene}: {e}") from None
+    except OSError as e:
+        raise UsageError(f"{args.out}: cannot write: {e.strerror or e}") from None
+    _out(f"{args.out}: {mapping.duration_s:g} s, {mapping.rate} Hz, 16-bit stereo")
+    _out(mapping.statement())
+    if mapping.dropped_above_nyquist:
+        _out(f"note: {mapping.dropped_above_nyquist} line(s) above {sonify.NYQUIST_SHARE * mapping.rate:.0f} Hz left "
+             f"out (lower --f0 to hear them)")
+    if mapping.below_audible_s > 0.0:
+        _out(f"note: for {mapping.below_audible_s:.1f} s the strongest line is below 20 Hz (raise --f0)")
+    _out(f"{png}: spectrogram of the WAV")
+    return EXIT_OK
 
 
 def _cmd_bench(args) -> int:
@@ -460,7 +524,8 @@ def _cmd_atlas(args) -> int:
 
 _COMMANDS = {"check": _cmd_check, "info": _cmd_info, "simulate": _cmd_simulate, "methods": _cmd_methods,
              "render": _cmd_render, "compare": _cmd_compare, "bench": _cmd_bench, "stress": _cmd_stress,
-             "report": _cmd_report, "atlas": _cmd_atlas, "observe": _cmd_observe}
+             "report": _cmd_report, "atlas": _cmd_atlas, "observe": _cmd_observe,
+             "listen": _cmd_listen}
 
 
 def entry() -> None:

@@ -148,20 +148,12 @@ def format_table(obs: Observation) -> str:
         lines.append(f"note: {note}")
     lines.append(f"{_horizon_text(obs)} (the scene's [observe] horizon, else its own)")
     lines.append("")
-    fu, pu = a.freq_unit, a.power_sr_unit
     head = f"{'':<34} {a.model:>22} {b.model:>22}"
     for label, i in (("at the start", 0), (f"at the end, t = {U.format_time(obs.horizon, obs.units)}", -1)):
         lines += [label, head]
-        rows = [("radiated power", lambda d: _num(d.power[i], a.power_unit, cgs, "power")),
-                ("power toward the detector", lambda d: _num(d.power_sr[i], pu, cgs, "sr")),
-                ("RMS field", lambda d: _num(d.field_rms[i], a.field_unit, cgs, "field")),
-                ("dominant frequency", lambda d: U.format_frequency(d.f_dom[i]) if cgs else f"{d.f_dom[i]:.4g} {fu}"),
-                ("rotation |L|/(2 pi I1)", lambda d: U.format_frequency(d.f_rot[i]) if cgs else f"{d.f_rot[i]:.4g} {fu}"),
-                ("polarization angle (from u1)", lambda d: f"{math.degrees(d.pol_angle[i]):.1f}° ({100 * d.linear[i]:.0f} % lin.)")]
-        if cgs:
-            rows.append(("photons per second per sr", lambda d: f"{d.photons_sr[i]:.3g}"))
-        for name, fn in rows:
-            lines.append(f"  {name:<32} {fn(a):>22} {fn(b):>22}")
+        cells = [_cells(d, i, cgs) for d in obs.detections]
+        for name in cells[0]:
+            lines.append(f"  {name:<32} {cells[0][name]:>22} {cells[1][name]:>22}")
         lines.append("")
     lines.append("when do the models part?")
     for key in OBSERVABLES:
@@ -174,6 +166,19 @@ def format_table(obs: Observation) -> str:
             text += f"   (the paper, {printed['where']}: {'~' if printed['approx'] else ''}{U.human_time(printed['value_s'])})"
         lines.append(text)
     return "\n".join(lines)
+
+
+def _cells(d: Detection, i: int, cgs: bool) -> dict[str, str]:
+    """One column of ``format_table``: the detection's observables at sample i, as text."""
+    freq = (lambda f: U.format_frequency(f)) if cgs else (lambda f: f"{f:.4g} {d.freq_unit}")
+    out = {"radiated power": _num(d.power[i], d.power_unit, cgs, "power"),
+           "power toward the detector": _num(d.power_sr[i], d.power_sr_unit, cgs, "sr"),
+           "RMS field": _num(d.field_rms[i], d.field_unit, cgs, "field"),
+           "dominant frequency": freq(d.f_dom[i]), "rotation |L|/(2 pi I1)": freq(d.f_rot[i]),
+           "polarization angle (from u1)": f"{math.degrees(d.pol_angle[i]) + 0.0:.1f}° ({100 * d.linear[i]:.0f} % lin.)"}
+    if cgs:
+        out["photons per second per sr"] = f"{d.photons_sr[i]:.3g}"
+    return out
 
 
 def _num(x, unit, cgs, kind) -> str:

@@ -270,6 +270,8 @@ def plot_wav(path_wav, path_png, title: str = "") -> None:
         fmax = max(fmax, float(f[strong].max()) if strong.any() else 0.0)
     fmax = min(rate / 2, 1.25 * fmax or rate / 4)
     for ch, (ax, (f, tt, S)) in enumerate(zip(axes, specs)):
+        keep = f <= fmax                                   # draw only the rows on screen
+        f, S = f[keep], S[keep]
         db = 10 * np.log10(np.maximum(S, top * 1e-12) / top)
         mesh = ax.pcolormesh(tt, f, db, vmin=-80, vmax=0, cmap="magma", shading="nearest", rasterized=True)
         model = m.get("left" if ch == 0 else "right", "")

@@ -339,8 +339,8 @@ BALANCE_EPS = (1e-2, 1e-3, 1e-4)
 def balance_bodies() -> tuple[B.Body, ...]:
     """The askew bodies the balance is measured on: a symmetric top in domain "3" (delta = 0.3,
     chi = 0.72) and an asymmetric body with a dipole along no principal axis."""
-    return (B.symmetric_top(0.3, 0.72, name="askew symmetric top (delta=0.3, chi=0.72)"),
-            B.custom((1.0, 0.8, 0.55), (0.5, 0.3, 0.81), units="dimensionless", name="asymmetric body (1, 0.8, 0.55)"))
+    return (B.symmetric_top(0.3, 0.72, name="askew top delta=0.3 chi=0.72"),
+            B.custom((1.0, 0.8, 0.55), (0.5, 0.3, 0.81), units="dimensionless", name="asymmetric (1, 0.8, 0.55)"))
 
 
 def _balance_rows(model: str, epsilons=BALANCE_EPS):

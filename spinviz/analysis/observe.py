@@ -171,11 +171,12 @@ def format_table(obs: Observation) -> str:
 def _cells(d: Detection, i: int, cgs: bool) -> dict[str, str]:
     """One column of ``format_table``: the detection's observables at sample i, as text."""
     freq = (lambda f: U.format_frequency(f)) if cgs else (lambda f: f"{f:.4g} {d.freq_unit}")
+    pol = round(math.degrees(d.pol_angle[i]), 1) + 0.0                      # never "-0.0"
     out = {"radiated power": _num(d.power[i], d.power_unit, cgs, "power"),
            "power toward the detector": _num(d.power_sr[i], d.power_sr_unit, cgs, "sr"),
            "RMS field": _num(d.field_rms[i], d.field_unit, cgs, "field"),
            "dominant frequency": freq(d.f_dom[i]), "rotation |L|/(2 pi I1)": freq(d.f_rot[i]),
-           "polarization angle (from u1)": f"{round(math.degrees(d.pol_angle[i]), 1) + 0.0:.1f}° ({100 * d.linear[i]:.0f} % lin.)"}
+           "polarization angle (from u1)": f"{pol:.1f}° ({100 * d.linear[i]:.0f} % lin.)"}
     if cgs:
         out["photons per second per sr"] = f"{d.photons_sr[i]:.3g}"
     return out

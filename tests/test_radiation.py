@@ -59,8 +59,9 @@ def test_uniform_rotation_radiates_larmor_sin2_theta_omega4(theta):
 
 
 def test_rotation_about_the_dipole_radiates_nothing():
-    """Rotation about d, the reduced model's end state (5.2), (6.7)-(6.8): no power, no flux of L,
-    no Schott term -- exactly (3.9)'s partner: the residual rotation is dark."""
+    """Rotation about d -- the reduced model's end state, (5.2), (6.7)-(6.8) -- radiates no power,
+    carries away no angular momentum (2.4a) and has no Schott term (2.4b): the residual rotation
+    is dark (to round-off of the real CGS numbers)."""
     body, W, tr = uniform_rotation(0.0)
     ds = tr.radiation()
     scale = K_CGS * body.dipole_magnitude**2 * W**4
@@ -230,3 +231,16 @@ def test_simulate_saves_the_radiation(tmp_path):
     # the cube at t = 0: Omega = pi 1e10 (0, 1, 1) rad/s, d along e3: sin^2 = 1/2, |Omega|^4 = 4 (pi 1e10)^4
     body = tr.body
     assert P0 == pytest.approx(K_CGS * body.dipole_magnitude**2 * 0.5 * 4 * (math.pi * 1e10) ** 4, rel=1e-12)
+
+
+def test_radiation_without_orientation_keeps_the_invariants():
+    """A run without orientation (kinematics "none") still has P, E, E_S and dE/dt -- rotation
+    invariants -- with units; for the reduced chi = 0 top dE/dt = Omega . N = -P (5.1), up to the
+    share w_a^2 ~ eps_rad^2 = 1e-5 the radiation part of Omega_dot adds to P; no world-frame vector
+    is made up."""
+    tr = spinviz.simulate(B.symmetric_top(0.3, 0.0), "reduced", (0.0, 1e-3, 3e-3), t_end=1e5, samples=11,
+                          kinematics="none")
+    ds = tr.radiation()
+    assert set(ds.data_vars) == {"power", "energy", "schott_energy", "work", "power_precession_averaged"}
+    assert ds["power"].attrs["units"] == "I1/tau0^3" and ds["energy"].attrs["units"] == "I1/tau0^2"
+    assert np.allclose(-ds["work"].values, ds["power"].values, rtol=1e-5)     # |omega|^2 ~ 1e-5

@@ -250,8 +250,8 @@ def plot(obs: Observation, path: str) -> None:
                         xycoords=("data", "axes fraction"), xytext=(4, 0), textcoords="offset points", fontsize=8,
                         color="tab:red", va="top")
         elif tp is None:
-            ax.annotate(f"never {word} apart within the run", (0.98, 0.04), xycoords="axes fraction", fontsize=8,
-                        color="0.35", va="bottom", ha="right")
+            ax.annotate(f"never {word} apart within the run", (0.98, 0.96), xycoords="axes fraction", fontsize=8,
+                        color="0.35", va="top", ha="right")
         ax.set_title(title)
         ax.set_ylabel(ylabel)
     axes[1, 0].set_ylim(-95, 95)
@@ -264,7 +264,8 @@ def plot(obs: Observation, path: str) -> None:
                 "polarization": diff["polarization"] / res.polarization_deg}
     for key, col in zip(OBSERVABLES, ("tab:orange", "tab:blue", "tab:green")):
         y = np.clip(np.nan_to_num(norm[key][pos], nan=np.nan, posinf=1e6), 1e-8, 1e6)
-        ax.plot(t, y, color=col, lw=1.6, label=res.label(key))
+        flat = not np.any(y > 1e-6)                        # below the axis: say so in the legend
+        ax.plot(t, y, color=col, lw=1.6, label=res.label(key) + (" (below 1e-6 throughout)" if flat else ""))
     ax.axhline(1.0, color="tab:red", lw=1.0, ls="--")
     ax.annotate("resolved: the models part", (0.01, 1.0), xycoords=("axes fraction", "data"), xytext=(2, 3),
                 textcoords="offset points", fontsize=8, color="tab:red")

@@ -40,7 +40,7 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("target", help="a preset name (cellulose_rod, dast_cube, dast_family1) or a scene file")
     i.add_argument("--json", action="store_true")
 
-    s = sub.add_parser("simulate", help="integrate a scene and write the trajectory (.npz)")
+    s = sub.add_parser("simulate", help="integrate a scene and write the trajectory and its radiation observables (.npz)")
     s.add_argument("scene")
     s.add_argument("--out", required=True, help="output .npz path")
     s.add_argument("--model", help="which of the scene's models (default: the first)")
@@ -67,6 +67,37 @@ def _parser() -> argparse.ArgumentParser:
                                   "<prefix>_compare.png, <prefix>_hodograph.png")
     c2.add_argument("--samples", type=_positive, default=800, help="evenly spaced plus as many log-spaced output times")
     c2.add_argument("--json", action="store_true", help="print the results as JSON")
+
+    o = sub.add_parser("observe", help="what a detector records from both models of a scene, and when the two part "
+                                       "(power, frequency, polarization); plots")
+    o.add_argument("scene")
+    o.add_argument("--out", help="prefix of the PNG plots (default renders/<scene>): <prefix>_observe.png, "
+                                 "<prefix>_detector.png")
+    o.add_argument("--los", type=_vector, help="line of sight X,Y,Z in the world frame (default: the scene's [observe], "
+                                              "else across L(0))")
+    o.add_argument("--distance-cm", type=_real, help="where the field is given (default 1 cm)")
+    o.add_argument("--power-factor", type=_real, help="power resolution, a ratio (default 2)")
+    o.add_argument("--frequency-resolution", type=_real, help="relative frequency resolution (default 0.01)")
+    o.add_argument("--polarization-deg", type=_real, help="polarization-angle resolution, degrees (default 5)")
+    o.add_argument("--samples", type=_positive, default=800, help="evenly spaced plus as many log-spaced instants")
+    o.add_argument("--json", action="store_true", help="print the results as JSON")
+
+    li = sub.add_parser("listen", help="hear the crystal spin down: the detector's signal of both models as a stereo "
+                                       "WAV (left one model, right the other), with its spectrogram")
+    li.add_argument("scene")
+    li.add_argument("--out", required=True, help="output .wav")
+    li.add_argument("--png", help="spectrogram of the WAV (default: beside it, .png)")
+    li.add_argument("--duration", type=_real, default=20.0, help="seconds of sound (default 20)")
+    li.add_argument("--f0", type=_real, default=440.0, help="pitch of the initial rotation frequency, Hz (default 440)")
+    li.add_argument("--time-map", choices=("log", "linear"), default="log", help="how sound time maps to the run's")
+    li.add_argument("--pitch", choices=("auto", "linear"), default="auto",
+                    help="linear: every frequency times one factor; auto: that, unless the frequency falls more than "
+                         "16x, which is then compressed into 16x (default)")
+    li.add_argument("--dynamic-range-db", type=_real, default=60.0,
+                    help="the field's range in dB is compressed into this many dB of sound when larger (default 60)")
+    li.add_argument("--los", type=_vector, help="line of sight X,Y,Z, world frame")
+    li.add_argument("--distance-cm", type=_real, help=argparse.SUPPRESS)
+    li.add_argument("--samples", type=_positive, default=800, help="evenly spaced plus as many log-spaced instants")
 
     b = sub.add_parser("bench", help="work-precision benchmark: error against run time, per method and horizon")
     b.add_argument("--quick", action="store_true", help="two problems, 1e2 and 1e4 turns, fewer settings (~2 min)")
@@ -107,6 +138,16 @@ def _positive(text: str) -> int:
     v = _whole(text)
     if v < 1:
         raise argparse.ArgumentTypeError(f"must be at least 1, got {v}")
+    return v
+
+
+def _vector(text: str):
+    try:
+        v = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected X,Y,Z, got {text!r}") from None
+    if len(v) != 3:
+        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z, got {text!r}")
     return v
 
 
@@ -235,7 +276,7 @@ def _cmd_simulate(args) -> int:
     except ValueError as e:
         raise UsageError(f"{args.scene}: {e}") from None
     try:
-        traj.save(args.out)
+        traj.save(args.out, radiation=True)
     except OSError as e:
         raise UsageError(f"{args.out}: cannot write: {e.strerror or e}") from None
     st = traj.stats
@@ -340,6 +381,109 @@ def _cmd_compare(args) -> int:
     return EXIT_OK
 
 
+def _observe_args(args):
+    """The observe/listen overrides, checked: (line of sight, distance)."""
+    import math
+
+    checks = (("--distance-cm", args.distance_cm, 1e-4, 1e30),
+              ("--power-factor", getattr(args, "power_factor", None), 1.0001, 1e6),
+              ("--frequency-resolution", getattr(args, "frequency_resolution", None), 1e-12, 0.5),
+              ("--polarization-deg", getattr(args, "polarization_deg", None), 0.01, 89.0))
+    for name, v, lo, hi in checks:
+        if v is not None and not lo <= v <= hi:
+            raise UsageError(f"--{name.lstrip('-')}: must lie in [{lo:g}, {hi:g}], got {v:g}")
+    los = args.los
+    if los is not None and (not all(math.isfinite(x) for x in los) or not any(x != 0.0 for x in los)):
+        raise UsageError(f"--los: must be a finite, non-zero vector, got {','.join(f'{x:g}' for x in los)}")
+    return los, args.distance_cm
+
+
+def _cmd_observe(args) -> int:
+    from .analysis import observe as OB
+    from .atomic import Outputs
+    from .scene import load_scene
+
+    los, dist = _observe_args(args)
+    sc = load_scene(args.scene)
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        raise UsageError("observe's plots need matplotlib: pip install 'spinviz[render]'") from None
+    if args.samples > OB_MAX_SAMPLES:
+        raise UsageError(f"--samples: at most {OB_MAX_SAMPLES}, got {args.samples}")
+    prefix = args.out or os.path.join("renders", os.path.splitext(os.path.basename(args.scene))[0])
+    paths = [f"{prefix}_observe.png", f"{prefix}_detector.png"]
+    group = Outputs(paths, [args.scene])
+    res = OB.scene_resolution(sc, args.power_factor, args.frequency_resolution, args.polarization_deg)
+    try:
+        obs, _ = OB.run_scene(sc, args.samples, los, dist, res)
+    except SimulationError as e:
+        raise SimulationError(f"{args.scene}: {e}") from None
+    except ValueError as e:
+        raise UsageError(f"{args.scene}: {e}") from None
+    try:
+        with group as tmps:
+            OB.plot(obs, tmps[0])
+            OB.plot_detector(obs, tmps[1])
+    except OSError as e:
+        raise UsageError(f"{prefix}: cannot write the plots: {e.strerror or e}") from None
+    if args.json:
+        print(json.dumps({**obs.record(), "plots": list(paths)}, indent=2, default=float))
+    else:
+        _out(OB.format_table(obs))
+        _out(f"\nplots: {paths[0]}, {paths[1]}")
+    return EXIT_OK
+
+
+OB_MAX_SAMPLES = 100_000
+
+
+def _cmd_listen(args) -> int:
+    from .analysis import sonify
+    from .atomic import Outputs
+    from .scene import load_scene
+
+    los, dist = _observe_args(args)
+    if os.path.splitext(args.out)[1].lower() != ".wav":
+        raise UsageError(f"--out: {args.out}: the sound is written as WAV; give a path ending in .wav")
+    png = args.png or os.path.splitext(args.out)[0] + ".png"
+    if os.path.splitext(png)[1].lower() != ".png":
+        raise UsageError(f"--png: {png}: give a path ending in .png")
+    if not 0.5 <= args.duration <= sonify.MAX_SECONDS:
+        raise UsageError(f"--duration: must lie in [0.5, {sonify.MAX_SECONDS:g}] s, got {args.duration:g}")
+    if not 20.0 <= args.f0 <= 5000.0:
+        raise UsageError(f"--f0: must lie in [20, 5000] Hz (audible, well under the Nyquist frequency), got {args.f0:g}")
+    if not 1.0 <= args.dynamic_range_db <= 120.0:
+        raise UsageError(f"--dynamic-range-db: must lie in [1, 120], got {args.dynamic_range_db:g}")
+    if args.samples > OB_MAX_SAMPLES:
+        raise UsageError(f"--samples: at most {OB_MAX_SAMPLES}, got {args.samples}")
+    sc = load_scene(args.scene)
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        raise UsageError("listen's spectrogram needs matplotlib: pip install 'spinviz[render]'") from None
+    group = Outputs([args.out, png], [args.scene])
+    try:
+        with group as (tmp_wav, tmp_png):
+            mapping = sonify.listen_scene(sc, tmp_wav, tmp_png, args.duration, args.f0, args.time_map, args.samples,
+                                          los, dist, args.dynamic_range_db, args.pitch)
+    except SimulationError as e:
+        raise SimulationError(f"{args.scene}: {e}") from None
+    except ValueError as e:
+        raise UsageError(f"{args.scene}: {e}") from None
+    except OSError as e:
+        raise UsageError(f"{args.out}: cannot write: {e.strerror or e}") from None
+    _out(f"{args.out}: {mapping.duration_s:g} s, {mapping.rate} Hz, 16-bit stereo")
+    _out(mapping.statement())
+    if mapping.dropped_above_nyquist:
+        _out(f"note: {mapping.dropped_above_nyquist} line(s) above {sonify.NYQUIST_SHARE * mapping.rate:.0f} Hz left "
+             f"out (lower --f0 to hear them)")
+    if mapping.below_audible_s > 0.0:
+        _out(f"note: for {mapping.below_audible_s:.1f} s the strongest line is below 20 Hz (raise --f0)")
+    _out(f"{png}: spectrogram of the WAV")
+    return EXIT_OK
+
+
 def _cmd_bench(args) -> int:
     from .atomic import write_json
     from .validation import bench
@@ -382,7 +526,8 @@ def _cmd_atlas(args) -> int:
 
 _COMMANDS = {"check": _cmd_check, "info": _cmd_info, "simulate": _cmd_simulate, "methods": _cmd_methods,
              "render": _cmd_render, "compare": _cmd_compare, "bench": _cmd_bench, "stress": _cmd_stress,
-             "report": _cmd_report, "atlas": _cmd_atlas}
+             "report": _cmd_report, "atlas": _cmd_atlas, "observe": _cmd_observe,
+             "listen": _cmd_listen}
 
 
 def entry() -> None:

@@ -153,6 +153,24 @@ class _Table:
 
 
 @dataclass(frozen=True)
+class ObserveSpec:
+    """[observe]: how a detector watches the scene (``spinviz observe``, ``spinviz listen``).
+
+    t_end : how long it watches, in the scene's time unit (None: the scene's horizon);
+    line_of_sight : world-frame direction to the detector (None: across L(0));
+    distance_cm : where the field is given; power_factor, frequency_resolution,
+    polarization_deg : the resolutions at which the two models count as told apart.
+    """
+
+    t_end: float | None = None
+    line_of_sight: tuple[float, float, float] | None = None
+    distance_cm: float = 1.0
+    power_factor: float = 2.0
+    frequency_resolution: float = 0.01
+    polarization_deg: float = 5.0
+
+
+@dataclass(frozen=True)
 class Scene:
     """A validated scene, in the body's units (CGS: s, rad/s; dimensionless: tau0, 1/tau0)."""
 
@@ -169,6 +187,7 @@ class Scene:
     atol: float = 1e-12
     step: float | None = None
     render: RenderSpec = field(default_factory=RenderSpec)
+    observe: ObserveSpec = field(default_factory=ObserveSpec)
 
     @property
     def units(self) -> str:
@@ -286,8 +305,9 @@ def parse_scene(data: dict, path: str = "<scene>") -> Scene:
         raise SceneError(path, "[initial].omega" if e.key == "omega" else "[body]", e.reason) from None
     sim = _simulation(st, body, omega0)
     render = _render(top, path, title, sim["t_end"])
+    observe = _observe(top.sub("observe"), body, omega0, sim)
     top.finish()
-    return Scene(path=str(path), title=title, body=body, omega0=omega0, q0=q0, render=render, **sim)
+    return Scene(path=str(path), title=title, body=body, omega0=omega0, q0=q0, render=render, observe=observe, **sim)
 
 
 def _initial(it: _Table):
@@ -373,6 +393,39 @@ def _render(top: _Table, path: str, title: str, t_end: float) -> RenderSpec:
         spec.check_horizon(t_end)
     except SpecError as e:
         raise SceneError(path, e.key if e.key.startswith("[") else f"[render].{e.key}", e.reason) from None
+    return spec
+
+
+DISTANCE_CM = (1e-4, 1e30, "from a micron to a megaparsec")
+
+
+def _observe(ot: _Table | None, body: B.Body, omega0, sim: dict) -> ObserveSpec:
+    """[observe], optional: the detector's horizon, line of sight, distance and resolutions."""
+    if ot is None:
+        return ObserveSpec()
+    t_end = None
+    tkey = ot.one_of("t_end", "t_end_T", "t_end_Theta")
+    if tkey is not None:
+        t_end = ot.number(tkey, positive=True)
+        if tkey != "t_end":
+            t_end *= _time_scale(body, omega0, tkey, ot)
+        if not math.isfinite(t_end) or not t_end / body.tau0 > 0.0:
+            raise ot.error(tkey, "the horizon is beyond float64")
+        try:
+            for m in sim["models"]:
+                check_cost(body, m, omega0, t_end, sim["method"], sim["step"])
+        except SpecError as e:
+            raise ot.error(tkey if e.key == "t_end" else e.key, e.reason) from None
+    los = ot.vector("line_of_sight")
+    if los is not None and not float(np.linalg.norm(los)) > 0.0:
+        raise ot.error("line_of_sight", "must not be zero")
+    spec = ObserveSpec(
+        t_end=t_end, line_of_sight=None if los is None else tuple(float(x) for x in los),
+        distance_cm=ot.number("distance_cm", 1.0, positive=True, within=DISTANCE_CM),
+        power_factor=ot.number("power_factor", 2.0, within=(1.0001, 1e6, "a ratio above 1")),
+        frequency_resolution=ot.number("frequency_resolution", 0.01, within=(1e-12, 0.5, "a relative difference")),
+        polarization_deg=ot.number("polarization_deg", 5.0, within=(0.01, 89.0, "degrees")))
+    ot.finish()
     return spec
 
 

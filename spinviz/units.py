@@ -23,6 +23,9 @@ C_LIGHT = 2.99792458e10          # speed of light, cm/s (exact)
 DEBYE = 1.0e-18                  # 1 D in statC cm
 AMU = 1.66053906660e-24          # atomic mass unit, g (CODATA 2018)
 NM = 1.0e-7                      # 1 nm in cm
+HBAR = 1.054571817e-27           # reduced Planck constant, erg s (CODATA 2018, exact since 2019)
+ERG_PER_S_IN_W = 1.0e-7          # 1 erg/s in W
+STATV_PER_CM_IN_V_PER_M = 2.99792458e4   # 1 statV/cm in V/m (c / 1e4 in SI digits)
 
 # --- time ------------------------------------------------------------------------------
 MINUTE = 60.0
@@ -115,3 +118,54 @@ def format_time(t: float, units: str) -> str:
 def format_omega(w: float, units: str) -> str:
     """|Omega| in rad/s (CGS), or |omega| in 1/tau0 (dimensionless)."""
     return f"|\u03a9| = {w:.3g} rad/s" if units == "cgs" else f"|\u03c9| = {w:.3g} /\u03c40"
+
+
+# --- radiation (the observables of ``physics.radiation``) ----------------------------------
+# Each quantity is computed in the variables (4.1) with the coupling g = sqrt(2/3c^3) d of unit
+# size, so (2/3c^3) d^2 = I1 tau0 = 1; back in CGS it carries I1^a tau0^b (and |d| for the dipole).
+RADIATION_UNITS = {
+    # kind: (power of I1, power of tau0, CGS unit, dimensionless unit)
+    "power": (1, -3, "erg/s", "I1/tau0^3"),
+    "power_per_sr": (1, -3, "erg/s/sr", "I1/tau0^3/sr"),
+    "torque": (1, -2, "erg", "I1/tau0^2"),
+    "energy": (1, -2, "erg", "I1/tau0^2"),
+    "angular_momentum": (1, -1, "erg s", "I1/tau0"),
+}
+DIPOLE_UNITS = ("statC cm", "statC cm/s", "statC cm/s^2", "statC cm/s^3")
+
+
+def radiation_from_dimensionless(x, kind: str, inertia1: float, tau0: float):
+    """A radiation quantity of ``kind`` (a key of ``RADIATION_UNITS``) from the variables (4.1)
+    (g of unit size) to CGS: times I1^a tau0^b.  Dimensionless bodies (I1 relative, tau0 = 1)
+    pass through unchanged up to I1."""
+    a, b, _, _ = RADIATION_UNITS[kind]
+    return np.asarray(x, dtype=float) * (float(inertia1) ** a) * (float(tau0) ** b)
+
+
+def radiation_unit(kind: str, units: str) -> str:
+    """The unit label of a radiation quantity in a unit system ("cgs" or "dimensionless")."""
+    cgs_unit, dimless_unit = RADIATION_UNITS[kind][2:]
+    return cgs_unit if units == "cgs" else dimless_unit
+
+
+def frequency_hz(angular_rate):
+    """An angular rate (rad/s) as a frequency, Hz: f = Omega / 2 pi."""
+    return np.asarray(angular_rate, dtype=float) / (2.0 * math.pi)
+
+
+def field_rms_from_power_per_sr(power_per_sr_cgs, distance_cm: float):
+    """RMS far field, statV/cm, at ``distance_cm`` from a source radiating dP/dOmega (erg/s/sr)
+    towards the observer: the Poynting flux c <E^2> / 4 pi equals dP/dOmega / R^2."""
+    return np.sqrt(4.0 * math.pi * np.asarray(power_per_sr_cgs, dtype=float) / C_LIGHT) / float(distance_cm)
+
+
+def format_frequency(f_hz: float) -> str:
+    """A frequency in its best unit: mHz .. THz."""
+    f = float(f_hz)
+    a = abs(f)
+    if not math.isfinite(f) or a == 0.0:
+        return f"{f:.3g} Hz"
+    for scale, name in ((1e12, "THz"), (1e9, "GHz"), (1e6, "MHz"), (1e3, "kHz"), (1.0, "Hz")):
+        if a >= scale:
+            return f"{f / scale:.4g} {name}"
+    return f"{f * 1e3:.3g} mHz"

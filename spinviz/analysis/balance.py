@@ -86,14 +86,14 @@ class BalanceRun:
 def balance_run(body: Body, model: str, eps: float, direction=(0.3, 0.5, 0.8), euler0=(0.3, 1.1, -0.4),
                 turns: float = 20.0, rtol: float = 1e-12, atol: float = 1e-14) -> BalanceRun:
     """Integrate ``model`` for ``turns`` turns at tau0 |Omega0| = ``eps`` (dimensionless body)
-    with lie-dop853 and measure the balance residuals (module docstring)."""
+    with taylor and measure the balance residuals (module docstring)."""
     if body.units != "dimensionless":
         raise ValueError("balance_run works in the variables (4.1): give a dimensionless body")
     w0 = eps * np.asarray(direction, dtype=float) / np.linalg.norm(direction)
     t_end = turns * 2.0 * math.pi / eps
     t, wt, ends = quadrature_times(t_end, int(round(turns * PANELS_PER_TURN)))
     start = time.perf_counter()
-    tr = simulate(body, model, w0, t_eval=t, euler_zxz0=euler0, method="lie-dop853", rtol=rtol, atol=atol)
+    tr = simulate(body, model, w0, t_eval=t, euler_zxz0=euler0, method="taylor", rtol=rtol, atol=atol)
     runtime = time.perf_counter() - start
     s = body.system(model)
     b = RA.balance(model, tr.omega, s.inertia, s.coupling)

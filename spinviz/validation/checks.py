@@ -370,7 +370,7 @@ def check_balance_2_4a(epsilons=BALANCE_EPS) -> CheckResult:
     """(2.4a): the truncated equation (2.5) is the balance dL/dt = -(2/3c^3) d_dot x d_ddot solved
     for Omega_dot, so along an integrated run L(t) - L(0) must equal the integral of the flux to
     the integrator's error.  Askew symmetric and asymmetric bodies, tau0 |Omega0| = 1e-2 .. 1e-4,
-    20 turns (lie-dop853, rtol 1e-12); residual relative to the largest |L(t) - L(0)|.
+    20 turns (taylor, rtol 1e-12); residual relative to the largest |L(t) - L(0)|.
 
     Criterion rtol / eps: the integrator's error is ~rtol |L| while |L(t) - L(0)| ~ eps |L| per
     turn (measured 0.005-0.05 rtol / eps)."""

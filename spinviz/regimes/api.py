@@ -215,6 +215,9 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
                 finally:
                     writer.close()
                     bar.finish()
+                    if stats is not None:
+                        stats.write_s, stats.checksum_s = writer.write_s, writer.checksum_s
+                        stats.chunk_writes = writer.chunk_writes
                 if stats.incomplete is not None and stats.incomplete.cluster_lost:
                     cl.close(fast=True)            # no point waiting for a cluster that is gone
         elif not exists:                           # an empty plan and no store: cannot happen

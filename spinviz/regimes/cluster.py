@@ -90,11 +90,16 @@ class WarmUp(WorkerPlugin):
         RN.warm()
 
 
-def polled(fn, *args, **kwargs):
+class GaveUp(Exception):
+    """``polled``'s ``give_up`` said the call can no longer succeed."""
+
+
+def polled(fn, *args, give_up=None, **kwargs):
     """``fn(*args, **kwargs)`` in a helper thread while this one waits in ``POLL_S`` slices,
     looking at ``interrupt.check()``: a blocking Dask call (connect, gather, an RPC) never
-    holds a stop signal back.  On a stop the helper is abandoned (a daemon thread; whatever
-    it waits for fails when the client closes)."""
+    holds a stop signal back.  ``give_up()``, if given, is asked at each slice too: when it
+    says so, ``GaveUp`` is raised.  An abandoned helper is a daemon thread: whatever it waits
+    for returns or fails on its own (at the latest when the client closes)."""
     box: dict = {}
     done = threading.Event()
 
@@ -109,6 +114,8 @@ def polled(fn, *args, **kwargs):
     threading.Thread(target=run, name="spinviz-dask-call", daemon=True).start()
     while not done.wait(POLL_S):
         check()
+        if give_up is not None and give_up():
+            raise GaveUp
     if "error" in box:
         raise box["error"]
     return box["value"]
@@ -284,8 +291,11 @@ class Cluster:
         self.close(fast=kind is not None)
 
 
-def _kill_workers(cluster) -> None:
-    """SIGKILL the LocalCluster's worker processes, after telling their nannies not to restart them."""
+def _kill_workers(cluster, wait_s: float = 0.5) -> None:
+    """SIGKILL the LocalCluster's worker processes, after telling their nannies not to restart
+    them, and wait (at most ``wait_s``) until they are reaped (Dask's watcher threads join
+    them): no process of the command outlives it, not even as a zombie."""
+    pids = []
     for nanny in list(getattr(cluster, "workers", {}).values()):
         with contextlib.suppress(Exception):
             nanny.close_gracefully()
@@ -293,6 +303,12 @@ def _kill_workers(cluster) -> None:
             pid = nanny.process.process.pid if nanny.process is not None and nanny.process.process is not None else None
             if pid:
                 os.kill(pid, signal.SIGKILL)
+                pids.append(pid)
+    end = time.monotonic() + wait_s
+    while pids and time.monotonic() < end:
+        pids = [p for p in pids if os.path.exists(f"/proc/{p}")]
+        if pids:
+            time.sleep(0.01)
 
 
 class _Monitor:
@@ -392,6 +408,9 @@ class Stats:
     max_rss_mb: dict = field(default_factory=dict)        # worker pid -> peak RSS, MiB
     task_compute_s: list = field(default_factory=list)
     incomplete: Incomplete | None = None
+    write_s: float = 0.0                                  # the client writing the store (data, done, checksums)
+    checksum_s: float = 0.0                               # of which: hashing the chunk files, recording the sums
+    chunk_writes: int = 0
 
     @property
     def overhead_share(self) -> float:
@@ -439,6 +458,7 @@ def execute(cluster: Cluster, batches: list, keys: list, writer, progress: Progr
     todo = list(range(len(batches)))
     todo.reverse()
     in_flight = {}
+    relost = {}                                   # futures whose result was lost after it finished
     arrived: queue.Queue = queue.Queue()
     not_done = 0                                  # runs of tasks that did not finish
     cause = None
@@ -459,20 +479,28 @@ def execute(cluster: Cluster, batches: list, keys: list, writer, progress: Progr
             try:
                 f = arrived.get(timeout=POLL_S)
             except queue.Empty:
-                problem = cluster.problem()
-                if problem:
-                    cause, cluster_lost = problem, True
-                    break
-                continue
+                f = next((g for g in relost.values() if g.status in ("finished", "error", "cancelled")), None)
+                if f is None:
+                    problem = cluster.problem()
+                    if problem:
+                        cause, cluster_lost = problem, True
+                        break
+                    continue
             if f.key not in in_flight:
                 continue
-            _, i = in_flight.pop(f.key)
+            relost.pop(f.key, None)
             res = None
             if f.status == "finished":
-                try:
-                    res = polled(f.result)
-                except Exception:                  # finished, then lost with its worker before the gather
+                try:                               # its worker may die before the gather
+                    res = polled(f.result, give_up=lambda f=f: f.status != "finished" or cluster.problem())
+                except Exception:
                     res = None
+            if res is None and f.status not in ("error", "cancelled"):
+                # the result was lost with its worker: the scheduler recomputes it (we hold the
+                # future); it is "lost" or "pending" until then, and its callback has fired already
+                relost[f.key] = f
+                continue
+            i = in_flight.pop(f.key)[1]
             if res is None:
                 problem = cluster.problem()
                 if problem:                        # the scheduler went away: every task in flight is lost

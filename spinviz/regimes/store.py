@@ -249,6 +249,7 @@ class Writer:
         self.written_runs = 0
         self.write_s = 0.0                    # wall time inside _write (data, done, checksums)
         self.checksum_s = 0.0                 # of which: hashing and recording the checksums
+        self.chunk_writes = 0
 
     def add(self, chunk_key, result: dict) -> None:
         p = self.pending.setdefault(chunk_key, _Pending([], time.monotonic(), self.expected[chunk_key]))
@@ -291,6 +292,7 @@ class Writer:
             IN.record(self.path, RUN_VARIABLES, key, int(done.sum()))
             self.checksum_s += time.perf_counter() - t1
         self.written_runs += int(new.sum())
+        self.chunk_writes += 1
         self.write_s += time.perf_counter() - t0
 
 

@@ -252,6 +252,7 @@ def _resume(spec: AtlasSpec, out: str, say) -> tuple:
     if rep.skeleton is None:
         if not os.path.exists(os.path.join(out, ".zgroup")):
             raise UsageError(f"{out}: exists and is not an atlas store (no .zgroup); choose another store path")
+        ST.check_identity(spec, out)                 # another Zarr store, or another spec: said as such
         raise StoreDamaged(f"{out}: carries no checksums (made by an earlier spinviz, or its {IN.DIR} was deleted), "
                            f"so its runs cannot be trusted; move it away and compute the atlas again")
     if rep.skeleton:

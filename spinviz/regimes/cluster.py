@@ -340,6 +340,7 @@ class _Monitor:
 
     def stop(self) -> None:
         self._stop.set()
+        self._thread.join(0.2)                     # an RPC in progress fails when the client closes
 
 
 # --- progress ------------------------------------------------------------------------------

@@ -181,13 +181,13 @@ def check_identity(spec, path: str) -> None:
     try:
         attrs = dict(zarr.open_group(path, mode="r", zarr_format=2).attrs)
     except Exception as e:                             # not a Zarr group at all
-        raise UsageError(f"{path}: exists and is not an atlas store ({type(e).__name__}); choose another --out") from None
+        raise UsageError(f"{path}: exists and is not an atlas store ({type(e).__name__}); choose another store path") from None
     if "spec_sha256" not in attrs:
-        raise UsageError(f"{path}: exists and is not an atlas store (no spec_sha256); choose another --out")
+        raise UsageError(f"{path}: exists and is not an atlas store (no spec_sha256); choose another store path")
     if attrs["spec_sha256"] != spec.identity():
         what = "the same spec from another classifier version" if _same_spec(attrs, spec) else "another spec"
         raise UsageError(f"{path}: holds an atlas of {what} (sha256 {attrs['spec_sha256'][:12]}, this spec "
-                         f"{spec.identity()[:12]}); refusing to mix them: choose another --out or delete it")
+                         f"{spec.identity()[:12]}); refusing to mix them: choose another store path or delete it")
 
 
 def _same_spec(attrs: dict, spec) -> bool:

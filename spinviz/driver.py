@@ -300,7 +300,7 @@ def solve_many(model: str, inertia: list, coupling: list, omega0: list, tau, *, 
     n = len(omega0)
     eta = np.zeros(n) if residual_eta is None else np.asarray(residual_eta, dtype=float)
     runs: list[Run | None] = [None] * n
-    groups: dict = {}
+    todo = []
     for i in range(n):
         system = System(model, tuple(map(float, inertia[i])), tuple(map(float, coupling[i])))
         w0 = np.asarray(omega0[i], dtype=float)
@@ -308,22 +308,22 @@ def solve_many(model: str, inertia: list, coupling: list, omega0: list, tau, *, 
             runs[i] = _singular_run(tau, w0, truncated_margin(system, w0), singular_margin)
             continue
         prob, eps = spin_problem(system, w0, tau, kinematics="none")
-        groups.setdefault(eps, []).append((i, prob))
-    for eps, members in groups.items():
-        t0 = time.perf_counter()
-        idx = [i for i, _ in members]
-        probs = [p for _, p in members]
-        if method == "taylor" and model != "free" and all(_atlas_body(p.system) for p in probs):
-            from .integrators.taylor import solve_batch
+        todo.append((i, prob, eps))
+    if not todo:
+        return runs
+    t0 = time.perf_counter()
+    probs = [p for _, p, _ in todo]
+    if method == "taylor" and model != "free" and all(_atlas_body(p.system) for p in probs):
+        from .integrators.taylor import solve_batch
 
-            results = [(r.omega, r.status, r.reached, r.t_stop, r.nsteps)
-                       for r in solve_batch(probs, rtol, max_steps, eta[idx], stop)]
-        else:
-            results = [_one_by_one(p, method, rtol, max_steps) for p in probs]
-        share = (time.perf_counter() - t0) / len(members)
-        for i, (w, st, reached, t_stop, nsteps) in zip(idx, results):
-            runs[i] = Run(tau, w * eps, int(st), int(reached), t_stop / eps, int(nsteps), share,
-                          _reason(st, tau, reached, t_stop / eps))
+        results = [(r.omega, r.status, r.reached, r.t_stop, r.nsteps)
+                   for r in solve_batch(probs, rtol, max_steps, eta[[i for i, _, _ in todo]], stop)]
+    else:
+        results = [_one_by_one(p, method, rtol, max_steps) for p in probs]
+    share = (time.perf_counter() - t0) / len(todo)
+    for (i, _, eps), (w, st, reached, t_stop, nsteps) in zip(todo, results):
+        runs[i] = Run(tau, w * eps, int(st), int(reached), t_stop / eps, int(nsteps), share,
+                      _reason(st, tau, reached, t_stop / eps))
     return runs
 
 

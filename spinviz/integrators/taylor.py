@@ -458,8 +458,9 @@ def solve_batch(problems: list[Problem], rtol: float, max_steps: int = MAX_STEPS
                 stop=None) -> list[BatchRun]:
     """Euler-only runs (kinematics "none") of symmetric tops (J = (1, 1, 1 - delta), g in the
     e1-e3 plane) of one model, ``width()`` at a time in heyoka's batch integrator on the
-    symmetric form (4.2)-(4.4) (or its truncated analogue), all on the same output grid
-    ``problems[0].t_eval`` (spin units each).
+    symmetric form (4.2)-(4.4) (or its truncated analogue); each run has its own output grid
+    ``t_eval`` (spin units: the same tau grid is a different t grid for each |omega0|), all of
+    one length.
 
     residual_eta : per problem, eta > 0 to stop at the residual rotation |d x omega| < eta
         |d||omega| (the atlas passes it where that rotation is the exact end state), else 0.
@@ -477,10 +478,10 @@ def solve_batch(problems: list[Problem], rtol: float, max_steps: int = MAX_STEPS
     if not problems:
         return []
     model = problems[0].system.model
-    t = np.asarray(problems[0].t_eval, dtype=float)
+    N = len(problems[0].t_eval)
     for p in problems:
-        if p.system.model != model or p.kinematics != "none" or p.t_eval.shape != t.shape or np.any(p.t_eval != t):
-            raise ValueError("a batch holds Euler-only runs of one model on one output grid")
+        if p.system.model != model or p.kinematics != "none" or len(p.t_eval) != N:
+            raise ValueError("a batch holds Euler-only runs of one model on output grids of one length")
     eta = np.zeros(len(problems)) if residual_eta is None else np.asarray(residual_eta, dtype=float)
     tol, _ = tolerance(rtol, rtol)
     n = width()
@@ -492,7 +493,7 @@ def solve_batch(problems: list[Problem], rtol: float, max_steps: int = MAX_STEPS
     for (residual, runaway), idx in groups.items():
         for a in range(0, len(idx), n):
             part = idx[a:a + n]
-            res = _one_batch([problems[i] for i in part], eta[part], t, model, tol, n, max_steps, stop,
+            res = _one_batch([problems[i] for i in part], eta[part], model, tol, n, max_steps, stop,
                              residual, runaway)
             for i, r in zip(part, res):
                 out[i] = r
@@ -503,8 +504,9 @@ RUNAWAY_RISK = 1.0         # tau0 |Omega0| above which a batch compiles in the r
 CHUNK = 24                 # samples a batch advances between looks at the stop flag and the budgets
 
 
-def _one_batch(probs, eta, t, model, tol, n, max_steps, stop, residual, runaway) -> list[BatchRun]:
+def _one_batch(probs, eta, model, tol, n, max_steps, stop, residual, runaway) -> list[BatchRun]:
     k = len(probs)
+    t = np.array([np.asarray(probs[min(j, k - 1)].t_eval, dtype=float) for j in range(n)])   # (lane, sample)
     ta = copy.copy(template(model, "none", tol, "double", n, symmetric=True, residual=residual, runaway=runaway))
     npar = ta.pars.shape[0]
     pars = np.zeros((N_PARS_SYMMETRIC, n))
@@ -514,15 +516,15 @@ def _one_batch(probs, eta, t, model, tol, n, max_steps, stop, residual, runaway)
         state[:, i] = p.omega0
     pars[:, k:] = pars[:, :1]
     pars[S_ETA2, k:] = 0.0                       # idle lanes: the first body, at rest (a fixed point)
-    ta.set_time(np.full(n, t[0]))
+    ta.set_time(t[:, 0].copy())
     ta.state[:] = state
     ta.pars[:] = pars[:npar]
-    N = len(t)
+    N = t.shape[1]
     y = np.full((N, 3, n), np.nan)
     y[0] = state
     nxt = np.ones(n, dtype=int)                  # next grid index per lane
     status = np.full(n, ST.OK)
-    t_stop = np.full(n, t[-1])
+    t_stop = t[:, -1].copy()
     live = np.arange(n) < k
     steps = np.zeros(n, dtype=np.int64)
     while live.any():
@@ -557,23 +559,23 @@ def _one_batch(probs, eta, t, model, tol, n, max_steps, stop, residual, runaway)
             ta.pars[:] = p
     out = []
     for i in range(k):
-        w = y[:, :, i] / np.sqrt(1.0 + float(pars[S_C, i]) * t)[:, None]
+        w = y[:, :, i] / np.sqrt(1.0 + float(pars[S_C, i]) * t[i])[:, None]
         out.append(BatchRun(w, int(status[i]), int(nxt[i]), float(t_stop[i]), int(steps[i])))
     return out
 
 
 def _restart_grid(t, nxt, times, live, chunk):
     """The output grid of the next stretch of a batch: lane j from its own time through up to
-    ``chunk`` of its next samples t[nxt[j]:], padded by steps of 1e-9 of its last time (heyoka
-    wants one strictly increasing column per lane, all of one length).  Returns (grid (M, n),
-    rows: lane -> the sample indices of grid rows 1..)."""
-    n = len(nxt)
-    M = 1 + max((min(chunk, len(t) - int(nxt[j])) for j in range(n) if live[j]), default=1)
+    ``chunk`` of its next samples t[j, nxt[j]:], padded by steps of 1e-9 of its last time
+    (heyoka wants one strictly increasing column per lane, all of one length).  Returns
+    (grid (M, n), rows: lane -> the sample indices of grid rows 1..)."""
+    n, N = t.shape
+    M = 1 + max((min(chunk, N - int(nxt[j])) for j in range(n) if live[j]), default=1)
     grid = np.empty((M, n))
     rows = {}
     for j in range(n):
-        idx = np.arange(nxt[j], min(len(t), nxt[j] + chunk)) if live[j] else np.arange(0)
-        col = np.concatenate([[times[j]], t[idx]])
+        idx = np.arange(nxt[j], min(N, nxt[j] + chunk)) if live[j] else np.arange(0)
+        col = np.concatenate([[times[j]], t[j, idx]])
         pad = M - len(col)
         if pad:
             end = max(col[-1], times[j])

@@ -96,18 +96,18 @@ def scene_text(sp: Spec, method: str, kw: dict) -> str:
 
 
 def configs(sp: Spec, quick: bool) -> list:
-    """(label, method, settings) of every point: each registered method where it applies."""
+    """(method, settings) of every point: each registered method where it applies."""
     period = 2.0 * math.pi / float(np.linalg.norm(sp.omega0))
     tols = (1e-6, 1e-8, 1e-10, 1e-12, 1e-13) if not quick else (1e-8, 1e-10, 1e-13)
-    out = [("spinviz", "taylor", {"rtol": r, "atol": r * 1e-2}) for r in tols]
-    out.append(("spinviz", "taylor-long", {"rtol": 1e-16, "atol": 1e-18}))
-    out += [("spinviz", "dop853", {"rtol": r, "atol": r * 1e-2}) for r in ((1e-8, 1e-10, 1e-12) if not quick else (1e-10,))]
+    out = [("taylor", {"rtol": r, "atol": r * 1e-2}) for r in tols]
+    out.append(("taylor-long", {"rtol": 1e-15, "atol": 1e-17}))
+    out += [("dop853", {"rtol": r, "atol": r * 1e-2}) for r in ((1e-8, 1e-10, 1e-12) if not quick else (1e-10,))]
     if not quick:
-        out += [("spinviz", "rk45", {"rtol": r, "atol": r * 1e-2}) for r in (1e-6, 1e-8)]
-        out += [("spinviz", m, {"rtol": 1e-6, "atol": 1e-8}) for m in ("radau", "bdf", "lsoda")]
+        out += [("rk45", {"rtol": r, "atol": r * 1e-2}) for r in (1e-6, 1e-8)]
+        out += [(m, {"rtol": 1e-6, "atol": 1e-8}) for m in ("radau", "bdf", "lsoda")]
         if sp.symmetric:
-            out += [("spinviz", m, {"step": period / 4}) for m in ("split2", "split4", "split6", "split8")]
-            out.append(("spinviz", "split8", {"step": period / 16}))
+            out += [(m, {"step": period / 4}) for m in ("split2", "split4", "split6", "split8")]
+            out.append(("split8", {"step": period / 16}))
     return out
 
 
@@ -150,8 +150,9 @@ def run(problems=PROBLEMS, turns: float = 400.0, repeats: int = 3, quick: bool =
             with open(pj, "w") as f:
                 json.dump({"model": sp.model, "inertia": list(sp.inertia), "dipole": list(sp.dipole),
                            "omega0": sp.omega0.tolist(), "q0": list(map(float, sp.q0)), "t": sp.t.tolist()}, f)
-            for k, (who, method, kw) in enumerate(configs(sp, quick)):
-                setting = ", ".join(f"{a}={v:.0e}" if a != "step" else f"step=turn/{2 * math.pi / np.linalg.norm(sp.omega0) / v:.0f}"
+            period = 2.0 * math.pi / float(np.linalg.norm(sp.omega0))
+            for k, (method, kw) in enumerate(configs(sp, quick)):
+                setting = ", ".join(f"{a}={v:.0e}" if a != "step" else f"step=turn/{period / v:.0f}"
                                     for a, v in kw.items() if a != "atol")
                 say(f"{name}: {method} {setting}")
                 scene = os.path.join(tmp, f"{name}_{k}.toml")

@@ -157,11 +157,18 @@ def _below_half(x: float) -> float:
 
 
 def _fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
-    """(slope, RMS residual) of the least-squares line y = a x + b."""
+    """(slope, RMS residual) of the least-squares line y = a x + b (closed form: np.polyfit's
+    SVD costs 25 us a call, and the atlas makes ~14 fits a run)."""
     if len(x) < 2:
         return math.nan, math.nan
-    a, b = np.polyfit(x, y, 1)
-    return float(a), float(np.sqrt(np.mean((y - (a * x + b)) ** 2)))
+    dx = x - x.mean()
+    dy = y - y.mean()
+    sxx = float(dx @ dx)
+    if sxx == 0.0:
+        return math.nan, math.nan
+    a = float(dx @ dy) / sxx
+    r = dy - a * dx
+    return a, math.sqrt(float(r @ r) / len(x))
 
 
 def gap(phi: np.ndarray) -> tuple[float, float]:

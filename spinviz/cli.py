@@ -103,6 +103,9 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--quick", action="store_true", help="two problems, 1e2 and 1e4 turns, fewer settings (~2 min)")
     b.add_argument("--json", metavar="PATH", help="also write rows and summary as JSON")
     b.add_argument("--plot", metavar="PATH", help="also draw error against time, log-log, one line per method (PNG)")
+    b.add_argument("--process", action="store_true",
+                   help="time whole processes (spinviz simulate, and the standalone heyoka and scipy scripts of "
+                        "benchmarks/) instead of in-process runs, at ~400 turns (~5 min; --quick ~1 min)")
 
     st = sub.add_parser("stress", help="stiff and extreme cases: pass/fail, error, time, and the method the driver picked")
     st.add_argument("--json", action="store_true", help="print a JSON list of records instead of a table")
@@ -488,6 +491,16 @@ def _cmd_bench(args) -> int:
     from .atomic import write_json
     from .validation import bench
 
+    if args.process:
+        from .validation import process_bench as PB
+
+        pts = PB.run(quick=args.quick, progress=_progress)
+        print(PB.format_table(pts))
+        if args.json:
+            write_json(args.json, {"points": [p.record() for p in pts], "headline": PB.headline(pts)})
+        if args.plot:
+            PB.plot(pts, args.plot)
+        return EXIT_OK
     plan = bench.quick_plan() if args.quick else bench.Plan()
     rows = bench.run(plan, progress=_progress)
     summ = bench.summary(rows)

@@ -96,13 +96,16 @@ def test_classifier_synthetic_noise_tolerated_then_refused(rng):
 
 
 def test_classifier_never_forces_a_label():
-    """A decay slower than any type (tau^-0.3), a hand-over in mid-window and a stopped phase
-    that is not (3.9) are "other", each with its best candidate named."""
+    """A decay slower than any type (tau^-0.3) and a stopped phase that is not (3.9) are
+    "other"; a hand-over from type 2 to type 1 in mid-window (omega_perp from tau^-0.6 to
+    tau^-1, the phase stopping) is "approaching" type 1, below the confidence of a label --
+    a slow hand-over said as such, neither "other" nor the type it has not reached."""
     slow = C.classify(TAU, polar(0.5 * TAU**-0.3, 3 * np.sqrt(TAU), 0.5 * TAU**-0.3), 0.5, 0.7)
-    assert slow.label == "other"
+    assert slow.label == "other" and slow.candidate == "none"
     hand = polar(np.where(TAU < 1e9, 0.3 * TAU**-0.6, 0.3 * 1e9**-0.6 * (TAU / 1e9) ** -1.0),
                  3 * np.sqrt(TAU) * (TAU < 1e9) + 1.5 * (TAU >= 1e9), 1.3 / np.sqrt(TAU))
-    assert C.classify(TAU, hand, 0.5, 0.38).label == "other"
+    v = C.classify(TAU, hand, 0.5, 0.38)
+    assert v.label == "approaching" and v.candidate == "1" and v.confidence < C.MIN_CONFIDENCE
     frozen = C.classify(TAU, polar(0.7 / np.sqrt(TAU), np.ones_like(TAU), 1e-3 * TAU**-1.5), 0.5, 0.7)
     assert frozen.label == "other" and frozen.candidate == "3.9" and "not (3.9)" in frozen.reason
 

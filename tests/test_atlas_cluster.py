@@ -79,7 +79,7 @@ def test_store_opens_with_plain_xarray(reference):
     assert spec["members"]["seed"] == 5 and ds.attrs["seed"] == 5 and ds.attrs["spinviz_version"]
     meanings = dict(zip(ds["regime"].attrs["flag_values"], ds["regime"].attrs["flag_meanings"].split()))
     labels = {meanings[c] for c in np.unique(ds["regime"].values)}
-    assert labels <= {"1", "2", "3", "4", "5", "T2", "T4", "Tcone", "TF", "other"}
+    assert labels <= {"1", "2", "3", "4", "5", "T2", "T4", "Tcone", "TF", "approaching", "other"}
     full = store.open_atlas(reference)
     # (0.5, 45 deg) reduced: the capture into type 5 happens by 1e8 at |omega0| = 0.05
     assert (full["label"].sel(model="reduced", delta=0.5).isel(chi=1).values == "5").sum() >= 2

@@ -26,8 +26,9 @@ from . import formulas as FM
 
 COLORS = {"1": "#1f5fa8", "2": "#8fc1e3", "3": "#3a9a3a", "4": "#f08c1e", "5": "#d62728", "3.9": "#8c564b",
           "R": "#7f7f7f", "T2": "#8fc1e3", "Tcone": "#3a9a3a", "T4": "#f08c1e", "TF": "#8c564b", "T1": "#1f5fa8",
-          "T5": "#d62728", "other": "#e4e4e4", "1|2": "#e4e4e4", "4|5": "#e4e4e4", "failed": "#111111", "missing": "#ffffff"}
-ORDER = ("1", "2", "3", "4", "5", "3.9", "R", "T2", "Tcone", "T4", "TF", "other", "failed", "missing")
+          "T5": "#d62728", "other": "#e4e4e4", "1|2": "#e4e4e4", "4|5": "#e4e4e4", "approaching": "#b0b0b0",
+          "failed": "#111111", "missing": "#ffffff"}
+ORDER = ("1", "2", "3", "4", "5", "3.9", "R", "T2", "Tcone", "T4", "TF", "approaching", "other", "failed", "missing")
 
 
 def hodograph_path(path: str) -> str:

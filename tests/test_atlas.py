@@ -399,3 +399,25 @@ def test_type_3_is_the_fixed_point_of_4_12_and_how_fast_it_attracts(delta, chi, 
     assert x == pytest.approx(f["A2"], rel=1e-12) and y == pytest.approx(f["B2"], rel=1e-12)
     jac = np.array([[-2 * a * x, -2 * b * x], [-2 * c * y, -2 * e * y]])
     assert sorted(np.linalg.eigvals(jac).real) == pytest.approx([-1.0, slow], abs=1e-4)
+
+
+PHYSICAL_POINTS = [  # one point per domain of figure 2 (reduced) and per truncated type
+    ("1", "reduced", -0.6, 17.2), ("2", "reduced", 0.5, 22.0), ("3", "reduced", 0.8, 11.4), ("4", "reduced", 0.5, 39.0),
+    ("5", "reduced", 0.8, 68.8), ("T2", "truncated", -0.6, 60.0), ("T4", "truncated", 0.5, 22.0),
+    ("Tcone", "truncated", -0.3, 20.0), ("TF", "truncated", 0.8, 68.8),
+]
+
+
+@pytest.mark.parametrize("name,model,delta,chi_deg", PHYSICAL_POINTS, ids=[p[0] for p in PHYSICAL_POINTS])
+def test_dimensionless_atlas_runs_match_physical_unit_simulate(name, model, delta, chi_deg):
+    """Issue 18.4: the atlas's (4.2)-(4.4) (or the truncated analogue), dimensionless, in
+    heyoka's batch mode, against spinviz.simulate on a CGS body with the same delta, chi and
+    tau0 = 1e-20 s (Omega0 ~ 1e19 rad/s), the general (2.2)+(2.3) or (2.5), mapped through
+    (4.1): every sample within 1e-7 relative to tau = 1e6 (both at rtol 1e-10; measured <= 3e-9
+    to tau = 1e8, python -m spinviz.regimes.physical_check)."""
+    from spinviz.regimes import physical_check as PC
+
+    rows = PC.compare([(name, model, delta, chi_deg)], members=2, tau_end=1e6)
+    for r in rows:
+        assert r["end_rel_diff"] < 1e-7, r
+        assert r["label_atlas"] == r["label_physical"], r

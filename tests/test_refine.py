@@ -39,7 +39,6 @@ def test_refinement_resolves_a_known_boundary_to_the_stated_width():
     maj, comp = run_levels(levels)
     fine = comp[levels]
     nd, nc = fine.shape
-    dd = RF.centres(-1.0, 1.0, 8, levels)
     assert RF.width(-1.0, 1.0, 8, levels) == 0.25 / 8 and RF.width(0.0, 90.0, 8, levels) == 11.25 / 8
     for d in np.linspace(-0.999, 0.999, 997):
         i = int((d + 1.0) / 2.0 * nd)

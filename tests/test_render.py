@@ -268,7 +268,7 @@ def test_render_command_errors_are_one_line(tmp_path, capsys):
     bad.write_text(ASKEW.format(models='model = "reduced"', show='["dipole", "halo"]', w=64, h=48))
     assert main(["render", str(bad)]) == 2
     assert capsys.readouterr().err.strip() == f"spinviz: error: {bad}: [render].show: unknown item 'halo'; valid: " \
-        "body, dipole, omega, L, axes, trail, sphere, hud, hodograph, inset"
+        "body, dipole, omega, L, axes, trail, sphere, hud, hodograph, inset, power"
     assert not any(p.suffix == ".mp4" for p in tmp_path.iterdir())
 
 

@@ -134,8 +134,9 @@ class Layout:
 
 @dataclass
 class _Wants:
-    """What the bands need, measured once: which are wanted, the wrapped subtitles, the lines
-    of numbers and notes, the legend's chips and the inset's plots."""
+    """What the bands need, measured once: which are wanted, the wrapped subtitles (on up to
+    two lines, and on one), the lines of numbers and notes, the legend's chips and the inset's
+    plots."""
 
     wanted: dict
     subtitles: list
@@ -144,6 +145,7 @@ class _Wants:
     legend: list
     sub_lines: int = 2
     plots: tuple = ()
+    short_subtitles: list = field(default_factory=list)
 
 
 def make_layout(plan, texts, metrics: TextMetrics) -> Layout:
@@ -172,12 +174,12 @@ def make_layout(plan, texts, metrics: TextMetrics) -> Layout:
     steps = DROP_ORDER if want.wanted["inset"] else tuple(x for x in DROP_ORDER if x != "subtitle2")
     for drop in (None, *steps):
         if drop == "subtitle2":
-            want.sub_lines = 1
+            # one line each, re-wrapped so that a cut subtitle ends with "…" (not mid-sentence)
+            want.sub_lines, want.subtitles = 1, want.short_subtitles
         elif drop == "notes2":
             want.notes_rows = 1
         elif drop:
             want.wanted[drop] = False
-        want.subtitles = [s[:want.sub_lines] for s in want.subtitles]
         top, rows, bottom = _bands(want, sizes, pad)
         if H - top - bottom >= (MIN_VIEW_INSET if want.wanted["inset"] else MIN_VIEW) * H:
             break
@@ -204,6 +206,7 @@ def _measure(plan, texts, metrics: TextMetrics, show, W: int, pad: int) -> _Want
     n = len(plan.panels)
     hud_on = "hud" in show
     subtitles = [wrap(texts.subtitles[k], metrics, W // n - 2 * pad) for k in range(n)]
+    short = [wrap(texts.subtitles[k], metrics, W // n - 2 * pad, lines=1) for k in range(n)]
     notes_n = len(texts.notes[0])
     F = plan.frames
     sample = sorted(set(np.linspace(0, F - 1, min(F, 24)).round().astype(int)))
@@ -213,7 +216,8 @@ def _measure(plan, texts, metrics: TextMetrics, show, W: int, pad: int) -> _Want
               "timebar": hud_on, "notes": hud_on and notes_n > 0, "title": hud_on and bool(texts.footer),
               "inset": bool(plots)}
     return _Wants(wanted=wanted, subtitles=subtitles, readout_lines=max(len(texts.readouts[k][0]) for k in range(n)),
-                  notes_rows=1 if joined <= W - 2 * pad else notes_n, legend=texts.legend, plots=plots)
+                  notes_rows=1 if joined <= W - 2 * pad else notes_n, legend=texts.legend, plots=plots,
+                  short_subtitles=short)
 
 
 def _bands(want: _Wants, sizes: TextSizes, pad: int) -> tuple[int, list[Row], int]:

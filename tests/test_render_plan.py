@@ -405,6 +405,22 @@ def test_small_frames_drop_the_power_inset_and_keep_text_apart():
     assert len(subtitle) == 1 and subtitle[0].endswith("…"), subtitle
 
 
+@pytest.mark.parametrize("size, kept", [((720, 720), ("angle", "omega")), ((1080, 1920), ("angle",))])
+def test_a_narrow_frame_keeps_the_plots_that_fit(size, kept):
+    """Type scales with the height, so a square or portrait frame has room for fewer plots side
+    by side: the rightmost go first, and each kept plot's title stays inside its own column --
+    it ends before the next plot's labels begin."""
+    pic = picture_of(made_plan(size=size, show=ALL_SHOWN + ("inset", "power")))
+    inset = pic.overlay.inset
+    assert inset.plots == kept
+    fonts = Fonts(pic.layout.sizes)
+    titles = [t for t in inset.labels if t.text in texts_of(pic.plan).plot_titles.values()]
+    assert len(titles) == len(kept)
+    for (bx0, _, bx1, _), t in zip(inset.boxes, titles):
+        assert t.xy[0] == bx0 and bx0 + fonts.width(t.text) <= bx1, (t.text, inset.boxes)
+    assert picture_of(made_plan(size=size, show=ALL_SHOWN + ("power",))).overlay.inset.plots == ("power",)
+
+
 def test_the_parent_computes_the_power_once_per_trajectory(monkeypatch):
     """plan_frames calls trajectory.radiated_power once per run, with that run sampled at the
     frame times, and keeps its values (erg/s) in the plan: the render workers only draw them.

@@ -9,7 +9,7 @@ and ``overlay`` decide where it goes.  Pure Python and NumPy.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -128,7 +128,8 @@ class Texts:
     the drawn body is a stand-in; footer : the title line; scale : what the time bar's unit is
     ("" without one); bar_ticks : (position 0..1, label) of its marks; readouts : [panel][frame]
     -> lines; time : per frame; notes : per frame -> lines (how time and spin are shown);
-    power : the title of the radiated-power plot ("" when it is not shown).
+    plot_titles : the title of each live plot shown ("angle", "omega" for ``inset``,
+    "power"), in the inset's order.
     """
 
     headings: list
@@ -140,7 +141,7 @@ class Texts:
     readouts: list
     time: list
     notes: list
-    power: str = ""
+    plot_titles: dict = field(default_factory=dict)
 
 
 def texts_of(plan) -> Texts:
@@ -167,7 +168,7 @@ def texts_of(plan) -> Texts:
                  legend=legend, footer=cap.footer(), scale=cap.scale_text(), bar_ticks=cap.bar_ticks(),
                  readouts=[[cap.readouts(k, f) for f in range(F)] for k in range(n)],
                  time=[cap.time_text(f) for f in range(F)], notes=[cap.notes(f) for f in range(F)],
-                 power=cap.power_title() if "power" in show else "")
+                 plot_titles=cap.plot_titles(show))
 
 
 class Captions:
@@ -257,6 +258,17 @@ class Captions:
             else:
                 k = self.spec.knee(plan.t_end)
                 out.append(f"time axis logarithmic after {sim_time(k, plan.units, 'physics')}")
+        return out
+
+    def plot_titles(self, show) -> dict[str, str]:
+        """The titles of the live plots ``show`` asks for: angle(d, L) and |Omega| / |Omega(0)|
+        ("inset"), the radiated power ("power")."""
+        out = {}
+        if "inset" in show:
+            out["angle"] = "∠(d, L)"
+            out["omega"] = "|Ω| / |Ω₀|" if self.cgs else "|ω| / |ω₀|"
+        if "power" in show:
+            out["power"] = self.power_title()
         return out
 
     def power_title(self) -> str:

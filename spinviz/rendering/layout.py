@@ -28,8 +28,13 @@ HEADING_TEXT = 18 / 360
 MIN_BODY_TEXT_PX, MIN_HEADING_TEXT_PX = 8, 9
 # bands dropped in this order until the 3-D view is tall enough (least needed first);
 # "subtitle2" and "notes2" take a band down to one line before it goes
-# the live plots of the inset row, per ``[render].show`` item, left to right
+# the live plots of the inset row, per ``[render].show`` item, left to right; each needs a
+# label column (as wide as PLOT_LABEL_SAMPLE, or its widest tick label), then room for its
+# title and at least PLOT_MIN_WIDTH body-text sizes of plot
 INSET_PLOTS = {"inset": ("angle", "omega"), "power": ("power",)}
+PLOT_LABEL_SAMPLE = "180°"
+PLOT_TICK_SAMPLE = {"power": "10⁻²⁰"}
+PLOT_MIN_WIDTH = 4
 DROP_ORDER = ("title", "subtitle2", "inset", "notes2", "subtitle", "notes", "legend", "timebar", "readouts", "headings")
 
 
@@ -211,13 +216,29 @@ def _measure(plan, texts, metrics: TextMetrics, show, W: int, pad: int) -> _Want
     F = plan.frames
     sample = sorted(set(np.linspace(0, F - 1, min(F, 24)).round().astype(int)))
     joined = max(metrics.width(NOTE_SEP.join(texts.notes[f])) for f in sample) if notes_n else 0.0
-    plots = tuple(plot for item, names in INSET_PLOTS.items() if item in show for plot in names)
+    plots = _fitting_plots(texts, metrics, show, W, pad)
     wanted = {"headings": hud_on, "subtitle": hud_on, "readouts": hud_on, "legend": hud_on and bool(texts.legend),
               "timebar": hud_on, "notes": hud_on and notes_n > 0, "title": hud_on and bool(texts.footer),
               "inset": bool(plots)}
     return _Wants(wanted=wanted, subtitles=subtitles, readout_lines=max(len(texts.readouts[k][0]) for k in range(n)),
                   notes_rows=1 if joined <= W - 2 * pad else notes_n, legend=texts.legend, plots=plots,
                   short_subtitles=short)
+
+
+def _fitting_plots(texts, metrics: TextMetrics, show, W: int, pad: int) -> tuple[str, ...]:
+    """The live plots ``show`` asks for that fit side by side across the frame, the rightmost
+    dropped first: each needs its label column, its title (or ``PLOT_MIN_WIDTH`` body-text
+    sizes) and a gap of two pads to the next."""
+    plots = [plot for item, names in INSET_PLOTS.items() if item in show for plot in names]
+    size = metrics.sizes.size
+
+    def need(name: str) -> float:
+        labels = max(metrics.width(PLOT_LABEL_SAMPLE), metrics.width(PLOT_TICK_SAMPLE.get(name, "")))
+        return labels + pad + max(metrics.width(texts.plot_titles.get(name, "")), PLOT_MIN_WIDTH * size)
+
+    while plots and sum(need(p) for p in plots) + 2 * pad * (len(plots) - 1) > W - 2 * pad:
+        plots.pop()
+    return tuple(plots)
 
 
 def _bands(want: _Wants, sizes: TextSizes, pad: int) -> tuple[int, list[Row], int]:

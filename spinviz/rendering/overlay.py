@@ -22,7 +22,7 @@ import numpy as np
 
 from .. import units as U
 from .captions import decade
-from .layout import NOTE_SEP, Layout, TextMetrics
+from .layout import NOTE_SEP, PLOT_LABEL_SAMPLE, Layout, TextMetrics
 from .style import MODEL_COLORS, Palette
 
 WHITE = (255, 255, 255)
@@ -282,7 +282,7 @@ def _inset(plan, texts, lay: Layout, row, bar: TimeBar | None, metrics: TextMetr
     scales = {name: _plot_scale(name, series[name]) for name in plots}
     ticks = {name: _scale_labels(name, scales[name]) for name in plots}
     # a label column as wide as "180°" (angle, ratio) or the widest decade (power)
-    label_w = {name: int(max(metrics.width(t) for t in (*ticks[name], "180°"))) + pad for name in plots}
+    label_w = {name: int(max(metrics.width(t) for t in (*ticks[name], PLOT_LABEL_SAMPLE))) + pad for name in plots}
     if plots == ("power",) and bar is not None and label_w["power"] <= bar.x0 - pad:
         boxes = [(bar.x0, y0, bar.x1, y1)]
     else:
@@ -292,7 +292,7 @@ def _inset(plan, texts, lay: Layout, row, bar: TimeBar | None, metrics: TextMetr
     inset = Inset(y0=row.y, height=row.height, boxes=boxes, plots=plots, scales=[scales[n] for n in plots],
                   cursor_color=pal.muted, dot_radius=max(2, lay.H // 180))
     _inset_marks(inset, plan.frames, [series[n] for n in plots], texts, pal)
-    titles = {"angle": "∠(d, L)", "omega": "|Ω| / |Ω₀|" if plan.units == "cgs" else "|ω| / |ω₀|", "power": texts.power}
+    titles = texts.plot_titles
     for (bx0, by0, _, by1), name in zip(boxes, plots):
         top, bottom = ticks[name]
         inset.labels += [Text(titles[name], (bx0, row.y), pal.fg), Text(top, (bx0 - pad // 2, by0), pal.muted, anchor="ra"),

@@ -268,7 +268,7 @@ def test_render_command_errors_are_one_line(tmp_path, capsys):
     bad.write_text(ASKEW.format(models='model = "reduced"', show='["dipole", "halo"]', w=64, h=48))
     assert main(["render", str(bad)]) == 2
     assert capsys.readouterr().err.strip() == f"spinviz: error: {bad}: [render].show: unknown item 'halo'; valid: " \
-        "body, dipole, omega, L, axes, trail, sphere, hud, hodograph, inset"
+        "body, dipole, omega, L, axes, trail, sphere, hud, hodograph, inset, power"
     assert not any(p.suffix == ".mp4" for p in tmp_path.iterdir())
 
 
@@ -479,20 +479,22 @@ def test_captions_key_is_validated():
 def test_render_workers_import_no_simulation_stack():
     """A render worker imports the drawing stack and unpickles a picture without loading numba,
     scipy or numpy-quaternion (about 1.5 s), nor pyvista's plotting module and matplotlib
-    (about 0.9 s): start-up is VTK, pyvista's meshes, Pillow and imageio-ffmpeg only."""
+    (about 0.9 s): start-up is VTK, pyvista's meshes, Pillow and imageio-ffmpeg only.  It draws
+    the power plot from the picture's numbers, without the physics that computes them."""
     import pickle
     import subprocess
     import sys
 
     from spinviz.rendering.video import picture_of
 
-    picture = picture_of(pipeline.plan(askew(w=64, h=48)))
+    picture = picture_of(pipeline.plan(askew(show='["dipole", "hud", "power"]', w=320, h=240)))
+    assert picture.overlay.inset is not None and picture.overlay.inset.plots == ("power",)
     code = ("import pickle, sys\n"
             "from spinviz.rendering import encode, session\n"
             "picture = pickle.loads(sys.stdin.buffer.read())\n"
             "session.RenderSession(picture).frame(0)\n"
-            "print(sorted(m for m in ('numba', 'scipy', 'quaternion', 'matplotlib', 'pyvista.plotting')"
-            " if m in sys.modules))")
+            "print(sorted(m for m in ('numba', 'scipy', 'quaternion', 'matplotlib', 'pyvista.plotting',"
+            " 'spinviz.trajectory', 'spinviz.physics.radiation') if m in sys.modules))")
     r = subprocess.run([sys.executable, "-c", code], input=pickle.dumps(picture), capture_output=True)
     assert r.returncode == 0, r.stderr.decode()
     assert r.stdout.decode().strip() == "[]"
@@ -520,3 +522,48 @@ def test_render_starts_its_workers_before_it_simulates(tmp_path, monkeypatch):
     assert seen and seen[0] >= 2, seen
     assert res.workers == 2 and imageio.get_reader(str(out)).count_frames() == 12
     assert multiprocessing.active_children() == []
+
+
+# --- the power inset (issue 19.5) --------------------------------------------------------------
+def _near(px, rgb, tol=40):
+    """Pixels within ``tol`` (sum of channel differences) of a colour."""
+    return np.abs(px.astype(int) - np.array(rgb)).sum(axis=-1) <= tol
+
+
+@pytest.mark.parametrize("size", [(640, 360), (1280, 720)])
+def test_power_inset_pixels_in_the_default_scene(size):
+    """The README's main scene, in its pixels: inside the power plot's box both model colours
+    are drawn; the cursor (a muted column) stands where the plan puts it -- right above the time
+    bar's cursor -- at the first, middle and last frames, with each model's dot on it; and late in
+    the run the reduced (teal) curve runs far below the truncated (purple) one: its residual
+    rotation about the dipole does not radiate."""
+    from spinviz.rendering.style import MODEL_COLORS
+
+    plan, imgs, session = scene_frames(SCENES[[p.stem for p in SCENES].index("default")], size=size)
+    try:
+        inset, bar = session.picture.overlay.inset, session.picture.overlay.bar
+        pal = session.picture.theme.hud
+        assert inset.plots == ("power",)
+        x0, y0, x1, y1 = inset.boxes[0]
+        teal, purple = MODEL_COLORS["reduced"], MODEL_COLORS["truncated"]
+        index = {"first": 0, "middle": plan.frames // 2, "last": plan.frames - 1}
+        for name, img in imgs.items():
+            f = index[name]
+            box = img[y0 + 1:y1 - 1, x0 + 1:x1 - 1]
+            assert _near(box, teal).sum() > 0.5 * (x1 - x0) and _near(box, purple).sum() > 0.5 * (x1 - x0), name
+            xc = int(inset.cursor[0, f])
+            assert xc == bar.x0 + int(bar.cuts[f]) - 1
+            column = img[y0 + 1:y1 - 1, xc]
+            assert (_near(column, pal.muted, 12) | _near(column, teal) | _near(column, purple)).mean() > 0.9, name
+            r = inset.dot_radius
+            for i, (color, _, rows) in enumerate(inset.dots):
+                if any(abs(int(later[f]) - int(rows[f])) <= 2 * r for _, _, later in inset.dots[i + 1:]):
+                    continue                # at the start both models radiate alike: the later dot covers this one
+                dot = img[int(rows[f]) - r:int(rows[f]) + r + 1, xc - r:xc + r + 1]
+                assert _near(dot, color, 12).mean() > 0.5, (name, color)
+        last = imgs["last"][y0 + 1:y1 - 1, x1 - 8 - size[0] // 40:x1 - 8]      # a strip left of the last dots
+        rows_teal = np.nonzero(_near(last, teal).any(axis=1))[0]
+        rows_purple = np.nonzero(_near(last, purple).any(axis=1))[0]
+        assert rows_teal.min() > rows_purple.max() + 0.3 * (y1 - y0), (rows_teal, rows_purple)
+    finally:
+        session.close()

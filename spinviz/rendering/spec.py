@@ -16,7 +16,7 @@ from dataclasses import dataclass, fields, replace
 
 from ..errors import SpecError, brief
 
-SHOW_ITEMS = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud", "hodograph", "inset")
+SHOW_ITEMS = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud", "hodograph", "inset", "power")
 DEFAULT_SHOW = ("body", "dipole", "axes", "trail", "sphere", "hud")
 ORIENTATION_ITEMS = ("body", "dipole", "omega", "L", "trail")
 VIDEO_FORMATS = (".mp4", ".gif")
@@ -44,7 +44,8 @@ class RenderSpec:
         tops: slow geometry exact, spin and precession phases re-timed so that the shown
         spin rate is ``spin_turns_per_second`` x |Omega_L(t)| / |Omega_L(0)|; labelled).
     show : the actors to build (others are not built, and what they need is not computed);
-        "inset" adds live plots of angle(d, L) and |Omega| of both models.
+        "inset" adds live plots of angle(d, L) and |Omega| of both models; "power" a live plot
+        of the radiated power P(t) of each model (log scale; W, or I1/tau0^3 dimensionless).
     trail_seconds : length of the dipole trail, video seconds.
     azimuth_deg, elevation_deg, zoom : the camera (view direction from the origin).
     background : "white" or "black".  title : shown under the panels when there is room.

@@ -154,42 +154,60 @@ def diagram(ds, path: str, title: str | None = None):
     _save_small(fig, path, dpi=110)
 
 
-def _cells(ax, ds, model: str) -> set:
-    """The bars of every cell (one PatchCollection per type) and the coexistence dots."""
-    from matplotlib.collections import PatchCollection
-    from matplotlib.patches import Rectangle
-
+def compose(ds, model: str) -> list[dict]:
+    """The diagram's cells of one model, as plain data for the PNG and the HTML page: each a
+    dict with ``i``, ``j``, the rectangle ``x0, x1`` (delta) and ``y0, y1`` (chi, deg), the
+    ``bars`` -- (type, width fraction, hatched) left to right in ``ORDER`` -- ``coexist`` and
+    ``counts`` (type or "->type" -> members)."""
     deltas, chis = ds["delta"].values, np.degrees(ds["chi"].values)
     de, ce = _edges(deltas, -1.0, 1.0), _edges(chis, 0.0, 90.0)
     lab, appr = cell_types(ds, model)
+    co = coexisting(ds, model)
     n = lab.shape[-1]
-    rects: dict = {}
-    seen = set()
+    cells = []
     for i in range(len(deltas)):
         for j in range(len(chis)):
-            x, w, y0, h = de[i], de[i + 1] - de[i], ce[j], ce[j + 1] - ce[j]
+            bars, counts = [], {}
             for name in ORDER:
-                if name == "approaching":
-                    continue
                 m = lab[i, j] == name
                 k = int(m.sum())
-                if not k:
+                if name == "approaching" or not k:
                     continue
                 ka = int((m & appr[i, j]).sum())
-                for count, hatched in ((k - ka, False), (ka, True)):
-                    if count:
-                        rects.setdefault((name, hatched), []).append(Rectangle((x, y0), w * count / n, h))
-                        x += w * count / n
-                seen.add(name)
+                if k - ka:
+                    bars.append((name, (k - ka) / n, False))
+                    counts[name] = k - ka
                 if ka:
-                    seen.add("approaching")
+                    bars.append((name, ka / n, True))
+                    counts["->" + name] = ka
+            cells.append({"i": i, "j": j, "delta": float(deltas[i]), "chi_deg": float(chis[j]), "x0": float(de[i]),
+                          "x1": float(de[i + 1]), "y0": float(ce[j]), "y1": float(ce[j + 1]), "bars": bars,
+                          "coexist": bool(co[i, j]), "counts": counts})
+    return cells
+
+
+def _cells(ax, ds, model: str) -> set:
+    """The bars of every cell (one PatchCollection per type and hatching) and the coexistence dots."""
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Rectangle
+
+    rects: dict = {}
+    seen = set()
+    dots = []
+    for c in compose(ds, model):
+        x, w, h = c["x0"], c["x1"] - c["x0"], c["y1"] - c["y0"]
+        for name, frac, hatched in c["bars"]:
+            rects.setdefault((name, hatched), []).append(Rectangle((x, c["y0"]), w * frac, h))
+            x += w * frac
+            seen.add("approaching" if hatched else name)
+            seen.add(name)
+        if c["coexist"]:
+            dots.append((c["delta"], c["chi_deg"]))
     for (name, hatched), rs in rects.items():
         ax.add_collection(PatchCollection(rs, facecolor=COLORS[name], edgecolor="white" if hatched else "none",
                                           hatch="////" if hatched else None, linewidth=0.0))
-    co = coexisting(ds, model)
-    if co.any():
-        ii, jj = np.nonzero(co)
-        ax.scatter(deltas[ii], chis[jj], s=7, color="black", edgecolors="white", linewidths=0.4, zorder=5)
+    if dots:
+        ax.scatter(*zip(*dots), s=7, color="black", edgecolors="white", linewidths=0.4, zorder=5)
         seen.add("coexisting")
     return seen
 

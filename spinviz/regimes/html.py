@@ -136,16 +136,20 @@ function hodo(id){
   const raw = atob(s.b64), n = raw.length / 6, v = new DataView(new ArrayBuffer(raw.length));
   for (let i = 0; i < raw.length; i++) v.setUint8(i, raw.charCodeAt(i));
   const p = []; for (let k = 0; k < n; k++) p.push([0,1,2].map(a => v.getInt16(6*k + 2*a, true) / 1000));
-  const lim = Math.max(0.05, ...p.map(q => Math.max(Math.abs(q[0]), Math.abs(q[1]), Math.hypot(q[0], q[1]), Math.abs(q[2])))) * 1.1;
+  const big = (q) => Math.max(Math.abs(q[0]), Math.abs(q[1]), Math.hypot(q[0], q[1]), Math.abs(q[2]));
+  const lim = Math.max(0.05, ...p.map(big)) * 1.1;
   const sc = (x) => 110 + 100 * x / lim, col = (k) => `hsl(${260 - 200 * k / Math.max(1, n - 1)},70%,45%)`;
   let a = '', b = '';
   p.forEach((q, k) => { a += `<circle cx="${sc(q[0])}" cy="${sc(-q[1])}" r="2" fill="${col(k)}"/>`;
                         b += `<circle cx="${sc(Math.hypot(q[0], q[1]))}" cy="${sc(-q[2])}" r="2" fill="${col(k)}"/>`; });
   const ax = `<line x1="10" x2="210" y1="110" y2="110" stroke="#bbb"/><line x1="110" x2="110" y1="10" y2="210" stroke="#bbb"/>`;
+  const fig = (title, dots) => `<svg viewBox="0 0 220 240" class="h"><text x="110" y="232" class="tick">` +
+    `${title}</text>${ax}${dots}</svg>`;
   box.innerHTML = `<h3>${id.replaceAll(':', ' ')}: first start, label ${s.label}</h3>` +
-    `<svg viewBox="0 0 220 240" class="h"><text x="110" y="232" class="tick">\u03c9\u2081\u221a\u03c4 \u2192, \u03c9\u2082\u221a\u03c4 \u2191</text>${ax}${a}</svg>` +
-    `<svg viewBox="0 0 220 240" class="h"><text x="110" y="232" class="tick">\u03c9\u22a5\u221a\u03c4 \u2192, \u03c9\u2083\u221a\u03c4 \u2191</text>${ax}${b}</svg>` +
-    `<p>log\u2081\u2080 \u03c4 from ${s.lt0.toFixed(1)} (violet) to ${s.lt1.toFixed(1)} (green); axes to \u00b1${lim.toFixed(2)}</p>`;
+    fig('\u03c9\u2081\u221a\u03c4 \u2192, \u03c9\u2082\u221a\u03c4 \u2191', a) +
+    fig('\u03c9\u22a5\u221a\u03c4 \u2192, \u03c9\u2083\u221a\u03c4 \u2191', b) +
+    `<p>log\u2081\u2080 \u03c4 from ${s.lt0.toFixed(1)} (violet) to ${s.lt1.toFixed(1)} (green); ` +
+    `axes to \u00b1${lim.toFixed(2)}</p>`;
 }
 document.querySelectorAll('.cell').forEach(g => g.addEventListener('click', () => hodo(g.dataset.id)));
 const m = location.hash.match(/open=([^&]+)/); if (m) hodo(decodeURIComponent(m[1]));

@@ -426,6 +426,32 @@ def _candidate(x: dict, scores: dict, best: str, names: dict) -> str:
     return "none"
 
 
+def _between_1_and_2(x: dict, model: str):
+    """The hand-over between types 2 and 1: omega3 ~ tau^-1/2 dominant and keeping its sign,
+    omega_perp falling faster, the phase neither turning freely nor stopped.  omega_perp is
+    then the sum of type 1's forced part (B/tau, a fixed phase) and type 2's spiral (tau^alpha,
+    turning), beating against each other, so its slope p wanders; whichever falls slower wins:
+    p < -1 - TOL_ONE/2 means the spiral dies first (-> type 1), p > -1 + TOL_ONE/2 that it
+    outlives the forced part (-> type 2).  Near alpha = -1 the two decay almost together and
+    the hand-over takes tens of decades ((0.5, 14 deg): alpha = -1.22).  Returns (class label,
+    reason) or None."""
+    S = x["S"]
+    p, q = S["p"], S["q"]
+    if not (x["Y"] > 2.0 * x["X"] and _near(q, -0.5, TOL_HALF) > 0.5 and x["sc"] == 0.0 and p < -0.5 - TOL_SEP):
+        return None
+    names = CLASS_LABEL[model]
+    if p < -1.0 - 0.5 * TOL_ONE:
+        target = "axial-stopped"
+    elif p > -1.0 + 0.5 * TOL_ONE:
+        target = "axial-spiral"
+    else:
+        return None
+    if names[target] in ("T1", "T5"):
+        return None
+    return names[target], (f"hand-over between types 2 and 1: omega_perp ~ tau^{p:.2f} beats its forced and spiral "
+                           f"parts; approaching {names[target]}")
+
+
 def _unsettled(x, scores, best, settle, fit_ok, delta, model, candidate, conf, devs) -> Verdict:
     """A run no class meets clearly: "approaching" the class it is within ``RELAX`` x the slope
     tolerances of and moving towards (its late half's slopes closer to the class than its early
@@ -441,6 +467,9 @@ def _unsettled(x, scores, best, settle, fit_ok, delta, model, candidate, conf, d
         c = float(min(0.49, wide[cls] * fit_ok))
         return Verdict("approaching", c, names[cls], f"approaching {cls} ({names[cls]}): within {RELAX:g}x the slope "
                                                      f"tolerances, slopes moving towards it (settled {settle:.2f})", ev, devs)
+    handover = _between_1_and_2(x, model)
+    if handover is not None:
+        return Verdict("approaching", float(min(0.49, fit_ok or 0.3)), handover[0], handover[1], ev, devs)
     why = (f"no class met clearly (best {best} {scores[best]:.2f}, settled {settle:.2f}, fit {fit_ok:.2f})"
            if scores[best] > 0.0 else "no class fits the slopes or the phase")
     return Verdict("other", float(conf), candidate, why, ev, devs)

@@ -205,10 +205,16 @@ def _bounds(cls, key: str):
     """(lower, lower open, upper, upper open) of field ``key`` of ``cls``, None where absent."""
     import annotated_types as at
 
+    import typing
+
     lo = hi = None
     lo_open = hi_open = False
     field = getattr(cls, "__pydantic_fields__", {}).get(key) if cls is not None else None
-    for m in getattr(field, "metadata", ()):
+    metadata = list(getattr(field, "metadata", ()))
+    for arg in typing.get_args(getattr(field, "annotation", None)):      # an optional field: X | None
+        for m in getattr(arg, "__metadata__", ()):
+            metadata += list(getattr(m, "metadata", None) or [m])        # Field(ge=...) inside Annotated
+    for m in metadata:
         if isinstance(m, at.Gt | at.Ge):
             lo, lo_open = (m.gt, True) if isinstance(m, at.Gt) else (m.ge, False)
         elif isinstance(m, at.Lt | at.Le):

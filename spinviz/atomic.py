@@ -17,7 +17,7 @@ import contextlib
 import os
 import tempfile
 
-from .errors import UsageError, printable
+from .errors import UsageError, shortened
 from .interrupt import deferred
 
 
@@ -127,7 +127,7 @@ def check_name(p) -> None:
     the end, after the work."""
     raw = os.fsencode(p)
     if b"\0" in raw:
-        raise UsageError(f"{printable(p, 200)}: a path cannot hold a NUL byte")
+        raise UsageError(f"{shortened(p)}: a path cannot hold a NUL byte")
     probe = os.path.dirname(os.path.abspath(p))
     while not os.path.exists(probe):
         probe = os.path.dirname(probe)
@@ -138,9 +138,9 @@ def check_name(p) -> None:
         name_max, path_max = 255, 4096
     for part in raw.split(b"/"):
         if len(part) > name_max:
-            raise UsageError(f"{printable(p, 200)}: a name of {len(part)} bytes; the file system takes at most {name_max}")
+            raise UsageError(f"{shortened(p)}: a name of {len(part)} bytes; the file system takes at most {name_max}")
     if len(os.fsencode(os.path.abspath(p))) >= path_max:
-        raise UsageError(f"{printable(p, 200)}: the path is {len(raw)} bytes; the file system takes at most {path_max - 1}")
+        raise UsageError(f"{shortened(p)}: the path is {len(raw)} bytes; the file system takes at most {path_max - 1}")
 
 
 def check_parent_writable(p: str) -> None:

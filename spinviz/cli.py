@@ -418,6 +418,8 @@ def _cmd_render(args) -> int:
         raise _option(e, args) from None
     except OSError as e:
         raise _cannot_write(out, e) from None
+    except SpinvizError:
+        raise                                           # says what it is about (an output, the scene)
     except ValueError as e:
         raise UsageError(f"{args.scene}: {e}") from None
     _out(f"{_p(res.path)}: {res.frames} frames {res.size[0]}x{res.size[1]}, "

@@ -65,6 +65,16 @@ def printable(text, limit: int = MAX_MESSAGE) -> str:
     return s if len(s) <= limit else s[: limit - 1] + "\u2026"
 
 
+def shortened(text, limit: int = 160) -> str:
+    """``text`` escaped as by ``printable`` and, when longer than ``limit``, cut in the middle
+    (a path keeps its folder's start and its file name's end)."""
+    s = printable(text, 10 * limit)
+    if len(s) <= limit:
+        return s
+    half = (limit - 1) // 2
+    return s[:half] + "\u2026" + s[len(s) - (limit - 1 - half):]
+
+
 def brief(value) -> str:
     """A short, printable repr of a value from a file (long lists and strings cut)."""
     return printable(_brief.repr(value), 120)

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .errors import SceneError, SpecError, printable
+from .errors import SceneError, SpecError, brief, printable
 from .inputs import scene as IS
 from .inputs.render import MAX_TITLE, RenderSpec
 from .inputs.simulation import SimulationRequest
@@ -112,7 +112,7 @@ class Scene:
         argument if ``model``, ``kinematics`` or ``t_eval`` is not acceptable."""
         model = self.model if model is None else model
         if model not in self.models:
-            raise SpecError("model", f"{printable(model, 40)!s} is not one of the scene's models ({', '.join(self.models)})")
+            raise SpecError("model", f"{brief(model)} is not one of the scene's models ({', '.join(self.models)})")
         times = {"t_end": self.t_end, "samples": self.samples} if t_eval is None else {"t_eval": t_eval}
         return SimulationRequest(body=self.body, model=model, omega0=self.omega0, q0=self.q0, method=self.method,
                                  rtol=self.rtol, atol=self.atol, step=self.step, kinematics=kinematics, **times)

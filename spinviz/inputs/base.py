@@ -203,9 +203,9 @@ _TYPE_ERRORS = {"spinviz_type", "unexpected_keyword_argument", "unexpected_posit
 
 def _bounds(cls, key: str):
     """(lower, lower open, upper, upper open) of field ``key`` of ``cls``, None where absent."""
-    import annotated_types as at
-
     import typing
+
+    import annotated_types as at
 
     lo = hi = None
     lo_open = hi_open = False

@@ -231,9 +231,9 @@ def _observe(data, path: str, body: B.Body, omega0, requests: list) -> ObserveSp
 
 def load_scene(path) -> Scene:
     """Read and validate a scene file; SceneError (one line: file, key, reason) on any problem."""
-    if not isinstance(path, (str, os.PathLike)):
+    if not isinstance(path, (str, bytes, os.PathLike)):
         from .errors import SpecTypeError
 
         raise SpecTypeError("path", f"must be the path of a scene file (str or os.PathLike), got {type(path).__name__}")
-    path = os.fspath(path)
+    path = os.fsdecode(path)
     return parse_scene(read_toml(path), path)

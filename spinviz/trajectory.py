@@ -340,9 +340,9 @@ class Trajectory:
 
         Raises ``TrajectoryFileError`` (a ValueError naming the file) for a file that is missing,
         unreadable, damaged or not a spinviz trajectory, never a zip, JSON or NumPy error."""
-        if not isinstance(path, (str, os.PathLike)):
+        if not isinstance(path, (str, bytes, os.PathLike)):
             raise SpecTypeError("path", f"must be the path of a .npz trajectory, got {type(path).__name__}")
-        path = os.fspath(path)
+        path = os.fsdecode(path)
         try:
             with np.load(path, allow_pickle=False) as z:
                 if not hasattr(z, "files"):

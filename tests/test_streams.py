@@ -92,7 +92,7 @@ def test_a_closed_or_full_stderr_never_costs_the_video(tmp_path, how):
 NAMES = [
     (b"new\nline", "new\\nline"), (b"carriage\rreturn", "carriage\\rreturn"), (b"fs\x1csep", "fs\\x1csep"),
     (b"gs\x1dsep", "gs\\x1dsep"), ("line\u2028sep".encode(), "line\\u2028sep"), ("bidi\u202eexe".encode(), "bidi\\u202eexe"),
-    (b"csi\x9b31m", "csi\\x9b31m"), (b"byte\xff", "byte\\xff"), ("esc\x1b[2J".encode(), "esc\\x1b[2J"),
+    (b"csi\x9b31m", "csi\\x9b31m"), (b"byte\xff", "byte\\xff"), (b"esc\x1b[2J", "esc\\x1b[2J"),
 ]
 
 

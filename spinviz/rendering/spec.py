@@ -26,5 +26,3 @@ from ..inputs.render import (  # noqa: F401  (re-exported)
     RenderSpec,
     poster_for,
 )
-
-__all__ = ["RenderSpec", "poster_for", "SHOW_ITEMS", "DEFAULT_SHOW", "ORIENTATION_ITEMS", "VIDEO_FORMATS"]

@@ -384,3 +384,34 @@ def test_render_frame_at_t_0_is_the_first_frame_and_t_is_the_runs_time():
     with spinviz.Renderer(sc, t_end=600.0, **look) as r:            # the video of [0, 600]: its last frame shows t = 600
         assert r.plan.sim_t[-1] == 600.0
         assert np.array_equal(spinviz.render_frame(sc, t=600.0, **look), r.frame(r.frames - 1))
+
+
+def test_adding_an_atlas_key_is_one_field_and_keeps_old_identities():
+    """The recipe of ``spinviz.inputs.atlas``: a key is one annotated field; marked ``Added()``
+    it enters the spec's identity only when it differs from its default, so a store made
+    before the key existed keeps its identity.  A store's canonical spec gives back the
+    Settings it was made with."""
+    from types import SimpleNamespace
+    from typing import Annotated
+
+    from pydantic import Field
+
+    from spinviz.inputs.atlas import Added, RunTable
+    from spinviz.inputs.base import Int, request
+    from spinviz.regimes.spec import _identity_values, load_spec, settings_from_canonical
+
+    @request
+    class RunWithRefinement:
+        tau_end: float = 1e10
+        refine_levels: Annotated[Int, Field(ge=0, le=8), Added()] = 0
+
+    old = SimpleNamespace(tau_end=1e10, refine_levels=0)
+    assert _identity_values(RunWithRefinement, old) == {"tau_end": 1e10}
+    assert _identity_values(RunWithRefinement, SimpleNamespace(tau_end=1e10, refine_levels=2)) == {
+        "tau_end": 1e10, "refine_levels": 2}
+    with pytest.raises(SpecError, match=r"refine_levels: must lie in \[0, 8\], got 9"):
+        RunWithRefinement(refine_levels=9)
+    spec = load_spec(SCENES / "atlas_quick.toml")
+    assert settings_from_canonical(json.loads(spec.canonical_json())) == spec.settings
+    assert set(_identity_values(RunTable, spec.settings)) == {"tau_end", "tau_start", "samples_per_decade", "rtol",
+                                                              "max_steps"}

@@ -13,7 +13,9 @@ reason, default).  Then:
   automatically -- mark it ``Added()`` so that it enters only when it differs from its
   default: stores made before the key existed keep their identity;
 * a rule joining several keys goes in the table's ``_together`` validator (``SpecError``
-  naming the key to blame).
+  naming the key to blame);
+* code that rebuilds ``Settings`` from a store (``regimes.plot``) should use
+  ``regimes.spec.settings_from_canonical``, which reads the tables through this schema.
 """
 
 from __future__ import annotations

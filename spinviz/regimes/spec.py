@@ -182,6 +182,15 @@ def settings_from(run, classify) -> Settings:
     return Settings(**kw)
 
 
+def settings_from_canonical(canonical: dict) -> Settings:
+    """``Settings`` from a store's canonical spec (``json.loads(ds.attrs["spec"])``): its
+    ``run`` and ``classify`` tables through the schema, so a key added later is read, and a
+    store made before it gets the key's default."""
+    run = IA.RunTable(**canonical.get("run", {}))
+    classify = IA.ClassifyTable(**canonical.get("classify", {}))
+    return settings_from(run, classify)
+
+
 def load_spec(path) -> AtlasSpec:
     """Read and validate an atlas spec; ``SceneError`` (file, key, reason) on any problem."""
     if not isinstance(path, str | os.PathLike):

@@ -188,7 +188,10 @@ class _Stream:
             if self.pipe_ends:
                 raise
             self.error = e
-        except UnicodeEncodeError:
+        except UnicodeEncodeError as e:
+            if not a:
+                self.error = e
+                return
             enc = getattr(self.stream, "encoding", None) or "utf-8"
             self._do(op, a[0].encode(enc, "backslashreplace").decode(enc))
         except (OSError, ValueError) as e:               # ValueError: a closed file object
@@ -206,6 +209,13 @@ class _Stream:
             return self.error is None and self.stream.isatty()
         except (OSError, ValueError, AttributeError):
             return False
+
+    def fileno(self) -> int:
+        if self.stream is None:
+            import io
+
+            raise io.UnsupportedOperation("the stream was closed before the command started")
+        return self.stream.fileno()
 
     def __getattr__(self, name):
         return getattr(self.stream, name)

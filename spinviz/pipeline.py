@@ -124,14 +124,14 @@ def _check_drawable(trajs: list[Trajectory] | None, spec: RenderSpec) -> None:
         return
     for tr in trajs:
         if tr.q is None:
-            raise UsageError(f"this {tr.model} trajectory has no orientation; simulate with kinematics=\"quaternion\" "
-                             f"or show only the hodograph")
+            raise SpecError("source", f"this {tr.model} trajectory has no orientation; simulate with "
+                                      f"kinematics=\"quaternion\" or show only the hodograph")
         if tr.slow is not None:
             continue
         turn = float(np.max(tr.omega_magnitude[:-1] * np.diff(tr.t))) if tr.t.size > 1 else 0.0
         if turn > MAX_STORED_TURN:
-            raise UsageError(f"the {tr.model} trajectory is stored too coarsely to draw (up to {np.degrees(turn):.0f} deg "
-                             f"between samples); simulate it at more instants")
+            raise SpecError("source", f"the {tr.model} trajectory is stored too coarsely to draw (up to "
+                                      f"{np.degrees(turn):.0f} deg between samples); simulate it at more instants")
 
 
 def plan(source: Source, t_end: float | None = None, frames: int | None = None, **overrides) -> FramePlan:
@@ -312,9 +312,9 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
 
 def default_output(scene, directory: str = "renders") -> str:
     """Where a scene's video goes by default: ``renders/<scene file's stem>.mp4``.  ``scene``: a
-    ``Scene`` or the path of its file (trajectories have no default: UsageError)."""
+    ``Scene`` or the path of its file (trajectories have no default: ``SpecError`` naming ``out``)."""
     if not isinstance(scene, (Scene, str, os.PathLike)):
-        raise UsageError("give out=... (a .mp4 or .gif path) to render trajectories")
+        raise SpecError("out", "missing value: trajectories have no default video path; give a .mp4 or .gif path")
     stem = os.path.splitext(os.path.basename(scene.path if isinstance(scene, Scene) else os.fspath(scene)))[0]
     return os.path.join(directory, f"{stem}.mp4")
 

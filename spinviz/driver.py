@@ -23,7 +23,7 @@ import numpy as np
 
 from . import rotations as R
 from . import units as U
-from .errors import SimulationError, SpecTypeError
+from .errors import SimulationError, SpecTypeError, SpinvizError
 from .inputs.simulation import SimulationRequest
 from .integrators import Problem, Solution, get
 from .integrators import status as ST
@@ -103,8 +103,16 @@ def simulate_request(request: SimulationRequest) -> Trajectory:
                   and estimated_turns(body, model, omega0, horizon, (problem, eps)) <= HARD_MAX_TURNS)
     _check_method(method, body, kinematics)
     start = time.perf_counter()
-    sol, name, reason = solve(problem, method, rtol=rtol, atol=atol, step=None if step is None else step * time_scale,
-                              auto=auto, reason=reason, resolvable=resolvable)
+    try:
+        sol, name, reason = solve(problem, method, rtol=rtol, atol=atol, step=None if step is None else step * time_scale,
+                                  auto=auto, reason=reason, resolvable=resolvable)
+    except SpinvizError:
+        raise
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as e:
+        # a numerical library giving up on the equations (e.g. (6.4) at sin theta = 0 under an
+        # implicit method, whose Jacobian turns non-finite): a run that cannot be done, said as such
+        raise SimulationError(f"the integration failed ({type(e).__name__}: {e}; method {request.method!r}"
+                              f"{f', started as {method!r}' if auto else ''})") from e
     runtime = time.perf_counter() - start
     if not sol.success:
         raise SimulationError(_failure_message(problem, sol, name, time_scale))

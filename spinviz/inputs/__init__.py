@@ -38,6 +38,7 @@ error messages and -- for an atlas spec -- the spec's identity follow from it
 option for it is one ``add_argument`` in ``spinviz.cli`` and one entry in that command's map
 of options to argument names.
 
-Importing this package loads nothing; its modules load pydantic (~50 ms, once) when a scene,
-a spec or a call is validated.
+Importing this package loads nothing; its modules load pydantic when a scene, a spec or a
+call is first validated (~65 ms once per process with the schema's classes, measured on this
+machine; render workers pay it too, since the frame plan carries its ``RenderSpec``).
 """

@@ -313,12 +313,12 @@ BAD = [
     (_with(("grid", "delta"), {"min": 0.5, "max": -0.5, "cells": 4}), "[grid.delta].max: must exceed min"),
     (_with(("grid", "delta"), {"min": -1.5, "max": 0.5, "cells": 4}), "[grid.delta].min: the range must lie within (-1, 1)"),
     (_with(("grid", "delta"), [1.0]), "[grid].delta: 1 is outside (-1, 1)"),
-    (_with(("grid", "delta"), {"min": -1.0, "max": 1.0, "cells": 0}), "[grid.delta].cells: must be at least 1"),
+    (_with(("grid", "delta"), {"min": -1.0, "max": 1.0, "cells": 0}), "[grid.delta].cells: must lie in [1, 4096], got 0"),
     (_with(("grid", "chi_deg"), [10.0, 95.0]), "[grid].chi_deg: 95 is outside [0, 90] deg"),
     (_with(("grid", "chi_deg"), [45.0, 10.0]), "[grid].chi_deg: values must increase"),
-    (_with(("members", "count"), 0), "[members].count: must be at least 1"),
-    (_with(("members", "count"), -3), "[members].count: must be at least 1"),
-    (_with(("members", "omega"), 50.0), "[members].omega: must not exceed 10"),
+    (_with(("members", "count"), 0), "[members].count: must lie in [1, 100000], got 0"),
+    (_with(("members", "count"), -3), "[members].count: must lie in [1, 100000], got -3"),
+    (_with(("members", "omega"), 50.0), "[members].omega: must lie in [1e-07, 10] (tau0 |Omega| << 1 above"),
     (_with(("members", "list"), [[0.0, 0.1, 0.0]]), "[members].count: give list (explicit starts) or count"),
     (_with(("run", "tau_end"), 10.0), "[run].tau_end: tau_end/tau_start spans 3 decades"),
     (_with(("run", "rtol"), 0.5), "[run].rtol: must lie in"),
@@ -351,7 +351,7 @@ def test_command_bad_spec_exit_2_nothing_written(tmp_path):
     r = subprocess.run([sys.executable, "-m", "spinviz.regimes", str(bad), "--out", str(out)], capture_output=True,
                        text=True, cwd=ROOT)
     assert r.returncode == 2
-    assert r.stderr.strip() == f"spinviz: error: {bad}: [members].count: must be at least 1, got 0"
+    assert r.stderr.strip() == f"spinviz: error: {bad}: [members].count: must lie in [1, 100000], got 0"
     assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
 
 

@@ -239,8 +239,8 @@ def test_plots_show_every_member(reference, tmp_path):
     reps = plot.representatives(ds)
     found = {(m, lab) for m, lab, *_ in reps}
     labels = {(m, str(x)) for m in ("reduced", "truncated") for x in np.unique(ds["label"].sel(model=m).values)}
-    assert found == {x for x in labels if x[1] not in ("other", "failed", "missing")}
+    assert found == {x for x in labels if x[1] not in ("other", "failed", "missing", "approaching")}
     paths = plot.draw(str(reference), [str(tmp_path / "d.png"), str(tmp_path / "d_hodographs.png")])
     w, h = Image.open(paths[0]).size
-    assert (w, h) == (2 * 576, 594)                              # two panels at 6.4 x 6.6 in, 90 dpi
+    assert (w, h) == (2 * 792, 836)                              # two panels at 7.2 x 7.6 in, 110 dpi
     assert os.path.getsize(paths[0]) < 300_000 and os.path.getsize(paths[1]) < 300_000

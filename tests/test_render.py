@@ -207,13 +207,13 @@ def test_hodograph_only_scene_integrates_no_orientation(monkeypatch):
     import spinviz.pipeline as V
 
     seen = []
-    real = V.simulate
+    real = V.simulate_request
 
-    def spy(*a, **k):
-        seen.append(k["kinematics"])
-        return real(*a, **k)
+    def spy(request):
+        seen.append(request.kinematics)
+        return real(request)
 
-    monkeypatch.setattr(V, "simulate", spy)
+    monkeypatch.setattr(V, "simulate_request", spy)
     sc = askew(models='models = ["reduced", "truncated"]', show='["hodograph", "axes"]', w=128, h=64)
     trajs = V.scene_trajectories(sc, sc.render)
     assert seen == ["none", "none"] and all(t.q is None for t in trajs)
@@ -229,9 +229,7 @@ def test_log_time_map_and_slowed_spin_label():
     """Log time map: starts at 0, ends at t_end, increasing; the slowed-spin factor is the
     true precession rate (rad per video second) over the shown one, the same in both panels."""
     spec = scene_from(ASKEW.format(models='model = "reduced"', show='["dipole"]', w=64, h=48)).render
-    from dataclasses import replace
-
-    spec = replace(spec, time_map="log", log_knee=0.5, duration=2.0, fps=10, spin="slowed", spin_turns_per_second=0.5)
+    spec = spec.with_(time_map="log", log_knee=0.5, duration=2.0, fps=10, spin="slowed", spin_turns_per_second=0.5)
     v, t, slope = timeline.frame_times(spec, 60.0)
     assert t[0] == 0.0 and t[-1] == 60.0 and np.all(np.diff(t) > 0)
     np.testing.assert_allclose(np.gradient(t, v)[5:-5], slope[5:-5], rtol=0.05)
@@ -509,13 +507,13 @@ def test_render_starts_its_workers_before_it_simulates(tmp_path, monkeypatch):
     import imageio
 
     seen = []
-    real = pipeline.simulate
+    real = pipeline.simulate_request
 
-    def spy(*a, **k):
+    def spy(request):
         seen.append(len(multiprocessing.active_children()))
-        return real(*a, **k)
+        return real(request)
 
-    monkeypatch.setattr(pipeline, "simulate", spy)
+    monkeypatch.setattr(pipeline, "simulate_request", spy)
     sc = askew(models='models = ["reduced", "truncated"]', show='["body", "dipole", "hud"]', w=160, h=96)
     out = tmp_path / "v.mp4"
     res = pipeline.render(sc, str(out), fps=12, duration=1.0, workers=2)

@@ -92,13 +92,14 @@ def cell_types(ds, model: str):
 
 
 def shares(ds, model: str) -> dict:
-    """label -> array (delta, chi) of the share of the members with that type (approaching
-    runs counted for the type they approach; ``"approaching"``: the share still approaching)."""
-    lab, appr = cell_types(ds, model)
+    """type -> array (delta, chi) of the share of the members of that type (an approaching run
+    counted for the type it approaches; how many are still approaching: ``cell_types``).
+    The shares of a cell add up to 1."""
+    lab, _ = cell_types(ds, model)
     n = lab.shape[-1]
     out = {}
     for name in ORDER:
-        s = appr.sum(axis=-1) / n if name == "approaching" else (lab == name).sum(axis=-1) / n
+        s = (lab == name).sum(axis=-1) / n
         if np.any(s > 0):
             out[name] = s
     return out
@@ -291,7 +292,7 @@ def representatives(ds) -> list[tuple]:
         lab = ds["label"].sel(model=model).values
         conf = ds["confidence"].sel(model=model).values
         for name in ORDER:
-            if name in ("other", "failed", "missing"):
+            if name in ("other", "failed", "missing", "approaching"):
                 continue
             m = lab == name
             if not m.any():

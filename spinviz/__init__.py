@@ -9,8 +9,9 @@ The public API (see the README's "Python" section)::
     import spinviz
     sc = spinviz.load_scene("scenes/askew_example.toml")
     tr = spinviz.simulate(sc.body, "reduced", sc.omega0, t_end=10, samples=5)   # -> Trajectory
+    tr = spinviz.simulate_request(sc.request("reduced"))                        # the scene's own run, typed
     tr.save("run.npz"); tr = spinviz.Trajectory.load("run.npz")
-    img = spinviz.render_frame(sc, t=10.0)                                      # RGB array
+    img = spinviz.render_frame(sc, t=0.0)                                       # RGB array: the first frame
     spinviz.render("scenes/default.toml", out="renders/default.mp4")
 
 Importing the package is light: every name loads its module on first use (PEP 562), and
@@ -36,13 +37,18 @@ _API = {
     "Body": ("physics.bodies", "Body"),
     "symmetric_top": ("physics.bodies", "symmetric_top"),
     "PRESETS": ("physics.presets", "PRESETS"),
+    "SimulationRequest": ("inputs.simulation", "SimulationRequest"),
+    "simulate_request": ("driver", "simulate_request"),
     "SpinvizError": ("errors", "SpinvizError"),
     "SceneError": ("errors", "SceneError"),
+    "SpecError": ("errors", "SpecError"),
+    "SpecTypeError": ("errors", "SpecTypeError"),
+    "TrajectoryFileError": ("errors", "TrajectoryFileError"),
     "SimulationError": ("errors", "SimulationError"),
     "atlas": ("regimes.api", "atlas"),
 }
 _SUBMODULES = {
-    "units", "rotations", "errors", "atomic", "plotting", "physics", "integrators", "driver", "trajectory", "scene",
+    "units", "rotations", "errors", "atomic", "plotting", "physics", "integrators", "inputs", "driver", "trajectory", "scene",
     "rendering", "pipeline", "analysis", "validation", "regimes", "cli",
 }
 

@@ -17,7 +17,7 @@ import contextlib
 import os
 import tempfile
 
-from .errors import UsageError
+from .errors import UsageError, shortened
 from .interrupt import deferred
 
 
@@ -43,7 +43,8 @@ class AtomicPath:
         try:
             os.makedirs(d, exist_ok=True)
             stem, ext = os.path.splitext(os.path.basename(self.path))
-            fd, self.tmp = tempfile.mkstemp(prefix=f".{stem}.", suffix=f".partial{ext}", dir=d)
+            # cut: the temporary name must fit where the output's own name just fits
+            fd, self.tmp = tempfile.mkstemp(prefix=f".{stem[:64]}.", suffix=f".partial{ext[:16]}", dir=d)
             os.close(fd)
         except BaseException:
             self.discard()
@@ -110,7 +111,7 @@ def _backup(path: str) -> str | None:
     if not os.path.isfile(path):
         return None
     d, name = os.path.split(os.path.abspath(path))
-    fd, b = tempfile.mkstemp(prefix=f".{name}.", suffix=".old", dir=d)
+    fd, b = tempfile.mkstemp(prefix=f".{name[:64]}.", suffix=".old", dir=d)
     os.close(fd)
     os.unlink(b)
     try:
@@ -120,9 +121,33 @@ def _backup(path: str) -> str | None:
     return b
 
 
+def check_name(p) -> None:
+    """Every part of the path ``p`` fits the file system (NAME_MAX bytes, usually 255, for a
+    name; PATH_MAX for the whole) and holds no NUL: otherwise the write would fail only at
+    the end, after the work."""
+    raw = os.fsencode(p)
+    if b"\0" in raw:
+        raise UsageError(f"{shortened(p)}: a path cannot hold a NUL byte")
+    probe = os.path.dirname(os.path.abspath(p))
+    while not os.path.exists(probe):
+        probe = os.path.dirname(probe)
+    try:
+        name_max = os.pathconf(probe, "PC_NAME_MAX")
+        path_max = os.pathconf(probe, "PC_PATH_MAX")
+    except (OSError, ValueError, AttributeError):
+        name_max, path_max = 255, 4096
+    for part in raw.split(b"/"):
+        if len(part) > name_max:
+            raise UsageError(f"{shortened(p)}: a name of {len(part)} bytes; the file system takes at most {name_max}")
+    if len(os.fsencode(os.path.abspath(p))) >= path_max:
+        raise UsageError(f"{shortened(p)}: the path is {len(raw)} bytes; the file system takes at most {path_max - 1}")
+
+
 def check_parent_writable(p: str) -> None:
-    """The nearest existing folder above ``p`` (created folders go below it) is a directory
-    this process may write in; otherwise one line naming ``p``."""
+    """``p``'s names fit the file system and the nearest existing folder above it (created
+    folders go below it) is a directory this process may write in; otherwise one line
+    naming ``p``."""
+    check_name(p)
     d = os.path.dirname(os.path.abspath(p))
     while not os.path.exists(d):
         d = os.path.dirname(d)
@@ -139,6 +164,7 @@ def check_outputs(paths, inputs=()) -> list[str]:
     paths = [os.fspath(p) for p in paths]
     seen = set()
     for p in paths:
+        check_name(p)
         real = os.path.realpath(p)
         if real in seen:
             raise UsageError(f"{p}: named twice as an output")

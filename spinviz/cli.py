@@ -1,10 +1,20 @@
 """Command line: a thin ``main(argv) -> int`` that parses, dispatches to library functions and
 maps errors to exit codes (0 success, 1 a check or run failed, 2 bad input, 130 interrupted).
-No physics and no file formats here."""
+No physics and no file formats here.
+
+Options are parsed here and checked by the library (the schema in ``spinviz.inputs``), so the
+command line and Python never disagree; a library error naming an argument is shown with
+the option that set it (``--workers: ...``), or with the scene's key when the value came from
+the file.  Standard output and error never crash a command: a closed or full stdout gives one
+line on stderr and exit status 1 (the output file is kept), a closed or full stderr is
+skipped, and every echoed name is escaped (``errors.printable``).
+"""
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import errno
 import json
 import os
 import sys
@@ -52,7 +62,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--size", type=_size, help="WIDTHxHEIGHT in pixels, e.g. 1280x720")
     r.add_argument("--fps", type=_whole, help="frames per second (1..240)")
     r.add_argument("--duration", type=_real, help="video length in seconds")
-    r.add_argument("--workers", type=_positive, help="render processes (default: one per core)")
+    r.add_argument("--workers", type=_whole, help="render processes (default: one per core, at most the cores)")
     r.add_argument("--bench", action="store_true",
                    help="measure frames per second at 1280x720 and 1920x1080, encoding included "
                         "(writes to a temporary directory)")
@@ -103,6 +113,9 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--quick", action="store_true", help="two problems, 1e2 and 1e4 turns, fewer settings (~2 min)")
     b.add_argument("--json", metavar="PATH", help="also write rows and summary as JSON")
     b.add_argument("--plot", metavar="PATH", help="also draw error against time, log-log, one line per method (PNG)")
+    b.add_argument("--process", action="store_true",
+                   help="time whole processes (spinviz simulate, and the standalone heyoka and scipy scripts of "
+                        "benchmarks/) instead of in-process runs, at ~400 turns (~5 min; --quick ~1 min)")
 
     st = sub.add_parser("stress", help="stiff and extreme cases: pass/fail, error, time, and the method the driver picked")
     st.add_argument("--json", action="store_true", help="print a JSON list of records instead of a table")
@@ -160,13 +173,76 @@ def _size(text: str):
 
 
 # --- dispatch ---------------------------------------------------------------------------
+class _Stream:
+    """A standard stream that never raises into a command: the first failure (a closed or full
+    stream) is kept in ``error`` and later writes are dropped; text the stream cannot encode
+    is written escaped.  A reader that left stdout (EPIPE) still ends the command quietly."""
+
+    def __init__(self, stream, pipe_ends: bool):
+        self.stream, self.pipe_ends = stream, pipe_ends
+        self.error = None if stream is not None else OSError(errno.EBADF, os.strerror(errno.EBADF))
+
+    def _do(self, op, *a):
+        if self.error is not None:
+            return
+        try:
+            op(*a)
+        except BrokenPipeError as e:
+            if self.pipe_ends:
+                raise
+            self.error = e
+        except UnicodeEncodeError as e:
+            if not a:
+                self.error = e
+                return
+            enc = getattr(self.stream, "encoding", None) or "utf-8"
+            self._do(op, a[0].encode(enc, "backslashreplace").decode(enc))
+        except (OSError, ValueError) as e:               # ValueError: a closed file object
+            self.error = e
+
+    def write(self, text: str) -> int:
+        self._do(lambda t: self.stream.write(t), text)
+        return len(text)
+
+    def flush(self) -> None:
+        self._do(lambda: self.stream.flush())
+
+    def isatty(self) -> bool:
+        try:
+            return self.error is None and self.stream.isatty()
+        except (OSError, ValueError, AttributeError):
+            return False
+
+    def fileno(self) -> int:
+        if self.stream is None:
+            import io
+
+            raise io.UnsupportedOperation("the stream was closed before the command started")
+        return self.stream.fileno()
+
+    def __getattr__(self, name):
+        return getattr(self.stream, name)
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
-    with interrupt.handlers(), warnings.catch_warnings():
-        # NumPy's overflow warnings are not for the user: every result is checked for finite
-        # values and a run that leaves them fails with one line (driver._check_finite)
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return _run(args)
+    out, err = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = _Stream(out, pipe_ends=True), _Stream(err, pipe_ends=False)
+    try:
+        with interrupt.handlers(), warnings.catch_warnings():
+            # NumPy's overflow warnings are not for the user: every result is checked for finite
+            # values and a run that leaves them fails with one line (driver._check_finite)
+            warnings.simplefilter("ignore", RuntimeWarning)
+            code = _run(args)
+        sys.stdout.flush()
+        if sys.stdout.error is not None:
+            # the report is lost; whatever the command wrote to files stays (it was written first)
+            e = sys.stdout.error
+            _say("", f"cannot write to standard output: {getattr(e, 'strerror', None) or e}")
+            code = code or EXIT_FAIL
+        return code
+    finally:
+        sys.stdout, sys.stderr = out, err
 
 
 def _say(prefix: str, message) -> None:
@@ -175,14 +251,23 @@ def _say(prefix: str, message) -> None:
     print(f"spinviz: {prefix}{printable(message)}", file=sys.stderr)
 
 
+def _p(name) -> str:
+    """A path or name for a report line: escaped (it may hold any byte a file system allows)."""
+    return printable(name, 300)
+
+
 def _out(text: str) -> None:
-    """Print a report for people, each line escaped: titles and paths come from files."""
-    print("\n".join(printable(line, 2000) for line in str(text).splitlines()))
+    """Print a report for people, each of its lines escaped (names in it are escaped by
+    ``_p`` where they are put in, so that a newline in a name cannot split a line)."""
+    print("\n".join(printable(line, 2000) for line in str(text).split("\n")))
 
 
 def _run(args) -> int:
     try:
         return _COMMANDS[args.command](args)
+    except WriteFailed as e:
+        _say("error: ", e)
+        return EXIT_FAIL
     except (UsageError, SceneError, SpecError) as e:
         _say("error: ", e)
         return EXIT_USAGE
@@ -203,9 +288,13 @@ def _run(args) -> int:
         # line, not a traceback (SPINVIZ_DEBUG=1 shows the traceback)
         if os.environ.get("SPINVIZ_DEBUG"):
             raise
-        what = getattr(e, "filename", None)
-        msg = f"{what}: {e.strerror}" if isinstance(e, OSError) and what and e.strerror else str(e) or type(e).__name__
-        _say("error: ", msg)
+        what = getattr(e, "filename", None) if isinstance(e, OSError) else None
+        if isinstance(e, OSError) and what is None and getattr(args, "out", None):
+            what = args.out                                 # e.g. a full disk while writing the output
+        if isinstance(e, OSError) and e.strerror:
+            _say("error: ", f"{what}: {e.strerror}" if what else e.strerror)
+            return EXIT_FAIL if e.errno in (errno.ENOSPC, errno.EIO, errno.EDQUOT, errno.EFBIG) else EXIT_USAGE
+        _say("error: ", str(e) or type(e).__name__)
         return EXIT_USAGE
 
 
@@ -237,9 +326,9 @@ def _cmd_info(args) -> int:
         from .scene import load_scene
 
         sc = load_scene(target)
-        body, title, omega = sc.body, f"{sc.title}  ({target}): {sc.body.name}", sc.omega0
+        body, title, omega = sc.body, f"{sc.title}  ({_p(target)}): {sc.body.name}", sc.omega0
     else:
-        raise UsageError(f"{target}: not a preset ({', '.join(PRESETS)}) nor a scene file")
+        raise UsageError(f"{_p(target)}: not a preset ({', '.join(PRESETS)}) nor a scene file")
     if args.json:
         print(json.dumps(info.rows(body, omega), indent=2, default=float))
     else:
@@ -249,7 +338,7 @@ def _cmd_info(args) -> int:
 
 def _cmd_simulate(args) -> int:
     from .atomic import check_outputs
-    from .driver import simulate
+    from .driver import simulate_request
     from .scene import load_scene
 
     if os.path.splitext(args.out)[1].lower() != ".npz":
@@ -259,32 +348,48 @@ def _cmd_simulate(args) -> int:
     model = args.model or sc.model
     if model not in sc.models:
         raise UsageError(f"{args.scene}: --model {model!r} is not one of the scene's models ({', '.join(sc.models)})")
-    kw = sc.simulation_kwargs()
-    if args.method:
-        from .integrators import get
-
-        if args.method.lower() != "auto":
-            try:
-                get(args.method)
-            except ValueError as e:
-                raise UsageError(f"--method: {e}") from None
-        kw["method"] = args.method.lower()
+    request = sc.request(model)
+    if args.method:                                 # the option replaces the scene's method, checked the same way
+        try:
+            request = dataclasses.replace(request, method=args.method)
+        except SpecError as e:
+            raise UsageError(f"--method: {e.reason}" if e.key == "method" else f"--method: {e.key}: {e.reason}") from None
     try:
-        traj = simulate(sc.body, model, **kw)
+        traj = simulate_request(request)
     except SimulationError as e:
         raise SimulationError(f"{args.scene}: {e}") from None
-    except ValueError as e:
-        raise UsageError(f"{args.scene}: {e}") from None
     try:
         traj.save(args.out, radiation=True)
     except OSError as e:
-        raise UsageError(f"{args.out}: cannot write: {e.strerror or e}") from None
+        raise _cannot_write(args.out, e) from None
     st = traj.stats
     cost = f"{st['nsteps']} steps" if "nsteps" in st else f"{st.get('nfev', '?')} rhs evaluations"
-    _out(f"{args.out}: {traj.t.size} samples, model {model}, method {st['method']}, {cost}, {st['runtime_s']:.3f} s")
+    _out(f"{_p(args.out)}: {traj.t.size} samples, model {model}, method {st['method']}, {cost}, {st['runtime_s']:.3f} s")
     for note in st.get("accuracy_notes", ()):
         _say("note: ", note)
     return EXIT_OK
+
+
+class WriteFailed(SpinvizError, OSError):
+    """An output could not be written (a full disk, an I/O error): exit status 1, the path named."""
+
+
+def _cannot_write(path, e: OSError) -> SpinvizError:
+    """One line naming the output that could not be written, and why."""
+    return WriteFailed(f"{path}: cannot write: {e.strerror or e}")
+
+
+def _named(e: SpecError, args, flags: dict, scene_keys: dict | None = None) -> UsageError:
+    """A library error about an argument, in the command line's terms: the option that set the
+    value (``--workers: ...``) when it was given on the command line, else the scene's key
+    (``SCENE: [render].fps: ...``), else the argument's own name."""
+    option = flags.get(e.key)
+    if option and getattr(args, option.lstrip("-").replace("-", "_"), None) is not None:
+        return UsageError(f"{option}: {e.reason}")
+    scene = getattr(args, "scene", None)
+    if scene_keys is not None and scene is not None:
+        return UsageError(f"{scene}: {scene_keys.get(e.key, e.key)}: {e.reason}")
+    return UsageError(f"{option or e.key}: {e.reason}")
 
 
 def _cmd_methods(args) -> int:
@@ -297,10 +402,18 @@ def _cmd_methods(args) -> int:
     return EXIT_OK
 
 
+RENDER_FLAGS = {"size": "--size", "fps": "--fps", "duration": "--duration", "out": "--out", "workers": "--workers",
+                "frames": "--frames"}
+
+
 def _option(e: SpecError, args) -> UsageError:
-    """A SpecError from a command-line override, named by its option."""
-    return UsageError(f"--{e.key}: {e.reason}" if e.key in ("size", "fps", "duration", "out") and
-                      getattr(args, e.key, None) is not None else f"{args.scene}: [render].{e.key}: {e.reason}")
+    """A SpecError from ``render``, named by its option, or by the scene's ``[render]`` key."""
+    return _named(e, args, RENDER_FLAGS, _RenderKeys())
+
+
+class _RenderKeys(dict):
+    def __missing__(self, key):
+        return f"[render].{key}"
 
 
 def _cmd_render(args) -> int:
@@ -317,13 +430,15 @@ def _cmd_render(args) -> int:
     except SpecError as e:
         raise _option(e, args) from None
     except OSError as e:
-        raise UsageError(f"{out}: cannot write: {e.strerror or e}") from None
+        raise _cannot_write(out, e) from None
+    except SpinvizError:
+        raise                                           # says what it is about (an output, the scene)
     except ValueError as e:
         raise UsageError(f"{args.scene}: {e}") from None
-    _out(f"{res.path}: {res.frames} frames {res.size[0]}x{res.size[1]}, "
+    _out(f"{_p(res.path)}: {res.frames} frames {res.size[0]}x{res.size[1]}, "
           f"rendered in {res.seconds:.1f} s ({res.fps:.1f} fps, {res.workers} workers)")
     if res.poster:
-        _out(f"{res.poster}: poster frame")
+        _out(f"{_p(res.poster)}: poster frame")
     for note in res.notes:
         _out(note)
     return EXIT_OK
@@ -344,7 +459,7 @@ def _render_bench(sc, args) -> int:
 def _cmd_compare(args) -> int:
     from .analysis import compare
     from .atomic import Outputs
-    from .driver import simulate
+    from .driver import simulate_request
     from .scene import load_scene
 
     sc = load_scene(args.scene)
@@ -361,41 +476,43 @@ def _cmd_compare(args) -> int:
     prefix = args.out or os.path.join("renders", os.path.splitext(os.path.basename(args.scene))[0])
     paths = [f"{prefix}_compare.png", f"{prefix}_hodograph.png"]
     group = Outputs(paths, [args.scene])                # checked before the runs, landed together after
-    kw = sc.simulation_kwargs(t_eval=compare.compare_times(sc.t_end, max(2, args.samples)))
+    times = compare.compare_times(sc.t_end, max(2, args.samples))
     try:
-        trajs = [simulate(sc.body, m, **kw) for m in sc.models]
-    except ValueError as e:
-        raise UsageError(f"{args.scene}: {e}") from None
+        trajs = [simulate_request(sc.request(m, t_eval=times)) for m in sc.models]
+    except SpecError as e:
+        raise _named(e, args, {"t_eval": "--samples"}) from None
     c = compare.compare(trajs)
     try:
         with group as tmps:
             compare.plot(c, tmps[0], sc.title)
             compare.plot_hodograph(c, tmps[1], sc.title)
     except OSError as e:
-        raise UsageError(f"{prefix}: cannot write the plots: {e.strerror or e}") from None
+        raise _cannot_write(prefix, e) from None
     if args.json:
         print(json.dumps({**c.record(), "plots": list(paths)}, indent=2, default=float))
     else:
         _out(compare.format_table(c, sc.title))
-        _out(f"\nplots: {paths[0]}, {paths[1]}")
+        _out(f"\nplots: {_p(paths[0])}, {_p(paths[1])}")
     return EXIT_OK
 
 
-def _observe_args(args):
-    """The observe/listen overrides, checked: (line of sight, distance)."""
-    import math
+OBSERVE_FLAGS = {"line_of_sight": "--los", "distance_cm": "--distance-cm", "power_factor": "--power-factor",
+                 "frequency_resolution": "--frequency-resolution", "polarization_deg": "--polarization-deg"}
 
-    checks = (("--distance-cm", args.distance_cm, 1e-4, 1e30),
-              ("--power-factor", getattr(args, "power_factor", None), 1.0001, 1e6),
-              ("--frequency-resolution", getattr(args, "frequency_resolution", None), 1e-12, 0.5),
-              ("--polarization-deg", getattr(args, "polarization_deg", None), 0.01, 89.0))
-    for name, v, lo, hi in checks:
-        if v is not None and not lo <= v <= hi:
-            raise UsageError(f"--{name.lstrip('-')}: must lie in [{lo:g}, {hi:g}], got {v:g}")
-    los = args.los
-    if los is not None and (not all(math.isfinite(x) for x in los) or not any(x != 0.0 for x in los)):
-        raise UsageError(f"--los: must be a finite, non-zero vector, got {','.join(f'{x:g}' for x in los)}")
-    return los, args.distance_cm
+
+def _observe_args(args):
+    """The observe/listen overrides, checked by the ``[observe]`` table's own schema (so an
+    option and the key it overrides take the same values): (line of sight, distance)."""
+    from .inputs.scene import ObserveTable
+
+    given = {k: getattr(args, opt.lstrip("-").replace("-", "_"), None) for k, opt in OBSERVE_FLAGS.items()
+             if k != "line_of_sight"}
+    given["line_of_sight"] = args.los
+    try:
+        ObserveTable(**{k: v for k, v in given.items() if v is not None})
+    except SpecError as e:
+        raise UsageError(f"{OBSERVE_FLAGS.get(e.key, e.key)}: {e.reason}") from None
+    return args.los, args.distance_cm
 
 
 def _cmd_observe(args) -> int:
@@ -426,12 +543,12 @@ def _cmd_observe(args) -> int:
             OB.plot(obs, tmps[0])
             OB.plot_detector(obs, tmps[1])
     except OSError as e:
-        raise UsageError(f"{prefix}: cannot write the plots: {e.strerror or e}") from None
+        raise _cannot_write(prefix, e) from None
     if args.json:
         print(json.dumps({**obs.record(), "plots": list(paths)}, indent=2, default=float))
     else:
         _out(OB.format_table(obs))
-        _out(f"\nplots: {paths[0]}, {paths[1]}")
+        _out(f"\nplots: {_p(paths[0])}, {_p(paths[1])}")
     return EXIT_OK
 
 
@@ -472,15 +589,15 @@ def _cmd_listen(args) -> int:
     except ValueError as e:
         raise UsageError(f"{args.scene}: {e}") from None
     except OSError as e:
-        raise UsageError(f"{args.out}: cannot write: {e.strerror or e}") from None
-    _out(f"{args.out}: {mapping.duration_s:g} s, {mapping.rate} Hz, 16-bit stereo")
+        raise _cannot_write(args.out, e) from None
+    _out(f"{_p(args.out)}: {mapping.duration_s:g} s, {mapping.rate} Hz, 16-bit stereo")
     _out(mapping.statement())
     if mapping.dropped_above_nyquist:
         _out(f"note: {mapping.dropped_above_nyquist} line(s) above {sonify.NYQUIST_SHARE * mapping.rate:.0f} Hz left "
              f"out (lower --f0 to hear them)")
     if mapping.below_audible_s > 0.0:
         _out(f"note: for {mapping.below_audible_s:.1f} s the strongest line is below 20 Hz (raise --f0)")
-    _out(f"{png}: spectrogram of the WAV")
+    _out(f"{_p(png)}: spectrogram of the WAV")
     return EXIT_OK
 
 
@@ -488,6 +605,16 @@ def _cmd_bench(args) -> int:
     from .atomic import write_json
     from .validation import bench
 
+    if args.process:
+        from .validation import process_bench as PB
+
+        pts = PB.run(quick=args.quick, progress=_progress)
+        print(PB.format_table(pts))
+        if args.json:
+            write_json(args.json, {"points": [p.record() for p in pts], "headline": PB.headline(pts)})
+        if args.plot:
+            PB.plot(pts, args.plot)
+        return EXIT_OK
     plan = bench.quick_plan() if args.quick else bench.Plan()
     rows = bench.run(plan, progress=_progress)
     summ = bench.summary(rows)
@@ -514,14 +641,21 @@ def _cmd_report(args) -> int:
     from .validation import report
 
     results, plot_path = report.generate(args.out, args.out_dir, args.quick, progress=_progress)
-    _out(f"{args.out}: regenerated; {plot_path}")
+    _out(f"{_p(args.out)}: regenerated; {_p(plot_path)}")
     return EXIT_OK if all(r.passed for r in results) else EXIT_FAIL
+
+
+ATLAS_FLAGS = {"out": "--out", "scheduler": "--scheduler", "workers": "--workers", "plot": "--plot",
+               "runs_per_task": "--runs-per-task"}
 
 
 def _cmd_atlas(args) -> int:
     from .regimes import command
 
-    return command.run(args)
+    try:
+        return command.run(args)
+    except SpecError as e:
+        raise _named(e, args, ATLAS_FLAGS) from None
 
 
 _COMMANDS = {"check": _cmd_check, "info": _cmd_info, "simulate": _cmd_simulate, "methods": _cmd_methods,
@@ -530,13 +664,47 @@ _COMMANDS = {"check": _cmd_check, "info": _cmd_info, "simulate": _cmd_simulate, 
              "listen": _cmd_listen}
 
 
+def _occupy_closed_std_fds() -> None:
+    """A standard descriptor (0, 1, 2) closed by the caller (``>&-``) is opened on /dev/null,
+    as careful Unix tools do: otherwise the next file opened -- the output itself -- would
+    take its number, and anything written to "stdout" (by us or a child process) would land
+    in it.  Python has already set ``sys.stdout`` (or ``stderr``) to None for it, so the
+    command still knows the stream is gone."""
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+        except OSError:
+            nul = os.open(os.devnull, os.O_RDWR)
+            if nul != fd:
+                os.dup2(nul, fd)
+                os.close(nul)
+
+
+def _settle(stream) -> None:
+    """Text a standard stream could not take stays in its buffer and would fail again (with
+    a complaint and exit status 120) at the interpreter's last flush: send it to /dev/null."""
+    if stream is None:
+        return
+    try:
+        stream.flush()
+    except (OSError, ValueError):
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), stream.fileno())
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+
+
 def entry() -> None:
     """Console-script entry point."""
+    _occupy_closed_std_fds()
     try:
         code = main()
-        sys.stdout.flush()
+        if sys.stdout is not None:
+            sys.stdout.flush()
     except BrokenPipeError:
         # the reader went away (spinviz methods | head -1): end quietly, as a Unix tool does
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         code = 128 + 13
+    _settle(sys.stdout)
+    _settle(sys.stderr)
     sys.exit(code)

@@ -23,16 +23,17 @@ import numpy as np
 
 from . import rotations as R
 from . import units as U
-from .errors import SimulationError
+from .errors import SimulationError, SpecTypeError, SpinvizError
+from .inputs.simulation import SimulationRequest
 from .integrators import Problem, Solution, get
 from .integrators import status as ST
-from .integrators.auto import HARD_MAX_TURNS, check_cost, choose_method, estimated_turns
-from .integrators.scaling import body_spin_problem, check_scale, spin_problem
+from .integrators.auto import HARD_MAX_TURNS, choose_method, estimated_turns
+from .integrators.scaling import body_spin_problem, spin_problem
 from .physics.bodies import Body
 from .physics.equations import System, truncated_singularity
 from .trajectory import Trajectory
 
-__all__ = ["simulate", "solve", "solve_many", "SimulationError", "Run"]
+__all__ = ["simulate", "simulate_request", "SimulationRequest", "solve", "solve_many", "SimulationError", "Run"]
 
 ATOL_FROM_RTOL = 1e-2      # atol = rtol / 100 when not given: in spin units the state is O(1), so atol >= rtol would rule
 
@@ -67,32 +68,51 @@ def simulate(
     step : step size for fixed-step methods, in units of t (s or tau).
     kinematics : "quaternion" (default), "euler_zxz" (the Poisson equations (6.4), for
     comparison; singular at theta = 0) or "none" (no orientation: Euler equation only).
+
+    The arguments are checked once, by ``spinviz.inputs.simulation.SimulationRequest``
+    (shared with scenes and the command line): a bad one raises ``SpecError`` naming it
+    (``SpecTypeError``, also a TypeError, for a value of the wrong kind).
     """
-    omega0 = np.asarray(omega0, dtype=float)
-    check_scale(body, omega0)
-    t_eval = output_times(t_end, samples, t_eval)
-    atol = rtol * ATOL_FROM_RTOL if atol is None else atol
-    q_init, euler_init = initial_orientation(q0, euler_zxz0)
+    return simulate_request(SimulationRequest(
+        body=body, model=model, omega0=omega0, t_end=t_end, samples=samples, t_eval=t_eval, q0=q0,
+        euler_zxz0=euler_zxz0, method=method, rtol=rtol, atol=atol, step=step, kinematics=kinematics))
+
+
+def simulate_request(request: SimulationRequest) -> Trajectory:
+    """Run a validated ``SimulationRequest`` (``Scene.request(model)`` makes one for a scene)."""
+    if not isinstance(request, SimulationRequest):
+        raise SpecTypeError("request", f"must be a SimulationRequest, got {type(request).__name__}")
+    body, model, kinematics = request.body, request.model, request.kinematics
+    omega0 = np.array(request.omega0)
+    t_eval = request.times()
+    rtol, atol, step = request.rtol, request.atol_or_default, request.step
+    q_init, euler_init = initial_orientation(request.q0, request.euler_zxz0)
     problem, eps = body_spin_problem(body, model, omega0, t_eval, q_init, euler_init, kinematics)
     if model == "truncated":
         check_truncated_solvable(problem.system, problem.omega0)
     time_scale = eps / body.tau0                   # spin-unit time per unit of t
-    method = str(method).lower()
+    method = request.method
     auto = method == "auto"
     horizon = float(t_eval[-1])
     if auto:
         method, reason = choose_method(body, model, omega0, horizon, kinematics, spin=(problem, eps), rtol=rtol)
     else:
         reason = "chosen by the user"
-    check_cost(body, model, omega0, horizon, "auto" if auto else method, step, spin=(problem, eps),
-               kinematics=kinematics, picked=method if auto else None)
     # a declining secular run can be handed to a resolving method when its cost check would pass
     resolvable = (auto and method == "secular"
                   and estimated_turns(body, model, omega0, horizon, (problem, eps)) <= HARD_MAX_TURNS)
     _check_method(method, body, kinematics)
     start = time.perf_counter()
-    sol, name, reason = solve(problem, method, rtol=rtol, atol=atol, step=None if step is None else step * time_scale,
-                              auto=auto, reason=reason, resolvable=resolvable)
+    try:
+        sol, name, reason = solve(problem, method, rtol=rtol, atol=atol, step=None if step is None else step * time_scale,
+                                  auto=auto, reason=reason, resolvable=resolvable)
+    except SpinvizError:
+        raise
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as e:
+        # a numerical library giving up on the equations (e.g. (6.4) at sin theta = 0 under an
+        # implicit method, whose Jacobian turns non-finite): a run that cannot be done, said as such
+        raise SimulationError(f"the integration failed ({type(e).__name__}: {e}; method {request.method!r}"
+                              f"{f', started as {method!r}' if auto else ''})") from e
     runtime = time.perf_counter() - start
     if not sol.success:
         raise SimulationError(_failure_message(problem, sol, name, time_scale))
@@ -141,18 +161,6 @@ def _stats_in_units(stats: dict, time_scale: float) -> dict:
     if "resonances" in out:
         out["resonances"] = [[m, t / time_scale, kick] for m, t, kick in out["resonances"]]
     return out
-
-
-def output_times(t_end=None, samples=None, t_eval=None) -> np.ndarray:
-    """The output instants: ``t_eval`` as given, or ``samples`` evenly spaced over [0, t_end]."""
-    if t_eval is None:
-        if t_end is None or samples is None:
-            raise ValueError("give t_end and samples, or t_eval")
-        t_eval = np.linspace(0.0, float(t_end), int(samples))
-    t_eval = np.asarray(t_eval, dtype=float)
-    if t_eval.ndim != 1 or t_eval.size < 2 or np.any(np.diff(t_eval) <= 0) or t_eval[0] != 0.0:
-        raise ValueError("t_eval must be increasing, start at 0 and hold at least two instants")
-    return t_eval
 
 
 def initial_orientation(q0=None, euler_zxz0=None):
@@ -300,7 +308,7 @@ def solve_many(model: str, inertia: list, coupling: list, omega0: list, tau, *, 
     n = len(omega0)
     eta = np.zeros(n) if residual_eta is None else np.asarray(residual_eta, dtype=float)
     runs: list[Run | None] = [None] * n
-    groups: dict = {}
+    todo = []
     for i in range(n):
         system = System(model, tuple(map(float, inertia[i])), tuple(map(float, coupling[i])))
         w0 = np.asarray(omega0[i], dtype=float)
@@ -308,22 +316,22 @@ def solve_many(model: str, inertia: list, coupling: list, omega0: list, tau, *, 
             runs[i] = _singular_run(tau, w0, truncated_margin(system, w0), singular_margin)
             continue
         prob, eps = spin_problem(system, w0, tau, kinematics="none")
-        groups.setdefault(eps, []).append((i, prob))
-    for eps, members in groups.items():
-        t0 = time.perf_counter()
-        idx = [i for i, _ in members]
-        probs = [p for _, p in members]
-        if method == "taylor" and model != "free" and all(_atlas_body(p.system) for p in probs):
-            from .integrators.taylor import solve_batch
+        todo.append((i, prob, eps))
+    if not todo:
+        return runs
+    t0 = time.perf_counter()
+    probs = [p for _, p, _ in todo]
+    if method == "taylor" and model != "free" and all(_atlas_body(p.system) for p in probs):
+        from .integrators.taylor import solve_batch
 
-            results = [(r.omega, r.status, r.reached, r.t_stop, r.nsteps)
-                       for r in solve_batch(probs, rtol, max_steps, eta[idx], stop)]
-        else:
-            results = [_one_by_one(p, method, rtol, max_steps) for p in probs]
-        share = (time.perf_counter() - t0) / len(members)
-        for i, (w, st, reached, t_stop, nsteps) in zip(idx, results):
-            runs[i] = Run(tau, w * eps, int(st), int(reached), t_stop / eps, int(nsteps), share,
-                          _reason(st, tau, reached, t_stop / eps))
+        results = [(r.omega, r.status, r.reached, r.t_stop, r.nsteps)
+                   for r in solve_batch(probs, rtol, max_steps, eta[[i for i, _, _ in todo]], stop)]
+    else:
+        results = [_one_by_one(p, method, rtol, max_steps) for p in probs]
+    share = (time.perf_counter() - t0) / len(todo)
+    for (i, _, eps), (w, st, reached, t_stop, nsteps) in zip(todo, results):
+        runs[i] = Run(tau, w * eps, int(st), int(reached), t_stop / eps, int(nsteps), share,
+                      _reason(st, tau, reached, t_stop / eps))
     return runs
 
 

@@ -4,23 +4,28 @@ Kept in a module of their own with no imports, so that the command line can catc
 without loading numba, scipy or the rendering stack (``spinviz info`` stays instant).
 
 * ``SceneError`` -- a scene (or atlas spec) file that cannot be used: file, key, reason.
-* ``SpecError`` -- a bad value for a named setting (a key of ``[render]``, an argument);
-  the scene layer turns it into a ``SceneError`` that also names the file.
+* ``SpecError`` -- a bad value for a named setting (a key of a TOML table, a Python
+  argument), named in the caller's terms; the scene layer turns it into a ``SceneError``
+  that also names the file, the command line names its option.  ``SpecTypeError`` is the
+  same for a value of the wrong kind (also a ``TypeError``).
+* ``TrajectoryFileError`` -- a file that is not a readable spinviz trajectory: path, reason.
 * ``UsageError`` -- any other bad request (an output path, a combination of options).
 * ``SimulationError`` -- a run that could not be completed (an integrator gave up, the
   solution ran away); says why and when.
 * ``RenderError`` -- drawing or encoding failed.
 
-The command line maps the first three to exit status 2, the last two to 1.
+The command line maps the bad-input errors to exit status 2, the failed runs to 1.
 
-``printable`` and ``brief`` make any echoed text safe for a terminal: control characters
-are shown escaped (``\\x1b``, ``\\n``) and long values are cut, so a message is always one
-short line whatever a file or a key name holds.
+``printable`` and ``brief`` make any echoed text safe for a terminal: every C0/C1 control,
+bidi and other format character, line or paragraph separator, and undecodable byte is shown
+escaped (``\\x1b``, ``\\n``, ``\\u202e``, ``\\xff``) and long values are cut, so a
+message is always one short line in logical order, whatever a file or a key name holds.
 """
 
 from __future__ import annotations
 
 import reprlib
+import unicodedata
 
 MAX_MESSAGE = 400          # characters of one error line
 _brief = reprlib.Repr()
@@ -28,20 +33,46 @@ _brief.maxlist = _brief.maxtuple = 6
 _brief.maxdict, _brief.maxstring, _brief.maxother, _brief.maxlevel = 4, 60, 60, 2
 
 
+_ESCAPED = {"Cc", "Cf", "Zl", "Zp", "Cs"}     # controls, format (bidi, zero-width), separators, lone surrogates
+_SHORT = {"\n": "\\n", "\r": "\\r", "\t": "\\t"}
+
+
+def _escape(ch: str) -> str:
+    o = ord(ch)
+    if ch in _SHORT:
+        return _SHORT[ch]
+    if 0xDC80 <= o <= 0xDCFF:          # an undecodable byte of a file name (surrogateescape): show the byte
+        return f"\\x{o - 0xDC00:02x}"
+    return f"\\x{o:02x}" if o < 0x100 else (f"\\u{o:04x}" if o < 0x10000 else f"\\U{o:08x}")
+
+
 def printable(text, limit: int = MAX_MESSAGE) -> str:
-    """``text`` with every control character escaped (one line, no terminal commands) and cut
-    to ``limit`` characters."""
+    """``text`` as one safe line: every control (C0, DEL, C1), format character (bidi
+    overrides and isolates, zero-width marks), line or paragraph separator and undecodable
+    byte escaped -- so nothing can colour, clear, split or reorder the terminal, and a
+    strict UTF-8 stream can always encode it -- and cut to ``limit`` characters."""
+    if isinstance(text, bytes):
+        text = text.decode("utf-8", "surrogateescape")
     out = []
+    n = 0
     for ch in str(text):
-        o = ord(ch)
-        if o < 0x20 or 0x7F <= o < 0xA0 or o in (0x2028, 0x2029):
-            out.append({"\n": "\\n", "\r": "\\r", "\t": "\\t"}.get(ch, f"\\x{o:02x}" if o < 0x100 else f"\\u{o:04x}"))
-        else:
-            out.append(ch)
-        if len(out) > limit:
+        piece = _escape(ch) if unicodedata.category(ch) in _ESCAPED else ch
+        out.append(piece)
+        n += len(piece)
+        if n > limit:
             break
     s = "".join(out)
     return s if len(s) <= limit else s[: limit - 1] + "\u2026"
+
+
+def shortened(text, limit: int = 160) -> str:
+    """``text`` escaped as by ``printable`` and, when longer than ``limit``, cut in the middle
+    (a path keeps its folder's start and its file name's end)."""
+    s = printable(text, 10 * limit)
+    if len(s) <= limit:
+        return s
+    half = (limit - 1) // 2
+    return s[:half] + "\u2026" + s[len(s) - (limit - 1 - half):]
 
 
 def brief(value) -> str:
@@ -65,6 +96,11 @@ class SpecError(SpinvizError, ValueError):
         super().__init__(f"{key}: {reason}")
 
 
+class SpecTypeError(SpecError, TypeError):
+    """A value of the wrong kind for ``key`` (a path where a body is expected, a string
+    where a number is): both a ``SpecError`` (ValueError) and a ``TypeError``."""
+
+
 class SceneError(SpinvizError, ValueError):
     """A scene that cannot be used: ``path``, ``key`` and ``reason`` give the one line."""
 
@@ -79,3 +115,12 @@ class SimulationError(SpinvizError, RuntimeError):
 
 class RenderError(SpinvizError, RuntimeError):
     """Rendering failed; the message says where (a worker's last traceback line included)."""
+
+
+class TrajectoryFileError(SpinvizError, ValueError):
+    """A file that is not a readable spinviz trajectory (missing, damaged, another format):
+    ``path`` and ``reason`` give the one line."""
+
+    def __init__(self, path, reason: str):
+        self.path, self.reason = str(path), reason
+        super().__init__(f"{printable(self.path, 200)}: {reason}")

@@ -14,9 +14,9 @@ from collections.abc import Sequence
 import numpy as np
 
 from .atomic import check_outputs
-from .driver import simulate
-from .errors import UsageError
-from .rendering.spec import RenderSpec, poster_for
+from .driver import simulate_request
+from .errors import SpecError, SpecTypeError, UsageError
+from .inputs.render import RenderArguments, RenderSpec, poster_for
 from .rendering.timeline import FramePlan, frame_times, plan_frames
 from .scene import Scene, load_scene
 from .trajectory import Trajectory
@@ -62,16 +62,26 @@ def require_render_stack():
 
 
 # --- what to draw ------------------------------------------------------------------------
+SOURCE_KINDS = "a Scene, the path of a scene file, a Trajectory or a list of one or two Trajectories"
+
+
 def _as_source(source: Source):
-    """(scene or None, trajectories or None) from any accepted source."""
+    """(scene or None, trajectories or None) from any accepted source; ``SpecTypeError``
+    naming ``source`` otherwise."""
     if isinstance(source, (str, os.PathLike)):
         return load_scene(source), None
     if isinstance(source, Scene):
         return source, None
-    trajs = [source] if isinstance(source, Trajectory) else list(source)
-    if not 1 <= len(trajs) <= 2 or not all(isinstance(t, Trajectory) for t in trajs):
-        raise UsageError("render a scene, a Trajectory or a list of one or two Trajectories")
-    return None, trajs
+    if isinstance(source, Trajectory):
+        return None, [source]
+    if isinstance(source, (list, tuple)) and 1 <= len(source) <= 2 and all(isinstance(t, Trajectory) for t in source):
+        return None, list(source)
+    raise SpecTypeError("source", f"must be {SOURCE_KINDS}, got {type(source).__name__}")
+
+
+def _horizon(scene, trajs) -> float:
+    """The end of the run (scene time unit): the scene's horizon or the first trajectory's end."""
+    return scene.t_end if scene is not None else float(trajs[0].t[-1])
 
 
 def resolve_spec(source: Source, **overrides) -> tuple[Scene | None, list[Trajectory] | None, RenderSpec]:
@@ -93,7 +103,7 @@ def resolve_spec(source: Source, **overrides) -> tuple[Scene | None, list[Trajec
     scene, trajs = _as_source(source)
     base = scene.render if scene is not None else RenderSpec()
     spec = base.with_(**overrides)
-    spec.check_horizon(scene.t_end if scene is not None else float(trajs[0].t[-1]))
+    spec.check_horizon(_horizon(scene, trajs))
     return scene, trajs, spec
 
 
@@ -102,8 +112,8 @@ def scene_trajectories(scene: Scene, spec: RenderSpec, t_end: float | None = Non
     [0, t_end] (scene time unit, default the scene's horizon); the orientation is integrated
     only when something shown needs it (quaternion kinematics, else none)."""
     _, sim_t, _ = frame_times(spec, scene.t_end if t_end is None else t_end)
-    kw = scene.simulation_kwargs(kinematics="quaternion" if spec.needs_orientation else "none", t_eval=sim_t)
-    return [simulate(scene.body, m, **kw) for m in scene.models]
+    kinematics = "quaternion" if spec.needs_orientation else "none"
+    return [simulate_request(scene.request(m, kinematics=kinematics, t_eval=sim_t)) for m in scene.models]
 
 
 def _check_drawable(trajs: list[Trajectory] | None, spec: RenderSpec) -> None:
@@ -114,24 +124,24 @@ def _check_drawable(trajs: list[Trajectory] | None, spec: RenderSpec) -> None:
         return
     for tr in trajs:
         if tr.q is None:
-            raise UsageError(f"this {tr.model} trajectory has no orientation; simulate with kinematics=\"quaternion\" "
-                             f"or show only the hodograph")
+            raise SpecError("source", f"this {tr.model} trajectory has no orientation; simulate with "
+                                      f"kinematics=\"quaternion\" or show only the hodograph")
         if tr.slow is not None:
             continue
         turn = float(np.max(tr.omega_magnitude[:-1] * np.diff(tr.t))) if tr.t.size > 1 else 0.0
         if turn > MAX_STORED_TURN:
-            raise UsageError(f"the {tr.model} trajectory is stored too coarsely to draw (up to {np.degrees(turn):.0f} deg "
-                             f"between samples); simulate it at more instants")
+            raise SpecError("source", f"the {tr.model} trajectory is stored too coarsely to draw (up to "
+                                      f"{np.degrees(turn):.0f} deg between samples); simulate it at more instants")
 
 
-def plan(source: Source, t: float | None = None, frames: int | None = None, **overrides) -> FramePlan:
+def plan(source: Source, t_end: float | None = None, frames: int | None = None, **overrides) -> FramePlan:
     """The frame plan of a video of ``source``: what each frame shows, independent of the
     frame size (a scene is simulated at the frame times; no drawing library is loaded).
 
     Parameters
     ----------
     source : Scene, path, Trajectory or list of one or two Trajectories
-    t : float, optional
+    t_end : float, optional
         The video ends at this simulation time (scene time unit); default the whole run.
     frames : int, optional
         Number of frames F; default ``duration * fps`` of the spec.
@@ -144,29 +154,31 @@ def plan(source: Source, t: float | None = None, frames: int | None = None, **ov
         Frame times (F,), and per panel the shown orientation (F, 4), world-frame vectors
         (F, 3) and readouts; see ``rendering.frameplan``.
     """
+    args = RenderArguments(t_end=t_end, frames=frames)
     scene, trajs, spec = resolve_spec(source, **overrides)
-    return _plan(scene, trajs, spec, t, frames)
+    return _plan(scene, trajs, spec, args.t_end, args.frames)
 
 
-def _plan(scene, trajs, spec: RenderSpec, t=None, frames=None) -> FramePlan:
+def _plan(scene, trajs, spec: RenderSpec, t_end=None, frames=None) -> FramePlan:
     """Trajectories at the frame times -- a scene simulated at them, given trajectories
     checked and, for a shorter video, sampled at them -- and their frame plan."""
-    t_end = _within(t, scene.t_end if scene is not None else float(trajs[0].t[-1]))
+    end = _within("t_end", t_end, _horizon(scene, trajs))
     _check_drawable(trajs, spec)
     if scene is not None:
-        trajs = scene_trajectories(scene, spec, t_end)
-    elif t is not None:
-        trajs = [tr.sample(frame_times(spec, t_end, frames)[1]) for tr in trajs]
+        trajs = scene_trajectories(scene, spec, end)
+    elif t_end is not None:
+        trajs = [tr.sample(frame_times(spec, end, frames)[1]) for tr in trajs]
     return plan_frames(spec, trajs, frames)
 
 
-def _within(t, t_end: float) -> float:
-    """The end of the video: ``t`` if given (it must lie in (0, t_end]), else ``t_end``."""
+def _within(name: str, t, horizon: float, start_open: bool = True) -> float:
+    """``t`` (argument ``name``) checked against the run: in (0, horizon] (or [0, horizon]
+    with ``start_open`` False); the horizon when None."""
     if t is None:
-        return t_end
-    t = float(t)
-    if not 0.0 < t <= t_end:
-        raise UsageError(f"t must lie in (0, {t_end:g}], got {t:g}")
+        return horizon
+    if not ((0.0 < t) if start_open else (0.0 <= t)) or not t <= horizon:
+        raise SpecError(name, f"must lie in {'(' if start_open else '['}0, {horizon:g}] (the run's time, in its unit), "
+                              f"got {t:g}")
     return t
 
 
@@ -182,15 +194,15 @@ class Renderer:
     ----------
     source : Scene, path, Trajectory or list of one or two Trajectories
         One panel per model or trajectory.
-    t : float, optional
+    t_end : float, optional
         The video ends at this simulation time (scene time unit); default the whole run.
     **overrides
         ``RenderSpec`` fields (size, fps, duration, show, ...).
     """
 
-    def __init__(self, source: Source, t: float | None = None, **overrides):
+    def __init__(self, source: Source, t_end: float | None = None, **overrides):
         video = require_render_stack()
-        self.plan = plan(source, t=t, **overrides)
+        self.plan = plan(source, t_end=t_end, **overrides)
         self._session = None
         self._render_frames = video.render_frames
 
@@ -201,8 +213,9 @@ class Renderer:
 
     def frame(self, f: int) -> np.ndarray:
         """Frame ``f`` (0 .. frames - 1) as an RGB array, shape (H, W, 3), uint8."""
+        f = RenderArguments(frame=f).frame
         if not 0 <= f < self.frames:
-            raise UsageError(f"frame must lie in 0..{self.frames - 1}, got {f}")
+            raise SpecError("frame", f"must lie in 0..{self.frames - 1}, got {f}")
         if self._session is None:
             imgs, self._session = self._render_frames(self.plan, [f])
             return imgs[0]
@@ -222,9 +235,10 @@ class Renderer:
 
 
 def render_frame(source: Source, t: float | None = None, *, size=(640, 360), **overrides) -> np.ndarray:
-    """The picture at time ``t`` as an RGB array, shape (H, W, 3), uint8.
+    """The picture at physical time ``t`` as an RGB array, shape (H, W, 3), uint8.
 
-    It is the last frame of the video of [0, t] (the trail and, for a slowed spin, the shown
+    ``t = 0`` is the first frame of the video (the start, nothing before it); a later ``t``
+    is the last frame of the video of [0, t] (the trail and, for a slowed spin, the shown
     phase depend on what came before).  Shows nicely in Jupyter with
     ``PIL.Image.fromarray(img)`` or ``matplotlib.pyplot.imshow(img)``.
 
@@ -232,14 +246,20 @@ def render_frame(source: Source, t: float | None = None, *, size=(640, 360), **o
     ----------
     source : Scene, path, Trajectory or list of one or two Trajectories
     t : float, optional
-        Simulation time (scene time unit); default the end of the run.
+        Simulation time (the trajectory's, scene time unit) in [0, end of the run]; default
+        the end of the run.  (A video's own end is ``Renderer(t_end=...)``.)
     size : (int, int)
         (width, height) px.
     **overrides
         ``RenderSpec`` fields.
     """
-    with Renderer(source, t=t, size=tuple(size), **overrides) as r:
-        return r.frame(r.frames - 1)
+    t = RenderArguments(t=t).t
+    scene, trajs = _as_source(source)
+    t = _within("t", t, _horizon(scene, trajs), start_open=False)
+    if isinstance(size, list):
+        size = tuple(size)
+    with Renderer(scene if scene is not None else trajs, t_end=None if t == 0.0 else t, size=size, **overrides) as r:
+        return r.frame(0 if t == 0.0 else r.frames - 1)
 
 
 def render(source: Source, out: str | None = None, *, size=None, fps=None, duration=None, workers=None,
@@ -258,7 +278,8 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
     duration : float, optional
         Video seconds.
     workers : int, optional
-        Render processes for an MP4 (default one per core, at most 4).
+        Render processes for an MP4 (default one per core, at most 4; never more than the
+        cores this process may use).
     progress : bool
         A progress bar on stderr.
     pool : rendering.video.WorkerPool, optional
@@ -272,8 +293,9 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
     rendering.video.RenderResult
         Path, poster, frames, size, seconds, fps.
     """
-    out = default_output(source) if out is None else out
+    args = RenderArguments(out=out, workers=workers, progress=progress)
     scene, trajs, spec = resolve_spec(source, size=size, fps=fps, duration=duration, **overrides)
+    out, workers = (default_output(scene if scene is not None else trajs) if args.out is None else args.out), args.workers
     spec.check_output(out, len(scene.models) if scene is not None else len(trajs))
     inputs = [scene.path] if scene is not None and os.path.exists(scene.path) else []
     check_outputs([out, poster_for(out)], inputs)        # before any work: nothing to undo later
@@ -288,11 +310,11 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
             pool.close()
 
 
-def default_output(scene: Scene | str | os.PathLike, directory: str = "renders") -> str:
+def default_output(scene, directory: str = "renders") -> str:
     """Where a scene's video goes by default: ``renders/<scene file's stem>.mp4``.  ``scene``: a
-    ``Scene`` or the path of its file (trajectories have no default: UsageError)."""
+    ``Scene`` or the path of its file (trajectories have no default: ``SpecError`` naming ``out``)."""
     if not isinstance(scene, (Scene, str, os.PathLike)):
-        raise UsageError("give out=... (a .mp4 or .gif path) to render trajectories")
+        raise SpecError("out", "missing value: trajectories have no default video path; give a .mp4 or .gif path")
     stem = os.path.splitext(os.path.basename(scene.path if isinstance(scene, Scene) else os.fspath(scene)))[0]
     return os.path.join(directory, f"{stem}.mp4")
 

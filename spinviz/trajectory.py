@@ -10,6 +10,7 @@ never step the integrator.
 from __future__ import annotations
 
 import json
+import os
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -17,6 +18,7 @@ import numpy as np
 from . import rotations as R
 from . import units as U
 from .atomic import atomic_path, plain
+from .errors import SpecTypeError, TrajectoryFileError
 from .physics.bodies import Body
 from .physics.equations import angular_momentum_world, kinetic_energy
 
@@ -33,9 +35,11 @@ def _frozen(a):
 
 @dataclass(frozen=True)
 class Trajectory:
-    """t (N,); omega (N, 3) body frame; q (N, 4) (w, x, y, z) or None when no orientation
-    was integrated; euler (N, 3) only when the Euler-angle kinematics (6.4) was integrated
-    instead of quaternions; all in ``units`` of ``body``.  stats: method, nfev, runtime_s, ...
+    """t (N,); omega_body (N, 3), the body-frame angular velocity (stored, and accepted by the
+    constructor, as ``omega``: the name of the field and of the array in saved files); q (N,
+    4) (w, x, y, z) or None when no orientation was integrated; euler (N, 3) only when the
+    Euler-angle kinematics (6.4) was integrated instead of quaternions; all in ``units`` of
+    ``body``.  stats: method, nfev, runtime_s, ...
 
     slow: for ``secular`` runs, the slow geometry -- q_L (4,) taking world z to the fixed
     L_world, and (N,) arrays theta_L (nutation of e3 from L), phi_L (precession phase) and
@@ -60,6 +64,13 @@ class Trajectory:
             raise ValueError(f"omega must have shape ({n}, 3), got {self.omega.shape}")
         if self.q is not None and self.q.shape != (n, 4):
             raise ValueError(f"q must have shape ({n}, 4), got {self.q.shape}")
+
+    @property
+    def omega_body(self) -> np.ndarray:
+        """Body-frame angular velocity Omega, shape (N, 3), rad/s (CGS) or 1/tau0: the
+        documented name of ``omega`` (which stays, as the field, the constructor's keyword and
+        the saved array's name)."""
+        return self.omega
 
     # -- units ---------------------------------------------------------------------------
     @property
@@ -301,7 +312,10 @@ class Trajectory:
         """Write the arrays and a JSON ``metadata`` entry (.npz), atomically (temp file + rename).
         ``Trajectory.load`` reads it back exactly.  ``radiation``: also the observables of
         ``physics.radiation.observables`` as ``radiation_<name>`` arrays, their units and dims in
-        ``metadata["radiation"]`` (``spinviz simulate`` writes them)."""
+        ``metadata["radiation"]`` (``spinviz simulate`` writes them).  An ``OSError`` (a full
+        disk, no permission) names the path."""
+        if not isinstance(path, (str, os.PathLike)):
+            raise SpecTypeError("path", f"must be a file path (str or os.PathLike), got {type(path).__name__}")
         meta, arrays = self.metadata(), self.arrays()
         if radiation:
             from .physics.radiation import observables
@@ -309,24 +323,73 @@ class Trajectory:
             data = observables(self.body, self.model, self.omega, self.q)
             arrays.update({f"radiation_{k}": np.asarray(v, dtype=float) for k, (_, v, _) in data.items()})
             meta["radiation"] = {k: {"dims": list(dims), **a} for k, (dims, _, a) in data.items()}
-        with atomic_path(path) as tmp, open(tmp, "wb") as fh:
-            np.savez(fh, metadata=np.array(json.dumps(meta)), **arrays)
+        try:
+            with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+                np.savez(fh, metadata=np.array(json.dumps(meta)), **arrays)
+        except OSError as e:
+            if e.filename is None:
+                e.filename = os.fspath(path)
+            raise
 
     save_npz = save
 
     @classmethod
     def load(cls, path) -> Trajectory:
         """A trajectory written by ``save`` (or ``spinviz simulate --out``): arrays, body, model,
-        stats and slow geometry as they were."""
-        with np.load(path, allow_pickle=False) as z:
-            meta = json.loads(str(z["metadata"]))
-            if meta.get("format") != FORMAT:
-                raise ValueError(f"{path}: not a spinviz trajectory of format {FORMAT!r}")
-            arrays = {k: np.array(z[k]) for k in z.files if k != "metadata"}
+        stats and slow geometry as they were.
+
+        Raises ``TrajectoryFileError`` (a ValueError naming the file) for a file that is missing,
+        unreadable, damaged or not a spinviz trajectory, never a zip, JSON or NumPy error."""
+        if not isinstance(path, (str, bytes, os.PathLike)):
+            raise SpecTypeError("path", f"must be the path of a .npz trajectory, got {type(path).__name__}")
+        path = os.fsdecode(path)
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                if not hasattr(z, "files"):
+                    raise TrajectoryFileError(path, "a single NumPy array, not a spinviz trajectory (.npz)")
+                if "metadata" not in z.files:
+                    raise TrajectoryFileError(path, "not a spinviz trajectory (no metadata entry)")
+                meta = json.loads(str(z["metadata"]))
+                if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+                    raise TrajectoryFileError(path, f"not a spinviz trajectory of format {FORMAT!r}")
+                arrays = {k: np.array(z[k]) for k in z.files if k != "metadata"}
+        except TrajectoryFileError:
+            raise
+        except FileNotFoundError:
+            raise TrajectoryFileError(path, "no such file") from None
+        except OSError as e:
+            raise TrajectoryFileError(path, e.strerror or str(e)) from None
+        except Exception as e:         # zip, zlib, EOF, JSON, pickle refusal: the file is damaged
+            raise TrajectoryFileError(path, f"damaged or not a spinviz trajectory (.npz): {type(e).__name__}") from None
+        return cls._from_file(path, meta, arrays)
+
+    @classmethod
+    def _from_file(cls, path: str, meta: dict, arrays: dict) -> Trajectory:
+        """The trajectory of a read file, every part checked (``TrajectoryFileError`` names what is wrong)."""
+        for k in ("t", "omega"):
+            if k not in arrays:
+                raise TrajectoryFileError(path, f"damaged: the array {k!r} is missing")
+        for k in ("t", "omega", "q", "euler"):
+            a = arrays.get(k)
+            if a is not None and (a.dtype.kind not in "fiu" or not np.all(np.isfinite(a))):
+                raise TrajectoryFileError(path, f"damaged: the array {k!r} is not finite numbers")
+        t = arrays["t"]
+        if t.ndim != 1 or t.size < 1 or np.any(np.diff(t) <= 0.0):
+            raise TrajectoryFileError(path, "damaged: the times 't' are not increasing")
+        try:
+            body = Body.from_dict(meta["body_description"])
+            model = meta["model"]
+            stats = dict(meta["stats"])
+        except Exception as e:         # KeyError, TypeError, BodyError: the metadata is damaged
+            raise TrajectoryFileError(path, f"damaged metadata: {type(e).__name__} {e}") from None
+        if model not in ("reduced", "truncated", "free"):
+            raise TrajectoryFileError(path, f"damaged metadata: unknown model {model!r}")
         slow = {k[5:]: v for k, v in arrays.items() if k.startswith("slow_")} or None
-        return cls(t=arrays["t"], omega=arrays["omega"], q=arrays.get("q"), euler=arrays.get("euler"),
-                   body=Body.from_dict(meta["body_description"]), model=meta["model"],
-                   stats=dict(meta["stats"]), slow=slow)
+        try:
+            return cls(t=t, omega=arrays["omega"], q=arrays.get("q"), euler=arrays.get("euler"), body=body, model=model,
+                       stats=stats, slow=slow)
+        except ValueError as e:
+            raise TrajectoryFileError(path, f"damaged: {e}") from None
 
 
 FORMAT = "spinviz-trajectory-1"

@@ -79,7 +79,7 @@ def test_store_opens_with_plain_xarray(reference):
     assert spec["members"]["seed"] == 5 and ds.attrs["seed"] == 5 and ds.attrs["spinviz_version"]
     meanings = dict(zip(ds["regime"].attrs["flag_values"], ds["regime"].attrs["flag_meanings"].split()))
     labels = {meanings[c] for c in np.unique(ds["regime"].values)}
-    assert labels <= {"1", "2", "3", "4", "5", "T2", "T4", "Tcone", "TF", "other"}
+    assert labels <= {"1", "2", "3", "4", "5", "T2", "T4", "Tcone", "TF", "approaching", "other"}
     full = store.open_atlas(reference)
     # (0.5, 45 deg) reduced: the capture into type 5 happens by 1e8 at |omega0| = 0.05
     assert (full["label"].sel(model="reduced", delta=0.5).isel(chi=1).values == "5").sum() >= 2
@@ -239,8 +239,8 @@ def test_plots_show_every_member(reference, tmp_path):
     reps = plot.representatives(ds)
     found = {(m, lab) for m, lab, *_ in reps}
     labels = {(m, str(x)) for m in ("reduced", "truncated") for x in np.unique(ds["label"].sel(model=m).values)}
-    assert found == {x for x in labels if x[1] not in ("other", "failed", "missing")}
+    assert found == {x for x in labels if x[1] not in ("other", "failed", "missing", "approaching")}
     paths = plot.draw(str(reference), [str(tmp_path / "d.png"), str(tmp_path / "d_hodographs.png")])
     w, h = Image.open(paths[0]).size
-    assert (w, h) == (2 * 576, 594)                              # two panels at 6.4 x 6.6 in, 90 dpi
+    assert (w, h) == (2 * 792, 836)                              # two panels at 7.2 x 7.6 in, 110 dpi
     assert os.path.getsize(paths[0]) < 300_000 and os.path.getsize(paths[1]) < 300_000

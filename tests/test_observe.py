@@ -196,7 +196,7 @@ TWO_MODELS = ONE_MODEL.replace('model = "reduced"', 'models = ["reduced", "trunc
     (["observe", "{scene}"], TWO_MODELS.replace("delta = 0.3\nchi = 0.7", "inertia = [1.0, 0.8, 0.55]\ndipole = [0.5, 0.3, 0.8]"),
      "needs a symmetric top"),
     (["observe", "{scene}", "--los", "1,2"], TWO_MODELS, "--los: expected three numbers"),
-    (["observe", "{scene}", "--los", "0,0,0"], TWO_MODELS, "--los: must be a finite, non-zero vector"),
+    (["observe", "{scene}", "--los", "0,0,0"], TWO_MODELS, "--los: must not be zero"),
     (["observe", "{scene}", "--power-factor", "0.5"], TWO_MODELS, "--power-factor: must lie in"),
     (["observe", "{scene}"], TWO_MODELS + "[observe]\ncolour = 1\n", "[observe].colour: unknown key"),
     (["observe", "{scene}"], TWO_MODELS + "[observe]\nline_of_sight = [0.0, 0.0, 0.0]\n",

@@ -207,13 +207,13 @@ def test_hodograph_only_scene_integrates_no_orientation(monkeypatch):
     import spinviz.pipeline as V
 
     seen = []
-    real = V.simulate
+    real = V.simulate_request
 
-    def spy(*a, **k):
-        seen.append(k["kinematics"])
-        return real(*a, **k)
+    def spy(request):
+        seen.append(request.kinematics)
+        return real(request)
 
-    monkeypatch.setattr(V, "simulate", spy)
+    monkeypatch.setattr(V, "simulate_request", spy)
     sc = askew(models='models = ["reduced", "truncated"]', show='["hodograph", "axes"]', w=128, h=64)
     trajs = V.scene_trajectories(sc, sc.render)
     assert seen == ["none", "none"] and all(t.q is None for t in trajs)
@@ -229,9 +229,7 @@ def test_log_time_map_and_slowed_spin_label():
     """Log time map: starts at 0, ends at t_end, increasing; the slowed-spin factor is the
     true precession rate (rad per video second) over the shown one, the same in both panels."""
     spec = scene_from(ASKEW.format(models='model = "reduced"', show='["dipole"]', w=64, h=48)).render
-    from dataclasses import replace
-
-    spec = replace(spec, time_map="log", log_knee=0.5, duration=2.0, fps=10, spin="slowed", spin_turns_per_second=0.5)
+    spec = spec.with_(time_map="log", log_knee=0.5, duration=2.0, fps=10, spin="slowed", spin_turns_per_second=0.5)
     v, t, slope = timeline.frame_times(spec, 60.0)
     assert t[0] == 0.0 and t[-1] == 60.0 and np.all(np.diff(t) > 0)
     np.testing.assert_allclose(np.gradient(t, v)[5:-5], slope[5:-5], rtol=0.05)
@@ -268,7 +266,7 @@ def test_render_command_errors_are_one_line(tmp_path, capsys):
     bad.write_text(ASKEW.format(models='model = "reduced"', show='["dipole", "halo"]', w=64, h=48))
     assert main(["render", str(bad)]) == 2
     assert capsys.readouterr().err.strip() == f"spinviz: error: {bad}: [render].show: unknown item 'halo'; valid: " \
-        "body, dipole, omega, L, axes, trail, sphere, hud, hodograph, inset"
+        "body, dipole, omega, L, axes, trail, sphere, hud, hodograph, inset, power"
     assert not any(p.suffix == ".mp4" for p in tmp_path.iterdir())
 
 
@@ -479,20 +477,22 @@ def test_captions_key_is_validated():
 def test_render_workers_import_no_simulation_stack():
     """A render worker imports the drawing stack and unpickles a picture without loading numba,
     scipy or numpy-quaternion (about 1.5 s), nor pyvista's plotting module and matplotlib
-    (about 0.9 s): start-up is VTK, pyvista's meshes, Pillow and imageio-ffmpeg only."""
+    (about 0.9 s): start-up is VTK, pyvista's meshes, Pillow and imageio-ffmpeg only.  It draws
+    the power plot from the picture's numbers, without the physics that computes them."""
     import pickle
     import subprocess
     import sys
 
     from spinviz.rendering.video import picture_of
 
-    picture = picture_of(pipeline.plan(askew(w=64, h=48)))
+    picture = picture_of(pipeline.plan(askew(show='["dipole", "hud", "power"]', w=320, h=240)))
+    assert picture.overlay.inset is not None and picture.overlay.inset.plots == ("power",)
     code = ("import pickle, sys\n"
             "from spinviz.rendering import encode, session\n"
             "picture = pickle.loads(sys.stdin.buffer.read())\n"
             "session.RenderSession(picture).frame(0)\n"
-            "print(sorted(m for m in ('numba', 'scipy', 'quaternion', 'matplotlib', 'pyvista.plotting')"
-            " if m in sys.modules))")
+            "print(sorted(m for m in ('numba', 'scipy', 'quaternion', 'matplotlib', 'pyvista.plotting',"
+            " 'spinviz.trajectory', 'spinviz.physics.radiation') if m in sys.modules))")
     r = subprocess.run([sys.executable, "-c", code], input=pickle.dumps(picture), capture_output=True)
     assert r.returncode == 0, r.stderr.decode()
     assert r.stdout.decode().strip() == "[]"
@@ -507,16 +507,61 @@ def test_render_starts_its_workers_before_it_simulates(tmp_path, monkeypatch):
     import imageio
 
     seen = []
-    real = pipeline.simulate
+    real = pipeline.simulate_request
 
-    def spy(*a, **k):
+    def spy(request):
         seen.append(len(multiprocessing.active_children()))
-        return real(*a, **k)
+        return real(request)
 
-    monkeypatch.setattr(pipeline, "simulate", spy)
+    monkeypatch.setattr(pipeline, "simulate_request", spy)
     sc = askew(models='models = ["reduced", "truncated"]', show='["body", "dipole", "hud"]', w=160, h=96)
     out = tmp_path / "v.mp4"
     res = pipeline.render(sc, str(out), fps=12, duration=1.0, workers=2)
     assert seen and seen[0] >= 2, seen
     assert res.workers == 2 and imageio.get_reader(str(out)).count_frames() == 12
     assert multiprocessing.active_children() == []
+
+
+# --- the power inset (issue 19.5) --------------------------------------------------------------
+def _near(px, rgb, tol=40):
+    """Pixels within ``tol`` (sum of channel differences) of a colour."""
+    return np.abs(px.astype(int) - np.array(rgb)).sum(axis=-1) <= tol
+
+
+@pytest.mark.parametrize("size", [(640, 360), (1280, 720)])
+def test_power_inset_pixels_in_the_default_scene(size):
+    """The README's main scene, in its pixels: inside the power plot's box both model colours
+    are drawn; the cursor (a muted column) stands where the plan puts it -- right above the time
+    bar's cursor -- at the first, middle and last frames, with each model's dot on it; and late in
+    the run the reduced (teal) curve runs far below the truncated (purple) one: its residual
+    rotation about the dipole does not radiate."""
+    from spinviz.rendering.style import MODEL_COLORS
+
+    plan, imgs, session = scene_frames(SCENES[[p.stem for p in SCENES].index("default")], size=size)
+    try:
+        inset, bar = session.picture.overlay.inset, session.picture.overlay.bar
+        pal = session.picture.theme.hud
+        assert inset.plots == ("power",)
+        x0, y0, x1, y1 = inset.boxes[0]
+        teal, purple = MODEL_COLORS["reduced"], MODEL_COLORS["truncated"]
+        index = {"first": 0, "middle": plan.frames // 2, "last": plan.frames - 1}
+        for name, img in imgs.items():
+            f = index[name]
+            box = img[y0 + 1:y1 - 1, x0 + 1:x1 - 1]
+            assert _near(box, teal).sum() > 0.5 * (x1 - x0) and _near(box, purple).sum() > 0.5 * (x1 - x0), name
+            xc = int(inset.cursor[0, f])
+            assert xc == bar.x0 + int(bar.cuts[f]) - 1
+            column = img[y0 + 1:y1 - 1, xc]
+            assert (_near(column, pal.muted, 12) | _near(column, teal) | _near(column, purple)).mean() > 0.9, name
+            r = inset.dot_radius
+            for i, (color, _, rows) in enumerate(inset.dots):
+                if any(abs(int(later[f]) - int(rows[f])) <= 2 * r for _, _, later in inset.dots[i + 1:]):
+                    continue                # at the start both models radiate alike: the later dot covers this one
+                dot = img[int(rows[f]) - r:int(rows[f]) + r + 1, xc - r:xc + r + 1]
+                assert _near(dot, color, 12).mean() > 0.5, (name, color)
+        last = imgs["last"][y0 + 1:y1 - 1, x1 - 8 - size[0] // 40:x1 - 8]      # a strip left of the last dots
+        rows_teal = np.nonzero(_near(last, teal).any(axis=1))[0]
+        rows_purple = np.nonzero(_near(last, purple).any(axis=1))[0]
+        assert rows_teal.min() > rows_purple.max() + 0.3 * (y1 - y0), (rows_teal, rows_purple)
+    finally:
+        session.close()

@@ -23,20 +23,23 @@ from spinviz.rendering.overlay import Fill, Text
 from spinviz.rendering.picture import plan_picture
 from spinviz.rendering.spec import RenderSpec
 from spinviz.rendering.stage import ARROW_VECTORS, EDGE_PX, arrow_length, content_points
-from spinviz.rendering.style import theme
+from spinviz.rendering.style import MODEL_COLORS, theme
 from spinviz.rendering.timeline import frame_times
 from spinviz.rotations import matrix_from_quat
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SCENES = sorted(p for p in (ROOT / "scenes").glob("*.toml") if not p.name.startswith("atlas_"))
 ALL_SHOWN = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud")
+POWER_DECADES_FALL = {"reduced": 6.0, "truncated": 2.0}
 
 
 def made_plan(size=(640, 360), show=ALL_SHOWN, captions="outreach", background="white", time_map="linear",
               fps=10, duration=2.0) -> FramePlan:
     """Two panels over 10 days: the body (a stand-in box) turns once about z, |Omega| =
     2 pi 5e9 rad/s in the first panel and falls linearly to half in the second; d-L at
-    30 deg; spin slowed 1.3e15 x; the time bar's unit is Theta = 3.2 days."""
+    30 deg; spin slowed 1.3e15 x; the time bar's unit is Theta = 3.2 days.  The radiated power
+    falls from 1.5e-10 erg/s by 6 decades (reduced) and 2 decades (truncated), straight lines
+    in log P against time."""
     spec = RenderSpec(duration=duration, fps=fps, size=size, show=show, captions=captions, background=background,
                       time_map=time_map, title="a test crystal")
     video_t, sim_t, _ = frame_times(spec, 10 * U.DAY)
@@ -50,7 +53,8 @@ def made_plan(size=(640, 360), show=ALL_SHOWN, captions="outreach", background="
         ratio = 1.0 - 0.5 * k * sim_t / sim_t[-1]
         panels.append(Panel(model=model, omega_mag=2 * np.pi * 5e9 * ratio, q=q, R_world_from_body=R,
                             d_world=R @ d_body, omega_world=np.c_[0 * a, 0 * a, ratio],
-                            L_world=np.c_[0.3 * ratio, 0 * a, ratio], angle_dL_deg=np.full(F, 30.0)))
+                            L_world=np.c_[0.3 * ratio, 0 * a, ratio], angle_dL_deg=np.full(F, 30.0),
+                            power=1.5e-10 * 10.0 ** (-POWER_DECADES_FALL[model] * sim_t / sim_t[-1])))
     shape = ShapeInfo(kind="box", dims=(1.0, 1.0, 1.0), label="box with the top's inertia")
     return FramePlan(spec=spec, video_t=video_t, sim_t=sim_t, panels=panels, units="cgs", body_name="DAST cube",
                      shape=shape, d_body=d_body, spin_mode="slowed", slowdown=np.full(F, 1.3e15),
@@ -305,3 +309,140 @@ print(sorted(m for m in ("PIL", "vtk", "vtkmodules", "pyvista", "imageio", "matp
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert r.returncode == 0, r.stderr
     assert r.stdout.strip() == "[]"
+
+
+# --- the power inset (issue 19.5) --------------------------------------------------------------
+def _rows_of(value_w, box, scale):
+    """The pixel row (float) of a power ``value_w`` (W) in a log plot ``box`` of ``scale``."""
+    _, lo, hi = scale
+    return box[3] - 1 - (math.log10(value_w) - lo) / (hi - lo) * (box[3] - box[1] - 1)
+
+
+def test_power_plot_is_planned_in_watts_on_whole_decades_and_lines_up_with_the_time_bar():
+    """show = [..., "power"]: one log plot of P in W (the plan keeps erg/s) over whole decades,
+    1.5e-17 W at the start down to 1.5e-23 W (reduced) -> 10^-23 .. 10^-16; each model's curve
+    and dot in its colour at the row its log P says; the reduced curve ends far below the
+    truncated one; alone, the plot spans the time bar's columns, so its cursor is the bar's
+    cursor column at every frame; faint rules at the six inner decades and at the bar's ticks."""
+    plan = made_plan(show=ALL_SHOWN + ("power",))
+    pic = picture_of(plan)
+    inset, bar = pic.overlay.inset, pic.overlay.bar
+    assert [r.kind for r in pic.layout.rows][0] == "inset" and inset.plots == ("power",)
+    assert inset.scales == [("log", -23, -16)]
+    box = inset.boxes[0]
+    assert (box[0], box[2]) == (bar.x0, bar.x1)
+    np.testing.assert_array_equal(inset.cursor[0], bar.x0 + bar.cuts - 1)      # the bar draws its cursor there
+    texts = {t.text: t for t in inset.labels}
+    assert texts["radio power (W)"].xy == (box[0], pic.layout.rows[0].y)
+    assert texts["10⁻¹⁶"].anchor == "ra" and texts["10⁻²³"].anchor == "rd"
+    assert [t.text for t in inset.labels if t.color in ((0, 128, 128), (136, 60, 180))] == ["truncated", "reduced"]
+    curves = [sh for sh in inset.shapes if sh[0] == "curve"]
+    assert [c[1] for c in curves] == [(0, 128, 128), (136, 60, 180)]
+    s = plan.sim_t / plan.sim_t[-1]
+    for (color, _, rows), panel in zip(inset.dots, plan.panels):
+        assert color == MODEL_COLORS[panel.model]
+        want = [_rows_of(1.5e-17 * 10.0 ** (-POWER_DECADES_FALL[panel.model] * x), box, inset.scales[0]) for x in s]
+        np.testing.assert_allclose(rows, want, atol=0.5)
+        np.testing.assert_allclose(panel.power[0], 1.5e-10)                      # erg/s in the plan
+    reduced, truncated = (rows for _, _, rows in inset.dots)
+    assert reduced[0] == truncated[0] and reduced[-1] - truncated[-1] > 0.5 * (box[3] - box[1])
+    rules = [sh[2] for sh in inset.shapes if sh[0] == "rule"]
+    across = sorted(r[1] for r in rules if r[1] == r[3])
+    down = sorted(r[0] for r in rules if r[0] == r[2])
+    assert len(across) == 6
+    np.testing.assert_allclose(across, sorted(_rows_of(10.0 ** e, box, inset.scales[0]) for e in range(-22, -16)),
+                               atol=0.5)
+    assert down == [bar.x0 + x for x, _, _ in bar.ticks]
+    phys = picture_of(made_plan(show=ALL_SHOWN + ("power",), captions="physics"))
+    assert "P (W)" in [t.text for t in phys.overlay.inset.labels]
+
+
+def test_power_beside_the_other_plots_and_for_a_single_model():
+    """With "inset" too the row holds three plots side by side, left to right angle, |Omega|,
+    power, disjoint and inside the frame; a single-model scene draws one power curve and one dot;
+    a panel that radiates nothing (P = 0) sits on the bottom edge."""
+    plan = made_plan(show=ALL_SHOWN + ("inset", "power"))
+    inset = picture_of(plan).overlay.inset
+    assert inset.plots == ("angle", "omega", "power") and [k for k, _, _ in inset.scales] == ["linear", "linear", "log"]
+    for a, b in zip(inset.boxes, inset.boxes[1:]):
+        assert a[2] < b[0]
+    assert inset.boxes[0][0] > 0 and inset.boxes[-1][2] <= plan.spec.size[0]
+    plan.panels = plan.panels[:1]
+    plan.panels[0].power = np.zeros(plan.frames)
+    one = picture_of(plan).overlay.inset
+    power_dots = [rows for _, j, rows in one.dots if j == 2]
+    assert len(power_dots) == 1 and len([sh for sh in one.shapes if sh[0] == "curve"]) == 3
+    assert one.scales[2] == ("log", -1, 0) and np.all(power_dots[0] == one.boxes[2][3] - 1)
+
+
+def test_the_band_names_the_radiation_for_people():
+    """"radio power" at the DAST cube's 7 GHz; infrared and light for faster spins."""
+    from spinviz.rendering.captions import decade, radiation_band
+
+    assert radiation_band(2 * np.pi * 7.07e9) == "radio"
+    assert radiation_band(2 * np.pi * 1e13) == "infrared" and radiation_band(2 * np.pi * 1e15) == "light"
+    assert (decade(-17), decade(0), decade(1), decade(3)) == ("10⁻¹⁷", "1", "10", "10³")
+
+
+def test_small_frames_drop_the_power_inset_and_keep_text_apart():
+    """At 320x180 the inset row goes (with the title and subtitles) and the 3-D view keeps
+    half the height; at 640x360 it stays, above the legend, and its texts -- title, decades,
+    model names -- overlap nothing on the first, middle and last frames.  A subtitle cut to one
+    line to make room ends with an ellipsis."""
+    small = picture_of(made_plan(size=(320, 180), show=ALL_SHOWN + ("power",)))
+    assert small.overlay.inset is None and "inset" not in [r.kind for r in small.layout.rows]
+    assert small.layout.views[0][3] - small.layout.views[0][1] >= 0.5 * 180
+    pic = picture_of(made_plan(show=ALL_SHOWN + ("inset", "power")))
+    assert [r.kind for r in pic.layout.rows][:2] == ["inset", "legend"]
+    W, H = pic.size
+    for f in (0, pic.frames // 2, pic.frames - 1):
+        boxes = _texts_at(pic, f)
+        for i, (ta, a, _) in enumerate(boxes):
+            assert 0 <= a[0] and a[2] <= W and 0 <= a[1] and a[3] <= H, (ta, a)
+            for tb, b, _ in boxes[i + 1:]:
+                assert not _overlap(a, b), (f, ta, a, tb, b)
+    subtitle = [text for text, role, _, _ in pic.layout.headings[0] if role == "small"]
+    assert len(subtitle) == 1 and subtitle[0].endswith("…"), subtitle
+
+
+@pytest.mark.parametrize("size, kept", [((720, 720), ("angle", "omega")), ((1080, 1920), ("angle",))])
+def test_a_narrow_frame_keeps_the_plots_that_fit(size, kept):
+    """Type scales with the height, so a square or portrait frame has room for fewer plots side
+    by side: the rightmost go first, and each kept plot's title stays inside its own column --
+    it ends before the next plot's labels begin."""
+    pic = picture_of(made_plan(size=size, show=ALL_SHOWN + ("inset", "power")))
+    inset = pic.overlay.inset
+    assert inset.plots == kept
+    fonts = Fonts(pic.layout.sizes)
+    titles = [t for t in inset.labels if t.text in texts_of(pic.plan).plot_titles.values()]
+    assert len(titles) == len(kept)
+    for (bx0, _, bx1, _), t in zip(inset.boxes, titles):
+        assert t.xy[0] == bx0 and bx0 + fonts.width(t.text) <= bx1, (t.text, inset.boxes)
+    assert picture_of(made_plan(size=size, show=ALL_SHOWN + ("power",))).overlay.inset.plots == ("power",)
+
+
+def test_the_parent_computes_the_power_once_per_trajectory(monkeypatch):
+    """plan_frames calls trajectory.radiated_power once per run, with that run sampled at the
+    frame times, and keeps its values (erg/s) in the plan: the render workers only draw them.
+    A scene that does not show the power never computes it."""
+    from spinviz import trajectory
+    from spinviz.rendering import timeline
+    from spinviz.scene import load_scene
+
+    calls = []
+
+    def spy(trajs, times=None):
+        calls.append((len(trajs), trajs[0].t.size))
+        return trajectory.radiated_power(trajs, times)
+
+    monkeypatch.setattr(timeline, "radiated_power", spy)
+    plan = pipeline.plan(ROOT / "scenes" / "default.toml", size=(320, 180), fps=10, duration=1.0)
+    assert "power" in plan.spec.show and calls == [(1, 10), (1, 10)]
+    sc = load_scene(ROOT / "scenes" / "default.toml")
+    runs = pipeline.scene_trajectories(sc, plan.spec)
+    for panel, run in zip(plan.panels, runs):
+        np.testing.assert_allclose(panel.power, run.radiated_power(), rtol=1e-12)
+    assert plan.panels[0].power[-1] < 1e-3 * plan.panels[1].power[-1]       # the reduced cube goes dark (2.6e-4)
+    calls.clear()
+    pipeline.plan(ROOT / "scenes" / "dast_family1.toml", size=(320, 180), fps=10, duration=1.0)
+    assert calls == []

@@ -98,15 +98,16 @@ def test_render_option_ranges(tmp_path, capsys):
     """Out-of-range overrides are refused by the render spec (the one place render inputs are
     validated), named by their option, in one line with exit 2; nothing is written."""
     p = scene(tmp_path)
-    cases = {("--fps", "0"): "must be between 1 and 240, got 0", ("--fps", "1000"): "must be between 1 and 240",
-             ("--duration", "-5"): "must be above 0, got -5", ("--duration", "inf"): "must be finite",
-             ("--duration", "4000"): "must be at most 3600", ("--size", "8x600"): "must be [width, height] in pixels"}
+    cases = {("--fps", "0"): "must lie in [1, 240], got 0", ("--fps", "1000"): "must lie in [1, 240], got 1000",
+             ("--duration", "-5"): "must lie in (0, 3600], got -5", ("--duration", "inf"): "must be finite",
+             ("--duration", "4000"): "must lie in (0, 3600], got 4000", ("--size", "8x600"): "must be [width, height] in pixels",
+             ("--workers", "-1"): "must be at least 1, got -1", ("--workers", "1000"): "must be at most"}
     for (opt, value), reason in cases.items():
         one_line_error(capsys, ["render", p, opt, value, "--out", tmp_path / "x.mp4"], f"{opt}: {reason}")
         assert sorted(q.name for q in tmp_path.iterdir()) == [p.name]
     with pytest.raises(SystemExit) as e:                    # not a number at all: argparse says so
-        main(["render", str(p), "--workers", "-1"])
-    assert e.value.code == 2 and "argument --workers: must be at least 1" in capsys.readouterr().err
+        main(["render", str(p), "--workers", "two"])
+    assert e.value.code == 2 and "argument --workers: expected a whole number, got 'two'" in capsys.readouterr().err
 
 
 def test_slowed_spin_on_an_asymmetric_body_is_one_line(tmp_path, capsys):

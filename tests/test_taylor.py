@@ -237,3 +237,22 @@ def test_spin_problem_coupling_and_time_scale():
     assert eps == pytest.approx(0.05) and np.linalg.norm(p.omega0) == pytest.approx(1.0)
     assert float(np.dot(p.system.coupling, p.system.coupling)) == pytest.approx(0.05)
     assert p.t_eval[-1] == pytest.approx(0.5)
+
+
+def test_built_integrators_are_cached_and_a_damaged_cache_is_rebuilt(tmp_path, monkeypatch):
+    """The pickled integrator gives the very numbers of a fresh build; a damaged file is
+    replaced, never loaded."""
+    monkeypatch.setenv("SPINVIZ_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(TY, "_templates", {})
+    body = B.symmetric_top(0.3, 0.7)
+    kw = dict(t_end=50.0, samples=5, method="taylor", rtol=1e-9)
+    a = simulate(body, "reduced", (0.0, 0.05, 0.3), **kw)
+    files = list((tmp_path / "taylor").glob("*.pickle"))
+    assert len(files) == 1
+    monkeypatch.setattr(TY, "_templates", {})
+    b = simulate(body, "reduced", (0.0, 0.05, 0.3), **kw)              # from the pickle
+    assert np.array_equal(a.q, b.q) and np.array_equal(a.omega, b.omega)
+    files[0].write_bytes(b"not a pickle")
+    monkeypatch.setattr(TY, "_templates", {})
+    c = simulate(body, "reduced", (0.0, 0.05, 0.3), **kw)
+    assert np.array_equal(a.q, c.q) and files[0].read_bytes()[:1] != b"n"

@@ -416,15 +416,15 @@ def scene_resolution(sc, power_factor=None, frequency=None, polarization_deg=Non
 def run_scene(sc, samples: int = 800, line_of_sight=None, distance_cm=None, resolution: Resolution | None = None):
     """Simulate both models of scene ``sc`` over its ``[observe]`` horizon (or its own) at
     ``observe_times`` and observe them: (Observation, trajectories)."""
-    from ..driver import simulate
+    from ..driver import simulate_request
 
     if len(sc.models) != 2:
         raise ValueError("[simulation].models: observe needs two models, e.g. models = [\"reduced\", \"truncated\"]")
     if not sc.body.is_symmetric:
         raise ValueError("[body]: the detector needs a symmetric top (I1 = I2); this body is asymmetric")
     horizon = sc.observe.t_end or sc.t_end
-    kw = sc.simulation_kwargs(t_eval=observe_times(horizon, samples))
-    trajs = [simulate(sc.body, m, **kw) for m in sc.models]
+    times = observe_times(horizon, samples)
+    trajs = [simulate_request(sc.request(m, t_eval=times)) for m in sc.models]
     los = line_of_sight if line_of_sight is not None else sc.observe.line_of_sight
     dist = sc.observe.distance_cm if distance_cm is None else float(distance_cm)
     obs = observe(trajs, sc.title, resolution or scene_resolution(sc), los, dist, omega0=sc.omega0)

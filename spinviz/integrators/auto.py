@@ -11,7 +11,7 @@ from .base import get
 from .scaling import body_spin_problem
 
 MAX_RESOLVED_TURNS = 1e6     # beyond this, resolving every turn costs more than ~10 s
-HARD_MAX_TURNS = 3e8         # a resolving method takes ~3 us per turn (taylor): beyond this ~15 min
+HARD_MAX_TURNS = 5e7         # taylor resolves an askew asymmetric body at ~17 us a turn (rtol 1e-10, 7.7 steps a turn): ~15 min
 # radiation decay rate / spin rate above which radau beats Taylor's method (measured on thin askew
 # tops: taylor 7-400x faster than radau from 1.5e2 to 1.6e5, a tie at 5e5, radau 1.3-2x faster at
 # 1.6e6 .. 1.6e7; an explicit Runge-Kutta method was stability-bound from ~10)

@@ -32,8 +32,13 @@ and a resolving method would otherwise follow it turn by turn for ever.
 
 from __future__ import annotations
 
+import contextlib
 import copy
+import hashlib
 import math
+import os
+import pickle
+import tempfile
 import threading
 from dataclasses import dataclass
 
@@ -119,9 +124,10 @@ def equations(model: str, kinematics: str = "quaternion", symmetric: bool = Fals
     return out
 
 
-def events(model: str, batch: bool, fp_type=np.float64, symmetric: bool = False, residual: bool = True):
-    """The terminal events: runaway (index ``RUNAWAY_EVENT``) and, with ``residual``, the
-    residual rotation (``RESIDUAL_EVENT``)."""
+def events(model: str, batch: bool, fp_type=np.float64, symmetric: bool = False, residual: bool = True,
+           runaway: bool = True):
+    """The terminal events, in this order: the runaway (with ``runaway``) and the residual
+    rotation (with ``residual``); see ``event_kind``."""
     hy = _hy()
     lay = _layout(model, symmetric)
     u1, u2, u3 = hy.make_vars("u1", "u2", "u3")
@@ -141,41 +147,119 @@ def events(model: str, batch: bool, fp_type=np.float64, symmetric: bool = False,
     # (measured: an event function of 1e6 took the steps up 3x and the error from 1e-12 to
     # 1e-2; the residual event as a rational function of u cost 60 % more steps, as a
     # polynomial 16 %, so it is compiled in only where a run needs it).
-    out = [make(uu / (lay.w2max * (1.0 + lay.c * hy.time)) - 1.0, d.positive)]
+    out = []
+    if runaway:
+        out.append(make(uu / (lay.w2max * (1.0 + lay.c * hy.time)) - 1.0, d.positive))
     if residual:
         out.append(make(c1 * c1 + c2 * c2 + c3 * c3 - lay.eta2 * gg * uu, d.negative))
     return out
 
 
-RUNAWAY_EVENT, RESIDUAL_EVENT = 0, 1
+def event_kind(index: int, runaway: bool) -> int:
+    """The status of terminal event ``index`` of an integrator built with (runaway, ...)."""
+    return ST.RUNAWAY if (runaway and index == 0) else ST.STOPPED_RESIDUAL
+
+
+def n_pars(symmetric: bool, residual: bool, runaway: bool) -> int:
+    """How many par[] the system uses (heyoka counts up to the highest index used)."""
+    c, w2, e2 = (S_C, S_W2MAX, S_ETA2) if symmetric else (C, W2MAX, ETA2)
+    return 1 + (e2 if residual else (w2 if runaway else c))
+
+
 
 _lock = threading.Lock()
 _templates: dict = {}
 
 
 def template(model: str, kinematics: str, tol: float, precision: str = "double", batch: int = 0,
-             symmetric: bool = False, residual: bool = True):
+             symmetric: bool = False, residual: bool = True, runaway: bool = True):
     """A compiled integrator for (model, kinematics, tol, precision, form, events), batch width
-    ``batch`` (0: scalar), made once per process (heyoka also caches the machine code on
-    disk).  Callers take a copy (``copy.copy``) or reset every field they use."""
-    key = (model, kinematics, float(tol), precision, int(batch), symmetric, residual)
+    ``batch`` (0: scalar), made once per process.  Callers take a copy (``copy.copy``) or reset
+    every field they use.
+
+    Start-up: heyoka caches machine code on disk itself, but still rebuilds the expression
+    decomposition at every construction (~45 ms for the 7-variable reduced system); the built
+    integrator is therefore also kept pickled in ``cache_dir()`` (loads in ~6 ms), keyed by the
+    system's own expressions, the tolerance, heyoka's version and the CPU's features (the
+    pickle holds code compiled for this CPU)."""
+    key = (model, kinematics, float(tol), precision, int(batch), symmetric, residual, runaway)
     with _lock:
         ta = _templates.get(key)
         if ta is None:
             hy = _hy()
             sys_ = equations(model, kinematics, symmetric)
-            n = len(sys_)
-            npar = (N_PARS_SYMMETRIC if symmetric else N_PARS) - (0 if residual else 1)   # ETA2 is the last
             fp = PRECISIONS[precision]
-            kw = {"tol": fp(tol), "t_events": events(model, bool(batch), fp, symmetric, residual)}
-            if precision != "double":
-                kw.update(fp_type=fp, compact_mode=True)
-            if batch:
-                ta = hy.taylor_adaptive_batch(sys_, np.zeros((n, batch)), pars=np.zeros((npar, batch)), **kw)
-            else:
-                ta = hy.taylor_adaptive(sys_, np.zeros(n, dtype=fp), pars=np.zeros(npar, dtype=fp), **kw)
+            evs = events(model, bool(batch), fp, symmetric, residual, runaway)
+            digest = _digest(sys_, evs, tol, precision, batch)
+            ta = _load_pickled(digest)
+            if ta is None:
+                n = len(sys_)
+                npar = n_pars(symmetric, residual, runaway)
+                kw = {"tol": fp(tol), "t_events": evs}
+                if precision != "double":
+                    kw.update(fp_type=fp, compact_mode=True)
+                if batch:
+                    ta = hy.taylor_adaptive_batch(sys_, np.zeros((n, batch)), pars=np.zeros((npar, batch)), **kw)
+                else:
+                    ta = hy.taylor_adaptive(sys_, np.zeros(n, dtype=fp), pars=np.zeros(npar, dtype=fp), **kw)
+                _store_pickled(digest, ta)
             _templates[key] = ta
     return ta
+
+
+def cache_dir() -> str:
+    """Where built integrators are kept: $SPINVIZ_CACHE_DIR, else $XDG_CACHE_HOME/spinviz or
+    ~/.cache/spinviz (a sub-folder ``taylor``)."""
+    base = os.environ.get("SPINVIZ_CACHE_DIR") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "spinviz")
+    return os.path.join(base, "taylor")
+
+
+def _cpu_features() -> str:
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("flags"):
+                    return line
+    except OSError:
+        pass
+    import platform
+
+    return platform.machine() + platform.processor()
+
+
+def _digest(sys_, evs, tol, precision, batch) -> str:
+    hy = _hy()
+    text = "\n".join([hy.__version__, _cpu_features(), repr(float(tol)), precision, str(batch), str(sys_),
+                       *(str(e) for e in evs)])
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _load_pickled(digest: str):
+    path = os.path.join(cache_dir(), digest + ".pickle")
+    try:
+        with open(path, "rb") as f:
+            return pickle.load(f)
+    except FileNotFoundError:
+        return None
+    except Exception:                            # damaged or from an incompatible heyoka: rebuild
+        with contextlib.suppress(OSError):
+            os.remove(path)
+        return None
+
+
+def _store_pickled(digest: str, ta) -> None:
+    """Written atomically (temporary file, then rename); a cache that cannot be written is skipped."""
+    folder = cache_dir()
+    try:
+        os.makedirs(folder, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=".", suffix=".partial")
+        with os.fdopen(fd, "wb") as f:
+            pickle.dump(ta, f, protocol=pickle.HIGHEST_PROTOCOL)
+        os.replace(tmp, os.path.join(folder, digest + ".pickle"))
+    except OSError:
+        with contextlib.suppress(OSError, UnboundLocalError):
+            os.remove(tmp)
 
 
 def tolerance(rtol: float, atol: float, precision: str = "double") -> tuple[float, bool]:
@@ -279,21 +363,21 @@ class _Watch:
         return True
 
 
-def _status(outcome, watch: _Watch) -> int:
+def _status(outcome, watch, runaway: bool = True) -> int:
     """A ``status`` code from heyoka's outcome of one run."""
     hy = _hy()
     o = hy.taylor_outcome
     if outcome in (o.time_limit, o.success):
         return ST.OK
     if outcome == o.cb_stop:
-        return watch.why if watch.why is not None else ST.INTERRUPTED
+        return watch.why if (watch is not None and watch.why is not None) else ST.INTERRUPTED
     if outcome == o.err_nf_state:
         return ST.NOT_FINITE
     if outcome == o.step_limit:
         return ST.TOO_MANY_STEPS
     v = int(outcome)
     if v < 0:                                    # terminal event i is reported as -(i + 1)
-        return ST.RUNAWAY if -v - 1 == RUNAWAY_EVENT else ST.STOPPED_RESIDUAL
+        return event_kind(-v - 1, runaway)
     return ST.NOT_FINITE
 
 
@@ -314,7 +398,7 @@ def solve_taylor(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, ste
     tol, honoured = tolerance(rtol, atol, precision)
     t = np.asarray(problem.t_eval, dtype=float)
     pars = parameters(problem)
-    ta = copy.copy(template(problem.system.model, problem.kinematics, tol, precision, residual=False))
+    ta = copy.copy(template(problem.system.model, problem.kinematics, tol, precision, residual=False, runaway=True))
     ta.time = ta.state.dtype.type(t[0])
     ta.state[:] = initial_state(problem)
     ta.pars[:] = pars[:len(ta.pars)]
@@ -374,38 +458,57 @@ def solve_batch(problems: list[Problem], rtol: float, max_steps: int = MAX_STEPS
                 stop=None) -> list[BatchRun]:
     """Euler-only runs (kinematics "none") of symmetric tops (J = (1, 1, 1 - delta), g in the
     e1-e3 plane) of one model, ``width()`` at a time in heyoka's batch integrator on the
-    symmetric form (4.2)-(4.4) (or its truncated analogue), all on the same output grid
-    ``problems[0].t_eval`` (spin units each).
+    symmetric form (4.2)-(4.4) (or its truncated analogue); each run has its own output grid
+    ``t_eval`` (spin units: the same tau grid is a different t grid for each |omega0|), all of
+    one length.
 
     residual_eta : per problem, eta > 0 to stop at the residual rotation |d x omega| < eta
         |d||omega| (the atlas passes it where that rotation is the exact end state), else 0.
-    A lane that stops (an event, a non-finite state) is parked at omega = 0 -- a fixed
-    point of the scaled system, costing nothing -- and the others go on.
+    A lane that stops (an event, a non-finite state, its step budget) keeps its samples so far
+    and is parked at omega = 0 -- a fixed point of the scaled system, costing nothing -- while
+    the others go on.
+
+    No per-step callback (a Python call a step costs ~0.3 us, a third of a step here): the
+    batch advances ``CHUNK`` samples at a time, and the stop flag and the step budgets are
+    looked at between chunks.  Events cost too (~15 %), so each is compiled in only where a
+    run can need it: the residual rotation where ``residual_eta`` asks for it, the runaway
+    where |omega0| > ``RUNAWAY_RISK`` (no symmetric top started below that ran away: 0 of 512
+    random (delta, chi, omega0) at |omega0| = 0.1 .. 3, to tau = 1e6).
     """
     if not problems:
         return []
     model = problems[0].system.model
-    t = np.asarray(problems[0].t_eval, dtype=float)
+    N = len(problems[0].t_eval)
     for p in problems:
-        if p.system.model != model or p.kinematics != "none" or p.t_eval.shape != t.shape or np.any(p.t_eval != t):
-            raise ValueError("a batch holds Euler-only runs of one model on one output grid")
+        if p.system.model != model or p.kinematics != "none" or len(p.t_eval) != N:
+            raise ValueError("a batch holds Euler-only runs of one model on output grids of one length")
     eta = np.zeros(len(problems)) if residual_eta is None else np.asarray(residual_eta, dtype=float)
     tol, _ = tolerance(rtol, rtol)
     n = width()
     out: list = [None] * len(problems)
-    for residual in (False, True):                # runs that may stop at the residual rotation get that event
-        idx = [i for i in range(len(problems)) if (eta[i] > 0.0) == residual]
+    groups: dict = {}
+    for i, p in enumerate(problems):
+        c = float(np.dot(p.system.coupling, p.system.coupling))       # = tau0 |Omega0| in spin units
+        groups.setdefault((bool(eta[i] > 0.0), c > RUNAWAY_RISK), []).append(i)
+    for (residual, runaway), idx in groups.items():
         for a in range(0, len(idx), n):
             part = idx[a:a + n]
-            res = _one_batch([problems[i] for i in part], eta[part], t, model, tol, n, max_steps, stop, residual)
+            res = _one_batch([problems[i] for i in part], eta[part], model, tol, n, max_steps, stop,
+                             residual, runaway)
             for i, r in zip(part, res):
                 out[i] = r
     return out
 
 
-def _one_batch(probs, eta, t, model, tol, n, max_steps, stop, residual) -> list[BatchRun]:
+RUNAWAY_RISK = 1.0         # tau0 |Omega0| above which a batch compiles in the runaway event
+CHUNK = 24                 # samples a batch advances between looks at the stop flag and the budgets
+
+
+def _one_batch(probs, eta, model, tol, n, max_steps, stop, residual, runaway) -> list[BatchRun]:
     k = len(probs)
-    ta = copy.copy(template(model, "none", tol, "double", n, symmetric=True, residual=residual))
+    t = np.array([np.asarray(probs[min(j, k - 1)].t_eval, dtype=float) for j in range(n)])   # (lane, sample)
+    ta = copy.copy(template(model, "none", tol, "double", n, symmetric=True, residual=residual, runaway=runaway))
+    npar = ta.pars.shape[0]
     pars = np.zeros((N_PARS_SYMMETRIC, n))
     state = np.zeros((3, n))
     for i, p in enumerate(probs):
@@ -413,22 +516,23 @@ def _one_batch(probs, eta, t, model, tol, n, max_steps, stop, residual) -> list[
         state[:, i] = p.omega0
     pars[:, k:] = pars[:, :1]
     pars[S_ETA2, k:] = 0.0                       # idle lanes: the first body, at rest (a fixed point)
-    ta.set_time(np.full(n, t[0]))
+    ta.set_time(t[:, 0].copy())
     ta.state[:] = state
-    ta.pars[:] = pars[:ta.pars.shape[0]]
-    N = len(t)
+    ta.pars[:] = pars[:npar]
+    N = t.shape[1]
     y = np.full((N, 3, n), np.nan)
     y[0] = state
     nxt = np.ones(n, dtype=int)                  # next grid index per lane
     status = np.full(n, ST.OK)
-    t_stop = np.full(n, t[-1])
+    t_stop = t[:, -1].copy()
     live = np.arange(n) < k
-    steps = np.zeros(n, dtype=np.int64)          # each lane's own steps (the batch's may be more)
-    watch = _Watch(max_steps, stop)
+    steps = np.zeros(n, dtype=np.int64)
     while live.any():
-        grid, rows = _restart_grid(t, nxt, np.asarray(ta.time, dtype=float), live)
-        _, res = ta.propagate_grid(grid, callback=watch)
+        grid, rows = _restart_grid(t, nxt, np.asarray(ta.time, dtype=float), live, CHUNK)
+        _, res = ta.propagate_grid(grid)
         res = np.asarray(res)
+        pr = ta.propagate_res
+        steps[live] += np.array([int(r[3]) for r in pr], dtype=np.int64)[live]
         for lane in np.flatnonzero(live):
             r = rows[lane]
             got = np.all(np.isfinite(res[1:len(r) + 1, :, lane]), axis=1)
@@ -436,18 +540,15 @@ def _one_batch(probs, eta, t, model, tol, n, max_steps, stop, residual) -> list[
             y[good, :, lane] = res[1:len(r) + 1][got, :, lane]
             if good.size:
                 nxt[lane] = int(good.max()) + 1
-        steps[live] += np.array([int(r[3]) for r in ta.propagate_res], dtype=np.int64)[live]
-        for lane in np.flatnonzero(live):
-            st = _status(ta.propagate_res[lane][0], watch)
+            st = _status(pr[lane][0], None, runaway)
             if st != ST.OK:
                 status[lane], t_stop[lane], live[lane] = st, float(ta.time[lane]), False
             elif nxt[lane] >= N:
                 live[lane] = False
-        if watch.why is not None:                # step budget or a stop: every lane left ends here
-            if watch.why == ST.INTERRUPTED:
-                raise InterruptedError("stop flag set")
-            for lane in np.flatnonzero(live):
-                status[lane], t_stop[lane], live[lane] = watch.why, float(ta.time[lane]), False
+            elif steps[lane] >= max_steps:
+                status[lane], t_stop[lane], live[lane] = ST.TOO_MANY_STEPS, float(ta.time[lane]), False
+        if stop is not None and stop[0] != 0:
+            raise InterruptedError("stop flag set")
         # stopped lanes are parked at omega = 0 (a fixed point, events off) while the others go on
         s = np.array(ta.state)
         s[:, ~live] = 0.0
@@ -458,24 +559,23 @@ def _one_batch(probs, eta, t, model, tol, n, max_steps, stop, residual) -> list[
             ta.pars[:] = p
     out = []
     for i in range(k):
-        w = y[:, :, i] / np.sqrt(1.0 + float(pars[S_C, i]) * t)[:, None]
+        w = y[:, :, i] / np.sqrt(1.0 + float(pars[S_C, i]) * t[i])[:, None]
         out.append(BatchRun(w, int(status[i]), int(nxt[i]), float(t_stop[i]), int(steps[i])))
     return out
 
 
-def _restart_grid(t, nxt, times, live):
-    """The output grid of a (re)started batch: lane j from its own time through t[nxt[j]:],
-    padded past the end by steps of 1e-9 t_end (heyoka wants one strictly increasing column
-    per lane, all of one length).  Returns (grid (M, n), rows: lane -> the sample indices of
-    grid rows 1..)."""
-    n = len(nxt)
-    first = int(nxt[live].min()) if live.any() else len(t)
-    M = len(t) - first + 1
+def _restart_grid(t, nxt, times, live, chunk):
+    """The output grid of the next stretch of a batch: lane j from its own time through up to
+    ``chunk`` of its next samples t[j, nxt[j]:], padded by steps of 1e-9 of its last time
+    (heyoka wants one strictly increasing column per lane, all of one length).  Returns
+    (grid (M, n), rows: lane -> the sample indices of grid rows 1..)."""
+    n, N = t.shape
+    M = 1 + max((min(chunk, N - int(nxt[j])) for j in range(n) if live[j]), default=1)
     grid = np.empty((M, n))
     rows = {}
     for j in range(n):
-        idx = np.arange(nxt[j], len(t)) if live[j] else np.arange(0)
-        col = np.concatenate([[times[j]], t[idx]])
+        idx = np.arange(nxt[j], min(N, nxt[j] + chunk)) if live[j] else np.arange(0)
+        col = np.concatenate([[times[j]], t[j, idx]])
         pad = M - len(col)
         if pad:
             end = max(col[-1], times[j])

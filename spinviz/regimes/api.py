@@ -24,13 +24,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..atomic import check_parent_writable
-from ..errors import UsageError, printable
+from ..errors import SpecTypeError, UsageError, printable
+from ..inputs.atlas import AtlasArguments
 from ..interrupt import check, deferred
 from . import integrity as IN
 from . import runs as RN
 from . import store as ST
 from .faults import AtlasIncomplete, StoreDamaged
-from .spec import AtlasSpec, load_spec
+from .spec import AtlasSpec, check_feasible, load_spec
 
 RUNS_PER_TASK = 32          # a task of ~32 runs lasts ~0.2-10 s: scheduling (~ms) stays below 1 %
 
@@ -172,12 +173,19 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
     the same call computes what is missing.  ``StoreDamaged`` for a store whose metadata do
     not match their checksums.
     """
-    from .cluster import Cluster, Progress, check_workers, execute
+    from .cluster import Cluster, Progress, execute
 
+    # the one schema (spinviz.inputs.atlas): arguments named as here, then the spec, then
+    # whether it can finish on this machine -- all before any work
+    args = AtlasArguments(out=out, scheduler=scheduler, workers=workers, plot=plot, progress=progress,
+                          runs_per_task=runs_per_task, processes=processes, flush_s=flush_s, retry_failed=retry_failed,
+                          on_result=on_result)
     spec = spec if isinstance(spec, AtlasSpec) else load_spec(spec)
-    out = os.fspath(out) if out is not None else default_out(spec)
+    check_feasible(spec, args)
+    out = args.out if args.out is not None else default_out(spec)
     check_out(out, spec.path)
-    check_workers(workers, scheduler)
+    if notify is not None and not callable(notify):
+        raise SpecTypeError("notify", f"must be callable (line) or None, got {type(notify).__name__}")
     say = notify if notify is not None else _say
     plots = []
     if plot is not None:

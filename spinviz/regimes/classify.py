@@ -52,7 +52,8 @@ import numpy as np
 
 from . import formulas as F
 
-VERSION = 1                # bump when a rule changes: stores made by another version are not resumed
+VERSION = 2                # bump when a rule changes: stores made by another version are not resumed
+# 2: slow hand-overs labelled "approaching" (candidate: the class), no longer "other"
 
 MIN_CONFIDENCE = 0.5
 TOL_HALF = 0.03            # |slope + 1/2| accepted as "-1/2" (full score within TOL/2, none beyond 1.5 TOL)
@@ -77,7 +78,7 @@ CLASS_LABEL = {
 # Every label the atlas can store, with its int8 code (CF flag_values / flag_meanings).  The
 # paper's types keep their number; 0 is Zarr's fill value, so a run not computed yet reads "missing".
 CODE = {"missing": 0, "1": 1, "2": 2, "3": 3, "4": 4, "5": 5, "3.9": 6, "R": 7, "T2": 8, "Tcone": 9, "T4": 10,
-        "TF": 11, "T1": 12, "T5": 13, "other": 14, "1|2": 15, "4|5": 16, "failed": -1}
+        "TF": 11, "T1": 12, "T5": 13, "other": 14, "1|2": 15, "4|5": 16, "approaching": 17, "failed": -1}
 LABELS = tuple(CODE)
 
 # The evidence of every run, in this order (the store's ``quantity`` dimension).
@@ -157,11 +158,18 @@ def _below_half(x: float) -> float:
 
 
 def _fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
-    """(slope, RMS residual) of the least-squares line y = a x + b."""
+    """(slope, RMS residual) of the least-squares line y = a x + b (closed form: np.polyfit's
+    SVD costs 25 us a call, and the atlas makes ~14 fits a run)."""
     if len(x) < 2:
         return math.nan, math.nan
-    a, b = np.polyfit(x, y, 1)
-    return float(a), float(np.sqrt(np.mean((y - (a * x + b)) ** 2)))
+    dx = x - x.mean()
+    dy = y - y.mean()
+    sxx = float(dx @ dx)
+    if sxx == 0.0:
+        return math.nan, math.nan
+    a = float(dx @ dy) / sxx
+    r = dy - a * dx
+    return a, math.sqrt(float(r @ r) / len(x))
 
 
 def gap(phi: np.ndarray) -> tuple[float, float]:
@@ -237,18 +245,22 @@ def classify(tau, omega, delta: float, chi: float, model: str = "reduced", windo
     tau, omega = tau[keep], omega[keep]
     if len(tau) == 0:
         return Verdict("other", 0.0, "none", "no samples after tau = 0")
-    tau_end = float(tau[-1])
-    m = tau >= tau_end / 10.0**window
-    tw, w = tau[m], omega[m]
+    m = tau >= float(tau[-1]) / 10.0**window
+    if m.sum() < MIN_SAMPLES:
+        return Verdict("other", 0.0, "none", f"{int(m.sum())} samples in the last {window:g} decades (need {MIN_SAMPLES})")
+    x = _measure(tau[m], omega[m], delta, chi, window)
+    scores = _scores(x, delta, model, relax=1.0)
+    return _verdict(x, scores, delta, chi, model)
+
+
+def _measure(tw, w, delta: float, chi: float, window: float) -> dict:
+    """Everything the scores are made of, over the window: envelope slopes, amplitudes, the
+    phase's statistics, settledness and the pendulum energy of the phase (``ev``: the evidence)."""
     n = len(tw)
-    if n < MIN_SAMPLES:
-        return Verdict("other", 0.0, "none", f"{n} samples in the last {window:g} decades (need {MIN_SAMPLES})")
     lt = np.log10(tw)
     nsub = max(2, int(round(2 * window)))
     S = _slopes(lt, w, nsub)
-    p, q, s = S["p"], S["q"], S["s"]
-    ev: dict = {"slope_perp": p, "slope_3": q, "slope_norm": s}
-
+    ev: dict = {"slope_perp": S["p"], "slope_3": S["q"], "slope_norm": S["s"]}
     wp = np.hypot(w[:, 0], w[:, 1])
     w3 = w[:, 2]
     wn = np.sqrt(wp * wp + w3 * w3)
@@ -258,122 +270,209 @@ def classify(tau, omega, delta: float, chi: float, model: str = "reduced", windo
     Y = float(np.sqrt(np.mean((w3[last] * sq[last]) ** 2)))
     ev.update(X2=X * X, Y2=Y * Y, w2_tau=float(np.mean(w[last, 1] * tw[last])),
               w1_tau32=float(np.mean(w[last, 0] * tw[last] ** 1.5)))
+    x = {"S": S, "ev": ev, "n": n, "X": X, "Y": Y, "tw": tw, "w": w, "wp": wp, "w3": w3, "wn": wn, "sq": sq,
+         "last": last, "half": lt >= lt[0] + 0.5 * (lt[-1] - lt[0])}
+    _phase(x, delta)
+    drift = max(abs(S["p_l"] - S["p_e"]), abs(S["q_l"] - S["q_e"]) if Y > 1e-3 * X else 0.0)
+    dvec = np.array([math.sin(chi), 0.0, math.cos(chi)])
+    ang = math.degrees(math.acos(min(1.0, abs(float(w[-1] @ dvec)) / max(float(wn[-1]), 1e-300))))
+    dxw = np.linalg.norm(np.cross(dvec, w[last]), axis=1)  # |d x omega| = |omega| |d x omega_hat|
+    ev.update(slope_drift=drift, angle_omega_d_deg=ang, frozen_norm=float(np.mean(dxw * np.sqrt(2.0 * tw[last]))))
+    x.update(drift=drift, settle=1.0 - _ramp(drift, DRIFT, 3.0 * DRIFT), ang=ang)
+    _pendulum(x, delta, chi)
+    # type 5's quantities of (4.42), measured: omega_angle (4.23), omega2, omega3 envelopes
+    n1, n3 = math.sin(chi), math.cos(chi)
+    w_ang = w[:, 0] + (n3 / n1) * (1.0 - delta) * w[:, 2] if n1 > 0.0 else w[:, 0]
+    ev.update(libration_A2=float(np.max((w_ang * sq) ** 2)), libration_B=float(np.mean(w[:, 1] * sq)),
+              libration_M2=float(np.max(w[:, 2] ** 2 * tw**1.5)))
+    return x
 
-    # the phase: turning, stopped or swinging (aliasing-proof statistics)
+
+def _phase(x: dict, delta: float) -> None:
+    """The phase phi = atan2(omega2, omega1): turning, stopped or swinging, judged from
+    statistics aliasing cannot fake (module docstring)."""
+    w, w3, tw, half, n = x["w"], x["w3"], x["tw"], x["half"], x["n"]
     phi = np.arctan2(w[:, 1], w[:, 0])
     g, centre = gap(phi)
-    half = lt >= lt[0] + 0.5 * (lt[-1] - lt[0])
-    arc_late = 2.0 * math.pi - gap(phi[half])[0]
-    zero3 = bool(Y < 1e-10 * X)                          # omega3 at round-off (an invariant plane)
+    zero3 = bool(x["Y"] < 1e-10 * x["X"])                # omega3 at round-off (an invariant plane)
     sgn = np.zeros_like(w3) if zero3 else np.sign(w3)
     sc = float(np.mean(sgn[1:] != sgn[:-1]))
     a3 = np.abs(w3) * tw
     turns = abs(delta) * float(np.sum(0.5 * (a3[1:] + a3[:-1]) * np.diff(np.log(tw)))) / (2.0 * math.pi)
-    ev.update(phi_arc=2.0 * math.pi - g, phi_centre=centre, w3_sign_changes=sc, turns=turns)
-    gap_random = 2.0 * math.pi * (math.log(n) + 0.58) / n      # expected largest gap of n random angles
+    x["ev"].update(phi_arc=2.0 * math.pi - g, phi_centre=centre, w3_sign_changes=sc, turns=turns)
+    x.update(phi=phi, gap=g, centre=centre, arc_late=2.0 * math.pi - gap(phi[half])[0], zero3=zero3, sc=sc,
+             turns=turns, gap_random=2.0 * math.pi * (math.log(n) + 0.58) / n)   # largest gap of n random angles
 
-    drift = max(abs(S["p_l"] - S["p_e"]), abs(S["q_l"] - S["q_e"]) if Y > 1e-3 * X else 0.0)
-    settle = 1.0 - _ramp(drift, DRIFT, 3.0 * DRIFT)
-    dvec = np.array([math.sin(chi), 0.0, math.cos(chi)])
-    ang = math.degrees(math.acos(min(1.0, abs(float(w[-1] @ dvec)) / max(float(wn[-1]), 1e-300))))
-    wl = w[last]
-    dxw = np.linalg.norm(np.cross(dvec, wl), axis=1)       # |d x omega| = |omega| |d x omega_hat|
-    ev.update(slope_drift=drift, angle_omega_d_deg=ang, frozen_norm=float(np.mean(dxw * np.sqrt(2.0 * tw[last]))))
 
-    # the pendulum of the phase (formulas.xi_spinviz_beta_minus_three_quarters): with
-    # rho = omega_perp sqrt(tau), u = omega3 tau^(3/4), k = n1 n3/(1 - delta),
-    # H = 2 delta u^2 + 4 k rho^3 sin(phi) is conserved over a swing; h = sign(delta) H/(4 k rho^3)
-    # is -1 at the bottom ((3.9), phi = -sign(delta) pi/2) and +1 on the separatrix
+def _pendulum(x: dict, delta: float, chi: float) -> None:
+    """The pendulum of the phase (formulas.xi_spinviz_beta_minus_three_quarters): with
+    rho = omega_perp sqrt(tau), u = omega3 tau^(3/4), k = n1 n3/(1 - delta),
+    H = 2 delta u^2 + 4 k rho^3 sin(phi) is conserved over a swing; h = sign(delta) H/(4 k rho^3)
+    is -1 at the bottom ((3.9), phi = -sign(delta) pi/2) and +1 on the separatrix."""
+    ev = x["ev"]
     n1, n3 = math.sin(chi), math.cos(chi)
     k = n1 * n3 / (1.0 - delta)
     h_mean = h_std = h_drift = math.nan
     if k > 0.0 and delta != 0.0:
-        rho3 = (wp * sq) ** 3
+        tw, w3, phi, half = x["tw"], x["w3"], x["phi"], x["half"]
+        rho3 = (x["wp"] * x["sq"]) ** 3
         hh = math.copysign(1.0, delta) * (2.0 * delta * (w3 * tw**0.75) ** 2 + 4.0 * k * rho3 * np.sin(phi)) \
             / np.maximum(4.0 * k * rho3, 1e-300)
         h_mean, h_std = float(np.mean(hh)), float(np.std(hh))
         h_drift = float(abs(np.mean(hh[half]) - np.mean(hh[~half])))
-        h_end = float(np.mean(hh[last]))
+        h_end = float(np.mean(hh[x["last"]]))
+        q = x["S"]["q"]
         # a rotating transverse phase has h > 1 with a kinetic part ~ tau^(2q + 3/2): for
         # q < -3/4 it reaches the separatrix and locks into the swing at about this tau
         if q < -0.76 and h_end > 1.0:
-            ev["lock_to_5_at_tau"] = float(tau_end * h_end ** (1.0 / (-2.0 * q - 1.5)))
+            ev["lock_to_5_at_tau"] = float(tw[-1] * h_end ** (1.0 / (-2.0 * q - 1.5)))
     ev.update(h_mean=h_mean, h_std=h_std)
+    x.update(h_mean=h_mean, h_std=h_std, h_drift=h_drift)
 
-    # type 5's quantities of (4.42), measured: omega_angle (4.23), omega2, omega3 envelopes
-    w_ang = w[:, 0] + (n3 / n1) * (1.0 - delta) * w[:, 2] if n1 > 0.0 else w[:, 0]
-    ev.update(libration_A2=float(np.max((w_ang * sq) ** 2)), libration_B=float(np.mean(w[:, 1] * sq)),
-              libration_M2=float(np.max(w[:, 2] ** 2 * tw**1.5)))
 
-    # --- class scores
+def _scores(x: dict, delta: float, model: str, relax: float = 1.0, slopes=None) -> dict:
+    """Each class's score (0..1) from the measurements; ``relax`` widens every slope tolerance
+    by that factor (the test of a run still approaching a class), ``slopes`` replaces (p, q)
+    (the early half's, to see which way a run moves)."""
+    p, q = slopes if slopes is not None else (x["S"]["p"], x["S"]["q"])
+    X, Y, sc, g, gr = x["X"], x["Y"], x["sc"], x["gap"], x["gap_random"]
+    th, tone, t34 = TOL_HALF * relax, TOL_ONE * relax, TOL_34 * relax
     scores: dict[str, float] = {}
-    scores["residual"] = _ramp(s, -0.15, RES_SLOPE) * (1.0 if ang < 5.0 else 0.3)
-    rel13 = float(np.max(np.hypot(w[:, 0], w[:, 2]) / np.maximum(wn, 1e-300)))
+    scores["residual"] = _ramp(x["S"]["s"], -0.15, RES_SLOPE) * (1.0 if x["ang"] < 5.0 else 0.3)
+    wn = x["wn"]
+    rel13 = float(np.max(np.hypot(x["w"][:, 0], x["w"][:, 2]) / np.maximum(wn, 1e-300)))
     exact39 = rel13 < EXACT_39 and abs(X * math.sqrt(2.0) - 1.0) < 0.01
-    stopped = _ramp(-arc_late, -4.0 * ARC_STOP, -ARC_STOP) * (1.0 if sc == 0.0 else 0.0)
+    x["exact39"] = exact39
+    stopped = _ramp(-x["arc_late"], -4.0 * ARC_STOP, -ARC_STOP) * (1.0 if sc == 0.0 else 0.0)
     turning = (1.0 - _ramp(sc, SC_SPIRAL, 2.0 * SC_SPIRAL)) \
-        * _ramp(-g, -max(1.2, 2.5 * gap_random), -max(0.8, 1.5 * gap_random)) * _ramp(turns, 1.0, 3.0)
+        * _ramp(-g, -max(1.2, 2.5 * gr), -max(0.8, 1.5 * gr)) * _ramp(x["turns"], 1.0, 3.0)
     if delta == 0.0:
         # a spherical top does not precess (phi_dot = -delta omega3 = 0): its "spiral" is the
         # straight line of (5.4) at delta = 0 ((6.9)), a fixed direction
         turning = stopped if model == "truncated" else 0.0
-    swinging = _ramp(sc, 0.5 * SC_LIBR, SC_LIBR) * _ramp(g, max(0.2, gap_random), max(0.35, 1.5 * gap_random))
+    swinging = _ramp(sc, 0.5 * SC_LIBR, SC_LIBR) * _ramp(g, max(0.2, gr), max(0.35, 1.5 * gr))
     y_dom = _ramp(Y / max(X, 1e-300), 1.0, 2.0)
     x_dom = _ramp(X / max(Y, 1e-300), 1.0, 2.0)
-    scores["axial-stopped"] = min(stopped, y_dom, _near(q, -0.5, TOL_HALF), _near(p, -1.0, TOL_ONE))
-    scores["axial-spiral"] = min(turning, y_dom, _near(q, -0.5, TOL_HALF), _below_half(p))
-    scores["balanced-spiral"] = min(turning, _near(p, -0.5, TOL_HALF), _near(q, -0.5, TOL_HALF))
-    scores["transverse-spiral"] = min(turning, x_dom, _near(p, -0.5, TOL_HALF), _below_half(q))
-    centre_ok = 1.0 - _ramp(abs(math.remainder(centre + math.copysign(0.5 * math.pi, delta or 1.0), 2.0 * math.pi)),
+    below = _ramp(-p, 0.5 + 0.5 * TOL_SEP, 0.5 + TOL_SEP)            # p clearly below -1/2
+    below_q = _ramp(-q, 0.5 + 0.5 * TOL_SEP, 0.5 + TOL_SEP)
+    scores["axial-stopped"] = min(stopped, y_dom, _near(q, -0.5, th), _near(p, -1.0, tone))
+    scores["axial-spiral"] = min(turning, y_dom, _near(q, -0.5, th), below)
+    scores["balanced-spiral"] = min(turning, _near(p, -0.5, th), _near(q, -0.5, th))
+    scores["transverse-spiral"] = min(turning, x_dom, _near(p, -0.5, th), below_q)
+    centre_ok = 1.0 - _ramp(abs(math.remainder(x["centre"] + math.copysign(0.5 * math.pi, delta or 1.0), 2.0 * math.pi)),
                             0.3, 0.6)
     h_ok = 0.0
-    if math.isfinite(h_std):
-        h_ok = (1.0 - _ramp(h_std, 0.05, 0.15)) * (1.0 - _ramp(h_drift, 0.03, 0.1)) * _ramp(-h_mean, -1.0, -0.97)
-    scores["libration"] = min(swinging, x_dom, _near(p, -0.5, 1.5 * TOL_HALF), centre_ok,
-                              max(h_ok, 0.6 * _near(q, -0.75, TOL_34)))
-    frozen3 = _ramp(-q, 1.0, 1.1) if (Y > 0.0 and not exact39 and not zero3) else 1.0
-    scores["transverse-frozen"] = 1.0 if exact39 else min(stopped, x_dom, _near(p, -0.5, TOL_HALF), frozen3)
+    if math.isfinite(x["h_std"]):
+        h_ok = (1.0 - _ramp(x["h_std"], 0.05, 0.15)) * (1.0 - _ramp(x["h_drift"], 0.03, 0.1)) \
+            * _ramp(-x["h_mean"], -1.0, -0.97)
+    scores["libration"] = min(swinging, x_dom, _near(p, -0.5, 1.5 * th), centre_ok, max(h_ok, 0.6 * _near(q, -0.75, t34)))
+    frozen3 = _ramp(-q, 1.0, 1.1) if (Y > 0.0 and not exact39 and not x["zero3"]) else 1.0
+    scores["transverse-frozen"] = 1.0 if exact39 else min(stopped, x_dom, _near(p, -0.5, th), frozen3)
+    return scores
 
+
+RELAX = 4.0                # slope tolerances x this: "approaching" a class (a slow hand-over), not yet in it
+
+
+def _verdict(x: dict, scores: dict, delta: float, chi: float, model: str) -> Verdict:
+    """The label from the scores: the best class if it is met clearly; else "approaching X"
+    when the run is within ``RELAX`` x the tolerances of class X and moving towards it (a slow
+    hand-over, e.g. type 3 below delta = -1/2 converging as tau^-0.1); else "other"."""
+    ev, S = x["ev"], x["S"]
     best = max(scores, key=scores.get)
     ordered = sorted(scores.values(), reverse=True)
     margin = ordered[0] - ordered[1]
-    if best == "libration" and math.isfinite(h_drift):
-        settle = 1.0 - _ramp(h_drift, 0.03, 0.1)            # omega3's RMS slope is noisy at random phases
+    settle = x["settle"]
+    if best == "libration" and math.isfinite(x["h_drift"]):
+        settle = 1.0 - _ramp(x["h_drift"], 0.03, 0.1)       # omega3's RMS slope is noisy at random phases
     fit_rms = max(S["res_p"], S["res_q"]) if (S["smooth3"] and math.isfinite(S["res_q"])) else S["res_p"]
     fit_ok = 1.0 - _ramp(fit_rms, 0.05, 0.15) if math.isfinite(fit_rms) else 0.0
+    exact39 = x["exact39"]
     exempt = exact39 or best == "residual"                # no power law to fit, nothing to settle
     conf = scores[best] * (1.0 if exempt else settle * fit_ok) * min(1.0, 0.5 + margin)
     ev.update(settled=settle, fit_rms=fit_rms, fit_quality=math.exp(-fit_rms / 0.02) if math.isfinite(fit_rms) else 0.0,
               score=scores[best], margin=margin)
-
     names = CLASS_LABEL[model]
-    if scores[best] >= 0.05:
-        candidate = names[best]
-    elif y_dom and _near(q, -0.5, TOL_HALF) > 0.5 and -1.0 - TOL_ONE < p < -0.5 and sc == 0.0:
-        candidate = "1|2"
-    elif x_dom and _near(p, -0.5, TOL_HALF) > 0.5 and q < -0.5:
-        candidate = "4|5"
-    else:
-        candidate = "none"
-    label = names[best]
+    candidate = _candidate(x, scores, best, names)
+    label = names[best] if scores[best] > 0.0 else "other"
     if exact39:
         label = candidate = "3.9"
     devs = deviations(label, ev, delta, chi, model)
     finite = [abs(v) for v in devs.values() if math.isfinite(v)]
     ev["deviation"] = max(finite) if finite else math.nan
-
     if conf < MIN_CONFIDENCE:
-        why = f"no class met clearly (best {best} {scores[best]:.2f}, settled {settle:.2f}, fit {fit_ok:.2f})"
-        return Verdict("other", float(conf), candidate, why, ev, devs)
+        return _unsettled(x, scores, best, settle, fit_ok, delta, model, candidate, conf, devs)
     if label == "3.9" and not exact39:
         return Verdict("other", float(min(conf, 0.45)), candidate,
                        "transverse rotation with a stopped phase, but not (3.9) itself", ev, devs)
     if label in ("T1", "T5"):
         return Verdict("other", float(min(conf, 0.45)), candidate, f"{best} has no counterpart in the truncated model",
                        ev, devs)
-    if best == "residual" and ang >= 5.0:
+    if best == "residual" and x["ang"] >= 5.0:
         return Verdict("other", float(min(conf, 0.45)), candidate, "residual rotation not about d", ev, devs)
     return Verdict(label, float(conf), candidate, f"{best}: score {scores[best]:.2f}, margin {margin:.2f}", ev, devs)
+
+
+def _candidate(x: dict, scores: dict, best: str, names: dict) -> str:
+    """The best class's label even where the run is not labelled, or a mixture."""
+    S, X, Y = x["S"], x["X"], x["Y"]
+    p, q = S["p"], S["q"]
+    if scores[best] >= 0.05:
+        return names[best]
+    if Y > X and _near(q, -0.5, TOL_HALF) > 0.5 and -1.0 - TOL_ONE < p < -0.5 and x["sc"] == 0.0:
+        return "1|2"
+    if X > Y and _near(p, -0.5, TOL_HALF) > 0.5 and q < -0.5:
+        return "4|5"
+    return "none"
+
+
+def _between_1_and_2(x: dict, model: str):
+    """The hand-over between types 2 and 1: omega3 ~ tau^-1/2 dominant and keeping its sign,
+    omega_perp falling faster, the phase neither turning freely nor stopped.  omega_perp is
+    then the sum of type 1's forced part (B/tau, a fixed phase) and type 2's spiral (tau^alpha,
+    turning), beating against each other, so its slope p wanders; whichever falls slower wins:
+    p < -1 - TOL_ONE/2 means the spiral dies first (-> type 1), p > -1 + TOL_ONE/2 that it
+    outlives the forced part (-> type 2).  Near alpha = -1 the two decay almost together and
+    the hand-over takes tens of decades ((0.5, 14 deg): alpha = -1.22).  Returns (class label,
+    reason) or None."""
+    S = x["S"]
+    p, q = S["p"], S["q"]
+    if not (x["Y"] > 2.0 * x["X"] and _near(q, -0.5, TOL_HALF) > 0.5 and x["sc"] == 0.0 and p < -0.5 - TOL_SEP):
+        return None
+    names = CLASS_LABEL[model]
+    if p < -1.0 - 0.5 * TOL_ONE:
+        target = "axial-stopped"
+    elif p > -1.0 + 0.5 * TOL_ONE:
+        target = "axial-spiral"
+    else:
+        return None
+    if names[target] in ("T1", "T5"):
+        return None
+    return names[target], (f"hand-over between types 2 and 1: omega_perp ~ tau^{p:.2f} beats its forced and spiral "
+                           f"parts; approaching {names[target]}")
+
+
+def _unsettled(x, scores, best, settle, fit_ok, delta, model, candidate, conf, devs) -> Verdict:
+    """A run no class meets clearly: "approaching" the class it is within ``RELAX`` x the slope
+    tolerances of and moving towards (its late half's slopes closer to the class than its early
+    half's), or "other"."""
+    ev, S = x["ev"], x["S"]
+    names = CLASS_LABEL[model]
+    wide = _scores(x, delta, model, relax=RELAX)
+    early = _scores(x, delta, model, relax=RELAX, slopes=(S["p_e"], S["q_e"]))
+    late = _scores(x, delta, model, relax=RELAX, slopes=(S["p_l"], S["q_l"]))
+    cls = max(wide, key=wide.get)
+    towards = late[cls] >= early[cls] and wide[cls] >= 0.5 and cls not in ("residual", "transverse-frozen")
+    if towards and names[cls] not in ("T1", "T5", "3.9"):
+        c = float(min(0.49, wide[cls] * fit_ok))
+        return Verdict("approaching", c, names[cls], f"approaching {cls} ({names[cls]}): within {RELAX:g}x the slope "
+                                                     f"tolerances, slopes moving towards it (settled {settle:.2f})", ev, devs)
+    handover = _between_1_and_2(x, model)
+    if handover is not None:
+        return Verdict("approaching", float(min(0.49, fit_ok or 0.3)), handover[0], handover[1], ev, devs)
+    why = (f"no class met clearly (best {best} {scores[best]:.2f}, settled {settle:.2f}, fit {fit_ok:.2f})"
+           if scores[best] > 0.0 else "no class fits the slopes or the phase")
+    return Verdict("other", float(conf), candidate, why, ev, devs)
 
 
 def deviations(label: str, ev: dict, delta: float, chi: float, model: str = "reduced") -> dict:

@@ -39,10 +39,10 @@ import threading
 import time
 from dataclasses import dataclass, field
 
-import numpy as np
 from distributed.diagnostics.plugin import WorkerPlugin
 
 from ..errors import printable
+from ..inputs.render import usable_cores
 from ..interrupt import SIGNALS, check
 from . import runs as RN
 from .faults import OptionError
@@ -52,14 +52,6 @@ START_TIMEOUT_S = 120.0          # LocalCluster workers (spawned Python, imports
 NO_WORKER_S = 60.0               # an existing cluster without any worker this long: the atlas gives up
 POLL_S = 0.05                    # how often the client looks at a stop signal while it waits
 HEALTH_S = 0.5                   # how often the monitor asks the scheduler how many workers it has
-
-
-def available_cores() -> int:
-    """Cores this process may run on (the affinity mask where there is one)."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except (AttributeError, OSError):
-        return max(1, os.cpu_count() or 1)
 
 
 def worker_info() -> dict:
@@ -161,18 +153,12 @@ def _quiet_distributed():
 
 
 def check_workers(workers, scheduler=None) -> None:
-    """``workers=``: 1 .. the cores available, and only for the embedded cluster."""
-    if workers is None:
-        return
-    if scheduler is not None:
-        raise OptionError("workers", workers, "applies to the embedded cluster only; an existing cluster has the "
-                                              "workers it was started with")
-    cores = available_cores()
-    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)):
-        raise OptionError("workers", workers, "must be a whole number")
-    if not 1 <= workers <= cores:
-        raise OptionError("workers", workers, f"must be 1..{cores} (one worker process per core of this machine; "
-                                              f"more would only share them)")
+    """``workers=``: 1 .. the cores this process may use, and only for the embedded cluster --
+    checked by the one schema (``inputs.atlas.AtlasArguments``; ``SpecError`` naming
+    ``workers``), also for a ``Cluster`` made directly (the benchmark)."""
+    from ..inputs.atlas import AtlasArguments
+
+    AtlasArguments(scheduler=scheduler, workers=workers)
 
 
 class Cluster:
@@ -220,7 +206,7 @@ class Cluster:
         from distributed import Client, LocalCluster
 
         RN.warm()                                    # compile once into the on-disk cache; the workers load it
-        n = self.workers or available_cores()
+        n = self.workers or usable_cores()
         opts = dict(n_workers=0, threads_per_worker=1, processes=self.processes,
                     dashboard_address=None, silence_logs=logging.CRITICAL + 1,
                     # the scheduler's HTTP server (health routes) on a free port of localhost, not the

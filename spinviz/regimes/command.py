@@ -17,9 +17,14 @@ import argparse
 import json
 import sys
 
-from ..errors import UsageError, printable
+from ..errors import SpecError, UsageError, printable
 from ..interrupt import Interrupted, check
 from .faults import AtlasIncomplete, OptionError
+
+# the library's argument -> the option that sets it (as spinviz.cli's ATLAS_FLAGS), so that
+# ``spinviz atlas`` and ``python -m spinviz.regimes`` say the same
+FLAGS = {"out": "--out", "scheduler": "--scheduler", "workers": "--workers", "plot": "--plot",
+         "runs_per_task": "--runs-per-task"}
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -63,6 +68,10 @@ def run(args) -> int:
         return _run(args)
     except OptionError as e:                          # the library's words, with the option's name
         raise UsageError(e.cli_message()) from None
+    except SpecError as e:                            # the schema's, about an argument
+        if e.key in FLAGS:
+            raise UsageError(f"{FLAGS[e.key]}: {e.reason}") from None
+        raise
 
 
 def _run(args) -> int:

@@ -1,8 +1,10 @@
 """How the atlas fails, in one line each (kept apart from ``spinviz.errors``: these are the
 atlas's own, and their text names library parameters, never command-line flags).
 
-* ``OptionError`` -- a bad value for one of ``atlas()``'s parameters (``workers=``,
-  ``scheduler=``); ``cli_message()`` says the same with the command line's option.
+* ``OptionError`` -- a value of ``atlas()``'s ``scheduler=`` that cannot be used (no
+  scheduler there, no worker, another spinviz version), with the value; ``cli_message()``
+  says the same with the command line's option.  (Values wrong in themselves -- ``workers=``
+  beyond the cores -- are the schema's ``SpecError``, ``spinviz.inputs.atlas``.)
 * ``StoreDamaged`` -- a store whose metadata do not match their checksums (or carry none):
   runs can be recomputed, a damaged catalogue cannot.
 * ``AtlasIncomplete`` -- the atlas ended with runs not computed because the cluster failed

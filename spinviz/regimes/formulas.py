@@ -167,34 +167,46 @@ def chi_of_xi(xi):
 
 
 def boundaries(model: str = "reduced", n: int = 801) -> list[dict]:
-    """The lines of the delta-chi diagram: each a dict with ``name``, ``source`` ("paper" or
-    "spinviz"), ``delta`` and ``chi`` (rad, NaN where the line does not exist).
+    """The lines of the delta-chi diagram: each a dict with ``name``, ``label`` (what the
+    diagram writes beside it), ``source`` ("paper" or "spinviz"), ``delta`` and ``chi`` (rad,
+    NaN where the line does not exist).
 
-    Reduced: (4.15), (4.17), (4.20) (= the upper bound of (4.19)), (4.43) as printed, and
-    spinviz's alpha = -1 and beta = -3/4 lines.  Truncated: spinviz's lines of the averaged
-    truncated flow (``truncated_averaged``): delta = 0 and the frozen-phase line."""
+    Reduced: (4.15), (4.17) (= the lower bound of (4.19)), (4.20) (= its upper bound), (4.43)
+    as printed and corrected (7 delta - 4, where (4.42)'s B is real), and spinviz's alpha = -1
+    of (4.14) and beta = -3/4 of (4.18).  Truncated: spinviz's lines of the averaged truncated
+    flow (``truncated_averaged``): delta = 0 and the frozen-phase line."""
     d = np.linspace(-1.0, 1.0, n)[1:-1]
     lines = []
     with np.errstate(divide="ignore", invalid="ignore"):
         if model == "reduced":
-            lines.append({"name": "(4.15): 2 | 3", "source": "paper", "delta": d, "chi": chi_of_xi(xi_eq4_15(d))})
             dm = np.where(d > -0.5, d, np.nan)
-            lines.append({"name": "(4.17), (4.19): 3 | 4", "source": "paper", "delta": dm, "chi": chi_of_xi(xi_eq4_17(dm))})
             dp = np.where(d > 0.0, d, np.nan)
-            lines.append({"name": "(4.20): 4 | ?", "source": "paper", "delta": dp, "chi": chi_of_xi(xi_eq4_20(dp))})
             d43 = np.where(d > 6.0 / 7.0, d, np.nan)
-            lines.append({"name": "(4.43) as printed: 5", "source": "paper", "delta": d43, "chi": chi_of_xi(xi_eq4_43(d43))})
-            lines.append({"name": "alpha = -1: 1 | 2", "source": "spinviz", "delta": d,
-                          "chi": chi_of_xi(xi_spinviz_alpha_minus_one(d))})
+            d47 = np.where(d > 4.0 / 7.0, d, np.nan)
             db = np.where(d > -0.2, d, np.nan)
-            lines.append({"name": "beta = -3/4: 4 | 5", "source": "spinviz", "delta": db,
-                          "chi": chi_of_xi(xi_spinviz_beta_minus_three_quarters(db))})
+            lines += [
+                {"name": "(4.15): 2 | 3", "label": "(4.15)", "source": "paper", "delta": d, "chi": chi_of_xi(xi_eq4_15(d))},
+                {"name": "(4.17), (4.19): 3 | 4", "label": "(4.17), (4.19)", "source": "paper", "delta": dm,
+                 "chi": chi_of_xi(xi_eq4_17(dm))},
+                {"name": "(4.20), (4.19): 4 | ?", "label": "(4.20), (4.19)", "source": "paper", "delta": dp,
+                 "chi": chi_of_xi(xi_eq4_20(dp))},
+                {"name": "(4.43) as printed: 5", "label": "(4.43) printed", "source": "paper", "delta": d43,
+                 "chi": chi_of_xi(xi_eq4_43(d43))},
+                {"name": "(4.43) corrected: 7 delta - 4", "label": "(4.43) corrected", "source": "spinviz",
+                 "delta": d47, "chi": chi_of_xi(xi_spinviz_type5_real(d47))},
+                {"name": "alpha = -1 of (4.14): 1 | 2", "label": "(4.14) \u03b1 = \u22121", "source": "spinviz",
+                 "delta": d, "chi": chi_of_xi(xi_spinviz_alpha_minus_one(d))},
+                {"name": "beta = -3/4 of (4.18): 4 | 5", "label": "(4.18) \u03b2 = \u2212\u00be", "source": "spinviz",
+                 "delta": db, "chi": chi_of_xi(xi_spinviz_beta_minus_three_quarters(db))},
+            ]
         else:
-            lines.append({"name": "delta = 0: T2 | T4", "source": "spinviz", "delta": np.array([0.0, 0.0]),
-                          "chi": np.array([0.0, 0.5 * math.pi])})
             dt = np.where(d > 0.5, d, np.nan)
-            lines.append({"name": "beta_T = -1: T4 | TF", "source": "spinviz", "delta": dt,
-                          "chi": chi_of_xi(2.0 * (1.0 - dt) / (2.0 * dt - 1.0))})
+            lines += [
+                {"name": "delta = 0: T2 | T4", "label": "\u03b4 = 0", "source": "spinviz", "delta": np.array([0.0, 0.0]),
+                 "chi": np.array([0.0, 0.5 * math.pi])},
+                {"name": "beta_T = -1: T4 | TF", "label": "\u03b2_T = \u22121", "source": "spinviz", "delta": dt,
+                 "chi": chi_of_xi(2.0 * (1.0 - dt) / (2.0 * dt - 1.0))},
+            ]
     return lines
 
 
@@ -237,9 +249,10 @@ def dast_families() -> list[dict]:
     t = P.DAST.dipole_angle_from_e1_deg
     d = np.linspace(-1.0, 1.0, 201)[1:-1]
     return [
-        {"name": f"DAST family 1 (a = b, chi = {90.0 - t:g} deg)", "delta": d, "chi": np.full_like(d, math.radians(90.0 - t)),
-         "style": "-"},
-        {"name": f"DAST family 2 (b = c, chi = {t:g} deg)", "delta": d, "chi": np.full_like(d, math.radians(t)), "style": "-."},
+        {"name": f"DAST family 1 (a = b, chi = {90.0 - t:g} deg)", "short": "DAST family 1 (a = b)", "delta": d,
+         "chi": np.full_like(d, math.radians(90.0 - t)), "style": "-"},
+        {"name": f"DAST family 2 (b = c, chi = {t:g} deg)", "short": "DAST family 2 (b = c)", "delta": d,
+         "chi": np.full_like(d, math.radians(t)), "style": "-."},
     ]
 
 

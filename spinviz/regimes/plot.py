@@ -22,12 +22,31 @@ import numpy as np
 from ..atomic import Outputs, check_outputs
 from ..errors import UsageError
 from ..plotting import pyplot
+from . import classify as C
 from . import formulas as FM
 
-COLORS = {"1": "#1f5fa8", "2": "#8fc1e3", "3": "#3a9a3a", "4": "#f08c1e", "5": "#d62728", "3.9": "#8c564b",
-          "R": "#7f7f7f", "T2": "#8fc1e3", "Tcone": "#3a9a3a", "T4": "#f08c1e", "TF": "#8c564b", "T1": "#1f5fa8",
-          "T5": "#d62728", "other": "#e4e4e4", "1|2": "#e4e4e4", "4|5": "#e4e4e4", "failed": "#111111", "missing": "#ffffff"}
-ORDER = ("1", "2", "3", "4", "5", "3.9", "R", "T2", "Tcone", "T4", "TF", "other", "failed", "missing")
+# Okabe & Ito's colour-blind-safe palette; a truncated type shares the colour of the reduced
+# type it resembles (T2 ~ 2, Tcone ~ 3, T4 ~ 4, TF ~ the frozen 3.9).
+COLORS = {"1": "#0072B2", "2": "#56B4E9", "3": "#009E73", "4": "#E69F00", "5": "#D55E00", "3.9": "#CC79A7",
+          "R": "#F0E442", "T2": "#56B4E9", "Tcone": "#009E73", "T4": "#E69F00", "TF": "#CC79A7", "T1": "#0072B2",
+          "T5": "#D55E00", "other": "#dddddd", "1|2": "#dddddd", "4|5": "#dddddd", "approaching": "#bbbbbb",
+          "failed": "#000000", "missing": "#ffffff"}
+ORDER = ("1", "2", "3", "4", "5", "3.9", "R", "T2", "Tcone", "T4", "TF", "approaching", "other", "failed", "missing")
+# what each type is, in plain words (the diagram's legend; the paper's section 4 for the formulas)
+WORDS = {
+    "1": "1: spin about the symmetry axis, the cross spin dies as 1/\u03c4",
+    "2": "2: spiral onto the symmetry axis",
+    "3": "3: balanced spiral, both parts fall as 1/\u221a\u03c4",
+    "4": "4: spiral with the cross spin dominant",
+    "5": "5: wobble about a cross axis (libration)",
+    "3.9": "(3.9): rotation about e\u2082 itself",
+    "R": "R: keeps spinning about the dipole",
+    "T2": "T2: slows to rest, spin gathering on the axis",
+    "Tcone": "Tcone: slows to rest on a fixed cone",
+    "T4": "T4: slows to rest, cross spin dominant",
+    "TF": "TF: slows to rest, turning about a fixed cross axis",
+}
+COEXIST = 0.10             # a type "coexists" in a cell when it holds at least this share next to another
 
 
 def hodograph_path(path: str) -> str:
@@ -59,19 +78,43 @@ def draw(store_path: str, paths: list[str]) -> list[str]:
     return list(paths)
 
 
+def cell_types(ds, model: str):
+    """(types, approaching): per (delta, chi, member) the type a run counts for in the diagram
+    (an "approaching X" run counts for X) as label strings, and whether it is still approaching."""
+    lab = ds["label"].sel(model=model).values
+    appr = lab == "approaching"
+    if appr.any():
+        names = {v: k for k, v in C.CODE.items()}
+        cand = np.vectorize(lambda c: names.get(int(c), "other"))(ds["candidate"].sel(model=model).values)
+        lab = np.where(appr, cand, lab)
+    lab = np.where(np.isin(lab, ["1|2", "4|5"]), "other", lab)
+    return lab, appr
+
+
 def shares(ds, model: str) -> dict:
-    """label -> array (delta, chi) of the share of the members with that label."""
-    lab = ds["label"].sel(model=model).values                # (delta, chi, member) strings
+    """type -> array (delta, chi) of the share of the members of that type (an approaching run
+    counted for the type it approaches; how many are still approaching: ``cell_types``).
+    The shares of a cell add up to 1."""
+    lab, _ = cell_types(ds, model)
     n = lab.shape[-1]
     out = {}
     for name in ORDER:
-        if name == "other":
-            s = np.isin(lab, ["other", "1|2", "4|5"]).sum(axis=-1) / n
-        else:
-            s = (lab == name).sum(axis=-1) / n
+        s = (lab == name).sum(axis=-1) / n
         if np.any(s > 0):
             out[name] = s
     return out
+
+
+def coexisting(ds, model: str) -> np.ndarray:
+    """(delta, chi) bool: cells where two settled types each hold >= ``COEXIST`` of the members."""
+    lab, appr = cell_types(ds, model)
+    settled = np.where(appr | np.isin(lab, ["other", "failed", "missing"]), "", lab)
+    n = lab.shape[-1]
+    count = np.zeros(lab.shape[:-1], dtype=int)
+    for name in ORDER:
+        if name in WORDS:
+            count += ((settled == name).sum(axis=-1) / n >= COEXIST)
+    return count >= 2
 
 
 def _edges(v: np.ndarray, lo: float, hi: float) -> np.ndarray:
@@ -84,54 +127,137 @@ def _edges(v: np.ndarray, lo: float, hi: float) -> np.ndarray:
 
 
 def diagram(ds, path: str, title: str | None = None):
-    """The delta-chi diagram, one panel per model (see the module docstring)."""
+    """The delta-chi diagram, one panel per model, like the paper's figures 2, 3.D and 5: each
+    cell split into bars, one per type, as wide as that type's share of the cell's members
+    (hatched: the share still approaching it at tau_end, a slow hand-over), a dot where two
+    types coexist among the starts; the analytic boundaries labelled with their equations; the
+    DAST families of figure 5; a legend in words."""
     plt = pyplot()
-    from matplotlib.patches import Patch, Rectangle
-
     models = [str(m) for m in ds["model"].values]
-    deltas = ds["delta"].values
-    chis = np.degrees(ds["chi"].values)
-    de, ce = _edges(deltas, -1.0, 1.0), _edges(chis, 0.0, 90.0)
-    fig, axes = plt.subplots(1, len(models), figsize=(6.4 * len(models), 6.6), squeeze=False)
+    fig, axes = plt.subplots(1, len(models), figsize=(7.2 * len(models), 7.6), squeeze=False)
     seen = set()
     for ax, model in zip(axes[0], models):
-        sh = shares(ds, model)
-        for i in range(len(deltas)):
-            for j in range(len(chis)):
-                x0, w = de[i], de[i + 1] - de[i]
-                y0, h = ce[j], ce[j + 1] - ce[j]
-                x = x0
-                for name, s in sh.items():
-                    if s[i, j] > 0:
-                        ax.add_patch(Rectangle((x, y0), w * s[i, j], h, facecolor=COLORS[name], edgecolor="none"))
-                        x += w * s[i, j]
-                        seen.add(name)
-                ax.add_patch(Rectangle((x0, y0), w, h, facecolor="none", edgecolor="white", lw=0.6))
-        for line in FM.boundaries(model):
-            paper = line["source"] == "paper"
-            color = "k" if paper else ("#1030c0" if ("alpha" in line["name"] or "delta = 0" in line["name"]) else "#c01010")
-            ls = {"(4.15)": "-", "(4.17)": "--", "(4.20)": ":", "(4.43)": "-."}.get(line["name"][:6], "-")
-            ax.plot(line["delta"], np.degrees(line["chi"]), color=color, ls=ls if paper else "-", lw=1.4 if paper else 1.8,
-                    label=("paper " if paper else "spinviz ") + line["name"])
-        for fam in FM.dast_families():
-            ax.plot(fam["delta"], np.degrees(fam["chi"]), color="0.35", ls=fam["style"], lw=2.2, alpha=0.8, label=fam["name"])
+        seen |= _cells(ax, ds, model)
+        _lines(ax, model)
+        n = ds.sizes["member"]
         ax.set_xlim(-1, 1)
         ax.set_ylim(0, 90)
-        ax.set_xlabel("\u03b4 = 1 \u2212 I\u2083/I\u2081")
-        ax.set_ylabel("\u03c7 (deg)")
-        n = ds.sizes["member"]
-        ax.set_title(f"{model} model: share of each type among {n} member{'s' if n != 1 else ''} per cell", fontsize=10)
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.11), ncol=2, fontsize=7, frameon=False)
-    handles = [Patch(facecolor=COLORS[k], edgecolor="0.6", label=k) for k in ORDER if k in seen]
-    fig.legend(handles=handles, loc="upper center", ncol=len(handles), fontsize=8, frameon=False,
-               bbox_to_anchor=(0.5, 1.0))
+        ax.set_xlabel("\u03b4 = 1 \u2212 I\u2083/I\u2081   (prolate \u2190 0 \u2192 oblate)")
+        ax.set_ylabel("\u03c7 = angle of the dipole from the symmetry axis (deg)")
+        ax.set_title(f"{model} model: type of each of {n} starts per cell", fontsize=11)
+    _legend(fig, seen)
     s = _spec(ds)
     w0 = s["members"]["omega"]
     starts = f"|\u03c9\u2080| = {w0}" if w0 else "explicit starts"
-    fig.suptitle(title or f"{ds.attrs.get('title', 'atlas')}: \u03c4_end = {s['run']['tau_end']:.0e}, {starts}",
-                 y=0.955, fontsize=10)
-    fig.tight_layout(rect=(0, 0, 1, 0.94))
-    _save_small(fig, path, dpi=90)
+    fig.suptitle(title or f"{ds.attrs.get('title', 'atlas')}   (\u03c4_end = {s['run']['tau_end']:.0e}, {starts})",
+                 y=0.985, fontsize=11)
+    fig.tight_layout(rect=(0, 0.13, 1, 0.96))
+    _save_small(fig, path, dpi=110)
+
+
+def compose(ds, model: str) -> list[dict]:
+    """The diagram's cells of one model, as plain data for the PNG and the HTML page: each a
+    dict with ``i``, ``j``, the rectangle ``x0, x1`` (delta) and ``y0, y1`` (chi, deg), the
+    ``bars`` -- (type, width fraction, hatched) left to right in ``ORDER`` -- ``coexist`` and
+    ``counts`` (type or "->type" -> members)."""
+    deltas, chis = ds["delta"].values, np.degrees(ds["chi"].values)
+    de, ce = _edges(deltas, -1.0, 1.0), _edges(chis, 0.0, 90.0)
+    lab, appr = cell_types(ds, model)
+    co = coexisting(ds, model)
+    n = lab.shape[-1]
+    cells = []
+    for i in range(len(deltas)):
+        for j in range(len(chis)):
+            bars, counts = [], {}
+            for name in ORDER:
+                m = lab[i, j] == name
+                k = int(m.sum())
+                if name == "approaching" or not k:
+                    continue
+                ka = int((m & appr[i, j]).sum())
+                if k - ka:
+                    bars.append((name, (k - ka) / n, False))
+                    counts[name] = k - ka
+                if ka:
+                    bars.append((name, ka / n, True))
+                    counts["->" + name] = ka
+            cells.append({"i": i, "j": j, "delta": float(deltas[i]), "chi_deg": float(chis[j]), "x0": float(de[i]),
+                          "x1": float(de[i + 1]), "y0": float(ce[j]), "y1": float(ce[j + 1]), "bars": bars,
+                          "coexist": bool(co[i, j]), "counts": counts})
+    return cells
+
+
+def _cells(ax, ds, model: str) -> set:
+    """The bars of every cell (one PatchCollection per type and hatching) and the coexistence dots."""
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Rectangle
+
+    rects: dict = {}
+    seen = set()
+    dots = []
+    for c in compose(ds, model):
+        x, w, h = c["x0"], c["x1"] - c["x0"], c["y1"] - c["y0"]
+        for name, frac, hatched in c["bars"]:
+            rects.setdefault((name, hatched), []).append(Rectangle((x, c["y0"]), w * frac, h))
+            x += w * frac
+            seen.add("approaching" if hatched else name)
+            seen.add(name)
+        if c["coexist"]:
+            dots.append((c["delta"], c["chi_deg"]))
+    for (name, hatched), rs in rects.items():
+        ax.add_collection(PatchCollection(rs, facecolor=COLORS[name], edgecolor="white" if hatched else "none",
+                                          hatch="////" if hatched else None, linewidth=0.0))
+    if dots:
+        ax.scatter(*zip(*dots), s=7, color="black", edgecolors="white", linewidths=0.4, zorder=5)
+        seen.add("coexisting")
+    return seen
+
+
+LINE_STYLE = {  # name prefix -> (colour, style, where to write its label: delta)
+    "(4.15)": ("k", "-", -0.72), "(4.17)": ("k", "--", -0.38), "(4.20)": ("k", ":", 0.62),
+    "(4.43) as printed": ("k", "-.", 0.93), "(4.43) corrected": ("#a3001b", "-.", 0.72),
+    "alpha": ("#0b3d91", "-", -0.62), "beta = -3/4": ("#a3001b", "-", 0.1),
+    "delta = 0": ("#0b3d91", "-", 0.0), "beta_T": ("#a3001b", "-", 0.75),
+}
+
+
+def _lines(ax, model: str) -> None:
+    """The analytic boundaries, each labelled with its equation, and the DAST families."""
+    for line in FM.boundaries(model):
+        key = next(k for k in sorted(LINE_STYLE, key=len, reverse=True) if line["name"].startswith(k))
+        color, ls, at = LINE_STYLE[key]
+        d, c = line["delta"], np.degrees(line["chi"])
+        ax.plot(d, c, color=color, ls=ls, lw=1.6)
+        ok = np.isfinite(c) & (c > 2) & (c < 88)
+        if ok.any():
+            k = int(np.argmin(np.where(ok, np.abs(d - at), np.inf)))
+            ax.annotate(line["label"], (d[k], c[k]), fontsize=7.5, color=color, ha="center", va="bottom",
+                        bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8})
+    for fam in FM.dast_families():
+        ax.plot(fam["delta"], np.degrees(fam["chi"]), color="0.25", ls=fam["style"], lw=1.2, alpha=0.9)
+        ax.text(-0.98, np.degrees(fam["chi"][0]) + 0.8, fam["short"], fontsize=7, color="0.2")
+
+
+def _legend(fig, seen: set) -> None:
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    handles = [Patch(facecolor=COLORS[k], edgecolor="0.5", label=WORDS[k]) for k in ORDER if k in seen and k in WORDS]
+    extra = []
+    if "approaching" in seen:
+        extra.append(Patch(facecolor="0.75", edgecolor="white", hatch="////",
+                           label="hatched: still approaching that type at \u03c4_end (a slow hand-over)"))
+    if "coexisting" in seen:
+        extra.append(Line2D([], [], marker="o", ls="", color="black", markersize=4,
+                            label="dot: two types coexist among the cell's starts (each \u2265 10 %)"))
+    if "other" in seen:
+        extra.append(Patch(facecolor=COLORS["other"], edgecolor="0.5", label="other: no type fits (yet)"))
+    if "failed" in seen:
+        extra.append(Patch(facecolor=COLORS["failed"], label="failed run (see its reason in the store)"))
+    extra += [Line2D([], [], color="k", lw=1.6, label="black: the paper's domain boundaries"),
+              Line2D([], [], color="#0b3d91", lw=1.6, label="blue, red: lines spinviz derived (labelled)"),
+              Line2D([], [], color="0.25", lw=1.2, label="grey: the DAST crystal families of figure 5")]
+    fig.legend(handles=handles + extra, loc="lower center", ncol=3, fontsize=8, frameon=False, bbox_to_anchor=(0.5, 0.0))
 
 
 def _save_small(fig, path: str, dpi: int) -> None:
@@ -166,7 +292,7 @@ def representatives(ds) -> list[tuple]:
         lab = ds["label"].sel(model=model).values
         conf = ds["confidence"].sel(model=model).values
         for name in ORDER:
-            if name in ("other", "failed", "missing"):
+            if name in ("other", "failed", "missing", "approaching"):
                 continue
             m = lab == name
             if not m.any():

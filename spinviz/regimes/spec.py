@@ -39,6 +39,11 @@ changing while a 12 x 12 x 8 atlas still runs in minutes on two cores.  rtol 1e-
 method on the scaled omega sqrt(1 + tau/T) / |omega0|, so the tolerance holds relative to the
 braking law to the end of the run (docs/atlas.md: labels and amplitudes against rtol).
 20 samples a decade and a 2-decade window: 41 samples, the labels are the same at 10-50.
+
+Every table is declared in the schema, ``spinviz.inputs.atlas`` (how to add a key is said
+there); this module builds the ``AtlasSpec`` from the validated tables and says, before any
+work, whether the atlas can finish on this machine (``check_feasible``: memory, run count,
+time).
 """
 
 from __future__ import annotations
@@ -51,26 +56,32 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SceneError, brief
+from ..errors import SceneError, SpecError, SpecTypeError
+from ..inputs import atlas as IA
+from ..inputs.base import fields_of
+from ..inputs.render import usable_cores
+from ..inputs.toml import read_toml, table
 from ..physics.bodies import MIN_INERTIA_RATIO
-from ..scene import _Table, read_toml
 from .runs import Settings
 
-MODELS = ("reduced", "truncated")
+MODELS = IA.MODELS
 FORMAT = 2                       # the store's version (identity): 2 = Taylor's method (heyoka), no atol
-MAX_RUNS = 100_000_000
-MAX_CELLS = 4096                 # per axis
-MAX_MEMBERS = 100_000
-OMEGA_MAX = 10.0                 # |omega(0)| beyond which the start is hopelessly stiff (tau0 Omega >> 1)
+MAX_RUNS = IA.MAX_RUNS
+MAX_CELLS = IA.MAX_CELLS         # per axis
+MAX_MEMBERS = IA.MAX_MEMBERS
+OMEGA_MAX = IA.OMEGA_RANGE[1]    # |omega(0)| beyond which the start is hopelessly stiff (tau0 Omega >> 1)
 
 
 @dataclass(frozen=True)
 class AtlasSpec:
-    """A validated atlas spec.
+    """A validated atlas spec (also when made by hand: every field is checked).
 
     deltas : shape (n_delta,), (3.6), each in (-1, 1).  chis : shape (n_chi,), rad, in [0, pi/2].
     omega0 : shape (members, 3), body-frame starts (dimensionless), the same at every cell.
     settings : how each run is integrated and classified.
+    axes : {"delta": (min, max, cells), "chi": (min, max, cells) in rad} when both axes were
+        given as {min, max, cells} (the grid refinement needs), else None.
+    refine_levels, refine_agree : ``[refine]``; series : ``[output].series``.
     """
 
     path: str
@@ -83,6 +94,34 @@ class AtlasSpec:
     settings: Settings
     seed: int | None = None
     omega_magnitude: float | None = None
+    axes: dict | None = None
+    refine_levels: int = 0
+    refine_agree: float = 0.9
+    series: int = 1
+
+    def __post_init__(self):
+        models = tuple(self.models) if isinstance(self.models, list | tuple) else None
+        if not models or any(m not in MODELS for m in models) or len(set(models)) != len(models):
+            raise SpecError("models", f"must be one or two of {', '.join(MODELS)}, each once, got {self.models!r}")
+        object.__setattr__(self, "models", models)
+        for name, lo, hi in (("deltas", -1.0, 1.0 - MIN_INERTIA_RATIO), ("chis", 0.0, 0.5 * math.pi)):
+            a = _array(name, getattr(self, name), 1)
+            if not (a.size and np.all((a >= lo) & (a <= hi)) and np.all(np.diff(a) > 0)):
+                raise SpecError(name, f"must be increasing values in [{lo:g}, {hi:g}] (at most {MAX_CELLS}), got {a!r}")
+            if a.size > MAX_CELLS:
+                raise SpecError(name, f"at most {MAX_CELLS} values, got {a.size}")
+            object.__setattr__(self, name, a)
+        w = _array("omega0", self.omega0, 2)
+        norms = np.linalg.norm(w, axis=1) if w.ndim == 2 and w.shape[1] == 3 else None
+        lo, hi = IA.OMEGA_RANGE
+        if norms is None or not 1 <= len(w) <= MAX_MEMBERS or not np.all((norms >= lo) & (norms <= hi)):
+            raise SpecError("omega0", f"must be 1..{MAX_MEMBERS} starts [w1, w2, w3] with |omega0| in [{lo:g}, {hi:g}], "
+                                      f"got shape {w.shape}")
+        object.__setattr__(self, "omega0", w)
+        if not isinstance(self.settings, Settings):
+            raise SpecTypeError("settings", f"must be a regimes.runs.Settings, got {type(self.settings).__name__}")
+        if self.refine_levels and self.axes is None:
+            raise SpecError("refine", "levels > 0 needs both grid axes as {min, max, cells} (a quadtree of equal cells)")
 
     @property
     def members(self) -> int:
@@ -95,7 +134,6 @@ class AtlasSpec:
     def canonical(self) -> dict:
         """Everything that decides the numbers, as plain JSON types (title and description
         excluded: renaming a study does not change it)."""
-        s = self.settings
         return {
             "format": FORMAT,
             "models": list(self.models),
@@ -103,9 +141,10 @@ class AtlasSpec:
             "chi": [float(x) for x in self.chis],
             "members": {"count": self.members, "seed": self.seed, "omega": self.omega_magnitude,
                         "omega0": [[float(x) for x in row] for row in self.omega0]},
-            "run": {"tau_end": s.tau_end, "tau_start": s.tau_start, "samples_per_decade": s.per_decade,
-                    "rtol": s.rtol, "max_steps": s.max_steps},
-            "classify": {"window_decades": s.window},
+            "run": _identity_values(IA.RunTable, self.settings),
+            "classify": _identity_values(IA.ClassifyTable, self.settings),
+            **({"refine": {"levels": self.refine_levels, "agree": self.refine_agree}} if self.refine_levels else {}),
+            **({"output": {"series": self.series}} if self.series != 1 else {}),
         }
 
     def canonical_json(self) -> str:
@@ -119,142 +158,145 @@ class AtlasSpec:
         return hashlib.sha256(f"classifier {VERSION}\n{self.canonical_json()}".encode()).hexdigest()
 
 
+def _array(name: str, v, ndim: int) -> np.ndarray:
+    try:
+        a = np.array(v, dtype=float)
+    except (TypeError, ValueError):
+        raise SpecTypeError(name, f"must be an array of numbers, got {type(v).__name__}") from None
+    if a.ndim != ndim or not np.all(np.isfinite(a)):
+        raise SpecError(name, f"must be a finite {ndim}-D array, got shape {a.shape}")
+    a.flags.writeable = False
+    return a
+
+
+def _kept(cls) -> dict:
+    """The keys of table ``cls`` that reach ``Settings`` (refused keys do not)."""
+    return {k: f for k, f in fields_of(cls).items() if k != "atol"}
+
+
+def _identity_values(cls, settings: Settings) -> dict:
+    out = {}
+    for key, f in _kept(cls).items():
+        value = getattr(settings, IA.SETTINGS_NAMES.get(key, key))
+        if any(isinstance(m, IA.Added) for m in f.metadata) and value == f.default:
+            continue
+        out[key] = value
+    return out
+
+
+def settings_from(run, classify) -> Settings:
+    """``Settings`` from the validated ``[run]`` and ``[classify]`` tables."""
+    kw = {}
+    for t in (run, classify):
+        for key in _kept(type(t)):
+            kw[IA.SETTINGS_NAMES.get(key, key)] = getattr(t, key)
+    return Settings(**kw)
+
+
+def settings_from_canonical(canonical: dict) -> Settings:
+    """``Settings`` from a store's canonical spec (``json.loads(ds.attrs["spec"])``): its
+    ``run`` and ``classify`` tables through the schema, so a key added later is read, and a
+    store made before it gets the key's default."""
+    run = IA.RunTable(**canonical.get("run", {}))
+    classify = IA.ClassifyTable(**canonical.get("classify", {}))
+    return settings_from(run, classify)
+
+
 def load_spec(path) -> AtlasSpec:
     """Read and validate an atlas spec; ``SceneError`` (file, key, reason) on any problem."""
+    if not isinstance(path, str | os.PathLike):
+        raise SpecTypeError("spec", f"must be the path of an atlas spec (TOML) or an AtlasSpec, got {type(path).__name__}")
     path = os.fspath(path)
     return parse_spec(read_toml(path, kind="atlas spec"), path)
 
 
 def parse_spec(data: dict, path: str = "<atlas spec>") -> AtlasSpec:
     """Validate a parsed TOML document (see the module docstring for every key)."""
-    top = _Table(path, "", data)
-    title = top.string("title", default="") or ""
-    description = top.string("description", default="") or ""
-    models = _models(top)
-    grid = top.sub("grid", required=True)
-    deltas = _axis(grid, "delta", (-1.0, 1.0), open_ends=True, unit="")
-    if grid.has("chi") and grid.has("chi_deg"):
-        raise grid.error("chi", "give chi (rad) or chi_deg, not both")
-    if grid.has("chi_deg"):
-        chis_deg = _axis(grid, "chi_deg", (0.0, 90.0), open_ends=False, unit=" deg")
+    path = os.fspath(path)
+    top = table(IA.AtlasFile, data, "", path, IA.SUBTABLES)
+    grid = table(IA.GridTable, top.grid, "grid", path)
+    deltas = _axis(path, "delta", grid.delta, (-1.0, 1.0), open_ends=True, unit="")
+    if grid.chi_deg is not None:
+        chis_deg = _axis(path, "chi_deg", grid.chi_deg, (0.0, 90.0), open_ends=False, unit=" deg")
         chis = np.radians(chis_deg)
         chis[chis_deg == 90.0] = 0.5 * math.pi             # exactly pi/2: the transverse case (5.5)
     else:
-        chis = _axis(grid, "chi", (0.0, 0.5 * math.pi), open_ends=False, unit=" rad", required=True)
-    grid.finish()
+        chis = _axis(path, "chi", grid.chi, (0.0, 0.5 * math.pi), open_ends=False, unit=" rad")
     for d in deltas:
         if 1.0 - d < MIN_INERTIA_RATIO:
-            raise grid.error("delta", f"delta = {d:g}: 1 - delta = I3/I1 is below {MIN_INERTIA_RATIO:g}, too thin to integrate")
-    omega0, seed, mag = _members(top)
-    settings = _run(top)
-    top.finish()
+            raise SceneError(path, "[grid].delta", f"delta = {d:g}: 1 - delta = I3/I1 is below {MIN_INERTIA_RATIO:g}, "
+                                                   f"too thin to integrate")
+    members = table(IA.MembersTable, top.members, "members", path)
+    if members.list is not None:
+        omega0, seed, mag = np.array(members.list), None, None
+    else:
+        mag = members.omega if members.omega is not None else 0.1
+        omega0, seed = directions(members.count, members.seed) * mag, int(members.seed)
+    run = table(IA.RunTable, top.run or {}, "run", path)
+    classify = table(IA.ClassifyTable, top.classify or {}, "classify", path)
+    refine = table(IA.RefineTable, top.refine or {}, "refine", path)
+    output = table(IA.OutputTable, top.output or {}, "output", path)
+    axes = _ranges(grid)
+    if refine.levels and axes is None:
+        raise SceneError(path, "[refine].levels", "needs [grid].delta and [grid].chi (or chi_deg) as {min, max, cells}")
+    settings = settings_from(run, classify)
+    _check_horizon(path, settings, omega0)
+    models = top.model_names
     n_runs = len(models) * len(deltas) * len(chis) * len(omega0)
     if n_runs > MAX_RUNS:
         raise SceneError(path, "[grid]", f"{n_runs} runs exceed the limit of {MAX_RUNS}")
-    return AtlasSpec(path=path, title=title, description=description, models=models, deltas=deltas, chis=chis,
-                     omega0=omega0, settings=settings, seed=seed, omega_magnitude=mag)
+    return AtlasSpec(path=path, title=top.title, description=top.description, models=models, deltas=deltas, chis=chis,
+                     omega0=omega0, settings=settings, seed=seed, omega_magnitude=mag, axes=axes,
+                     refine_levels=refine.levels, refine_agree=refine.agree,
+                     series=min(output.series, len(omega0)))
 
 
-def _models(top: _Table) -> tuple:
-    key = top.one_of("model", "models")
-    if key is None:
-        return ("reduced",)
-    if key == "model":
-        return (top.string("model", choices=MODELS),)
-    v = top.raw("models")
-    if not isinstance(v, list) or not v:
-        raise top.error("models", f"must be a non-empty list of {', '.join(MODELS)}, got {brief(v)}")
-    out = []
-    for m in v:
-        if m not in MODELS:
-            raise top.error("models", f"unknown model {brief(m)}; valid: {', '.join(MODELS)}")
-        if m in out:
-            raise top.error("models", f"{m!r} named twice")
-        out.append(m)
-    return tuple(out)
+def _ranges(grid) -> dict | None:
+    """{axis: (min, max, cells)} (chi in rad) when both axes are {min, max, cells}, else None."""
+    chi = grid.chi_deg if grid.chi_deg is not None else grid.chi
+    if not (isinstance(grid.delta, dict) and isinstance(chi, dict)):
+        return None
+    scale = math.pi / 180.0 if grid.chi_deg is not None else 1.0
+    return {"delta": (float(grid.delta["min"]), float(grid.delta["max"]), int(grid.delta["cells"])),
+            "chi": (float(chi["min"]) * scale, float(chi["max"]) * scale, int(chi["cells"]))}
 
 
-def _axis(t: _Table, k: str, bounds: tuple, open_ends: bool, unit: str, required: bool = True):
+def _axis(path, k: str, v, bounds: tuple, open_ends: bool, unit: str) -> np.ndarray:
     """A grid axis: a list of values, or ``{min, max, cells}`` (the centres of ``cells``
     equal cells, so never an end of the range)."""
-    v = t.raw(k, required=required)
     lo, hi = bounds
     ends = f"({lo:g}, {hi:g})" if open_ends else f"[{lo:g}, {hi:g}]"
     if isinstance(v, dict):
-        r = _Table(t.path, f"{t.name}.{k}" if t.name else k, v)
-        a = r.number("min", required=True)
-        b = r.number("max", required=True)
-        n = r.integer("cells", required=True, minimum=1)
-        r.finish()
-        if not a < b:
-            raise r.error("max", f"must exceed min ({a:g}), got {b:g}")
-        if a < lo or b > hi:
-            raise r.error("min" if a < lo else "max", f"the range must lie within {ends}{unit}, got [{a:g}, {b:g}]")
-        if n > MAX_CELLS:
-            raise r.error("cells", f"at most {MAX_CELLS}, got {n}")
-        v = a + (np.arange(n) + 0.5) * (b - a) / n
-        v[np.abs(v) < 1e-12 * (b - a)] = 0.0       # an odd count centred on 0 hits it exactly (delta = 0: (5.2))
-        return v
-    if isinstance(v, list):
-        if not v:
-            raise t.error(k, "is empty: give at least one value, or {min, max, cells}")
-        vals = []
-        for x in v:
-            if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(float(x)):
-                raise t.error(k, f"must be a list of finite numbers, got {brief(v)}")
-            x = float(x)
-            inside = lo < x < hi if open_ends else lo <= x <= hi
-            if not inside:
-                raise t.error(k, f"{x:g} is outside {ends}{unit}")
-            vals.append(x)
-        if len(set(vals)) != len(vals):
-            raise t.error(k, "a value is listed twice")
-        if any(b <= a for a, b in zip(vals, vals[1:])):
-            raise t.error(k, "values must increase")
-        if len(vals) > MAX_CELLS:
-            raise t.error(k, f"at most {MAX_CELLS} values, got {len(vals)}")
-        return np.array(vals)
-    raise t.error(k, f"must be a list of values or a table {{min, max, cells}}, got {brief(v)}")
+        r = table(IA.AxisRange, v, f"grid.{k}", path)
+        if r.min < lo or r.max > hi:
+            raise SceneError(path, f"[grid.{k}].{'min' if r.min < lo else 'max'}",
+                             f"the range must lie within {ends}{unit}, got [{r.min:g}, {r.max:g}]")
+        out = r.min + (np.arange(r.cells) + 0.5) * (r.max - r.min) / r.cells
+        out[np.abs(out) < 1e-12 * (r.max - r.min)] = 0.0     # an odd count centred on 0 hits it exactly (delta = 0: (5.2))
+        return out
+    for x in v:
+        if not (lo < x < hi if open_ends else lo <= x <= hi):
+            raise SceneError(path, f"[grid].{k}", f"{x:g} is outside {ends}{unit}")
+    return np.array(v, dtype=float)
 
 
-def _members(top: _Table):
-    m = top.sub("members", required=True)
-    if m.has("list"):
-        for other in ("count", "seed", "omega"):
-            if m.has(other):
-                raise m.error(other, "give list (explicit starts) or count, seed and omega, not both")
-        v = m.raw("list")
-        if not isinstance(v, list) or not v:
-            raise m.error("list", f"must be a non-empty list of [w1, w2, w3], got {brief(v)}")
-        rows = []
-        for row in v:
-            if not isinstance(row, list) or len(row) != 3 or any(isinstance(x, bool) or not isinstance(x, (int, float))
-                                                                 for x in row):
-                raise m.error("list", f"each start must be [w1, w2, w3] (numbers), got {brief(row)}")
-            r = np.array(row, dtype=float)
-            if not np.all(np.isfinite(r)):
-                raise m.error("list", f"each start must be finite, got {brief(row)}")
-            n = float(np.linalg.norm(r))
-            if not 0.0 < n <= OMEGA_MAX:
-                raise m.error("list", f"|omega(0)| must lie in (0, {OMEGA_MAX:g}], got {n:g} for {brief(row)}")
-            rows.append(r)
-        if len(rows) > MAX_MEMBERS:
-            raise m.error("list", f"at most {MAX_MEMBERS} starts, got {len(rows)}")
-        m.finish()
-        return np.array(rows), None, None
-    count = m.raw("count", required=True)
-    if isinstance(count, bool) or not isinstance(count, int):
-        raise m.error("count", f"must be a whole number, got {brief(count)}")
-    if count <= 0:
-        raise m.error("count", f"must be at least 1, got {count}")
-    if count > MAX_MEMBERS:
-        raise m.error("count", f"at most {MAX_MEMBERS}, got {count}")
-    seed = m.integer("seed", required=True, minimum=0)
-    mag = m.number("omega", default=0.1, positive=True)
-    if mag > OMEGA_MAX:
-        raise m.error("omega", f"must not exceed {OMEGA_MAX:g} (tau0 |Omega| >> 1 is outside the model), got {mag:g}")
-    m.finish()
-    return directions(count, seed) * mag, int(seed), float(mag)
+def _check_horizon(path, s: Settings, omega0) -> None:
+    """The horizon must hold the classifier's windows and reach the asymptotic regime of the
+    slowest start (section 4's laws hold for tau |omega0|^2 >> 1)."""
+    decades = math.log10(s.tau_end / s.tau_start)
+    if decades < 2.0 * s.window:
+        raise SceneError(path, "[run].tau_end", f"tau_end/tau_start spans {decades:.2g} decades; the classifier needs at "
+                                                f"least 2 x window_decades = {2 * s.window:g} (one window, and one before "
+                                                f"it to see the label hold)")
+    if s.per_decade * s.window < 12:
+        raise SceneError(path, "[run].samples_per_decade", f"{s.per_decade} a decade gives {s.per_decade * s.window:g} "
+                                                           f"samples in the {s.window:g}-decade window; the classifier needs 12")
+    slowest = float(np.min(np.linalg.norm(omega0, axis=1)))
+    braking = s.tau_end * slowest**2
+    if braking < IA.MIN_BRAKING_TIMES:
+        raise SceneError(path, "[run].tau_end", f"tau_end = {s.tau_end:g} is {braking:.3g} braking times T = 1/|omega0|^2 "
+                                                f"of the slowest start (|omega0| = {slowest:g}); the asymptotic laws need at "
+                                                f"least {IA.MIN_BRAKING_TIMES:g}")
 
 
 def directions(count: int, seed: int) -> np.ndarray:
@@ -263,35 +305,66 @@ def directions(count: int, seed: int) -> np.ndarray:
     return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 
-def _run(top: _Table) -> Settings:
-    d = Settings()
-    r = top.sub("run")
-    c = top.sub("classify")
-    if r is None:
-        r = _Table(top.path, "run", {})
-    tau_end = r.number("tau_end", default=d.tau_end, positive=True)
-    tau_start = r.number("tau_start", default=d.tau_start, positive=True)
-    per = r.integer("samples_per_decade", default=d.per_decade, minimum=6)
-    if per > 1000:
-        raise r.error("samples_per_decade", f"at most 1000, got {per}")
-    rtol = r.number("rtol", default=d.rtol, within=(1e-14, 1e-3, "Taylor's method in float64"))
-    if r.has("atol"):
-        raise r.error("atol", "is not used since the atlas integrates with Taylor's method: its one tolerance, rtol, "
-                              "holds on omega sqrt(1 + tau/T) / |omega0| (docs/atlas.md); remove the key")
-    max_steps = r.integer("max_steps", default=d.max_steps, minimum=1000)
-    r.finish()
-    window = d.window
-    if c is not None:
-        window = c.number("window_decades", default=d.window, within=(0.5, 6.0, "the classifier's window"))
-        c.finish()
-    if tau_end > 1e16:
-        raise r.error("tau_end", f"at most 1e16 (float64 time steps), got {tau_end:g}")
-    decades = math.log10(tau_end / tau_start)
-    if decades < 2.0 * window:
-        raise r.error("tau_end", f"tau_end/tau_start spans {decades:.2g} decades; the classifier needs at least "
-                                 f"2 x window_decades = {2 * window:g} (one window, and one before it to see the label hold)")
-    if per * window < 12:
-        raise r.error("samples_per_decade", f"{per} a decade gives {per * window:g} samples in the {window:g}-decade "
-                                            f"window; the classifier needs 12")
-    return Settings(tau_end=tau_end, tau_start=tau_start, per_decade=per, rtol=rtol, max_steps=max_steps,
-                    window=window)
+# --- can it finish? ------------------------------------------------------------------------------
+# What this process holds for an atlas, measured with tracemalloc around api.plan and the
+# store's predictions (64 x 64 cells x 32 members: 955 B a cell at the peak, 650 B a task),
+# with a margin; and what a run costs (docs/atlas.md, "Benchmark": 10.4 runs/s per worker on
+# the shipped atlas, tau_end = 1e10, both models).
+BYTES_PER_CELL = 1200            # the paper's predictions at each (delta, chi), as Python lists, then float64
+BYTES_PER_TASK = 1000            # a batch (its chi tuple, omega0 view, region), its key and counters
+BYTES_PER_RUN = 16               # done mask, label codes and their copies
+CPU_S_PER_RUN = 0.096            # a run to tau_end = 1e10 at rtol 1e-8, one core
+MAX_DAYS = 30.0                  # an embedded atlas expected to take longer is refused: it would not finish here
+MEMORY_SHARE = 0.5               # of physical memory, for this process (the workers need the rest)
+
+
+@dataclass(frozen=True)
+class Cost:
+    """What an atlas needs: ``bytes`` in this process, ``cpu_s`` of integration, ``wall_s`` on ``workers``."""
+
+    runs: int
+    tasks: int
+    bytes: float
+    cpu_s: float
+    wall_s: float | None
+    workers: int | None
+
+
+def physical_memory() -> float:
+    """Bytes of physical memory (0 if unknown)."""
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return 0.0
+
+
+def cost(spec: AtlasSpec, runs_per_task: int = 32, workers: int | None = None) -> Cost:
+    """The estimate ``check_feasible`` judges: memory of this process, CPU time (a run's cost
+    grows as sqrt(tau_end), the steps of a spiral), and wall time on ``workers``."""
+    cells = len(spec.deltas) * len(spec.chis)
+    tm = min(spec.members, 256, max(1, runs_per_task))
+    tc = max(1, runs_per_task // tm)
+    tasks = len(spec.models) * len(spec.deltas) * math.ceil(len(spec.chis) / tc) * math.ceil(spec.members / tm)
+    nbytes = BYTES_PER_CELL * cells + BYTES_PER_TASK * tasks + BYTES_PER_RUN * spec.runs
+    cpu = spec.runs * CPU_S_PER_RUN * math.sqrt(max(spec.settings.tau_end, 1.0) / 1e10)
+    return Cost(spec.runs, tasks, nbytes, cpu, None if not workers else cpu / workers, workers)
+
+
+def check_feasible(spec: AtlasSpec, arguments: IA.AtlasArguments) -> Cost:
+    """Refuse, before any work, an atlas that cannot finish here: more memory in this process
+    than half the machine's, or (on the embedded cluster) more than ``MAX_DAYS`` of work on
+    its workers.  ``SceneError`` names the spec and the key to change; returns the estimate."""
+    workers = None if arguments.scheduler is not None else (arguments.workers or usable_cores())
+    c = cost(spec, arguments.runs_per_task, workers)
+    mem = physical_memory()
+    if mem and c.bytes > MEMORY_SHARE * mem:
+        raise SceneError(spec.path, "[grid]", f"{c.runs} runs in {c.tasks} tasks would need ~{c.bytes / 1e9:.3g} GB in this "
+                                              f"process (~{BYTES_PER_CELL} B a cell, {BYTES_PER_TASK} B a task); this "
+                                              f"machine has {mem / 1e9:.3g} GB (limit {MEMORY_SHARE:g} of it): use fewer "
+                                              f"cells or members, or more runs per task")
+    if c.wall_s is not None and c.wall_s > MAX_DAYS * 86400.0:
+        raise SceneError(spec.path, "[grid]", f"{c.runs} runs to tau_end = {spec.settings.tau_end:g} would take "
+                                              f"~{c.wall_s / 86400.0:.3g} days on {workers} workers (~{CPU_S_PER_RUN:g} s a "
+                                              f"run at tau_end 1e10, growing as sqrt(tau_end)); at most {MAX_DAYS:g} days: "
+                                              f"use fewer cells or members, a shorter [run].tau_end, or a cluster (scheduler)")
+    return c

@@ -9,7 +9,7 @@ and ``overlay`` decide where it goes.  Pure Python and NumPy.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -32,6 +32,13 @@ SUBTITLES = {
 }
 ARROW_NAMES = {"dipole": ("d", "dipole"), "L": ("L", "angular momentum"), "omega": ("Ω", "rotation")}
 
+# the unit the power plot is drawn in: W for CGS scenes (the physics stays in erg/s), and the
+# unit of the dimensionless variables (4.1) otherwise
+POWER_UNIT = {"cgs": "W", "dimensionless": "I₁/τ₀³"}
+# what a lay viewer calls radiation of a frequency, Hz: radio up to 300 GHz (microwaves included),
+# infrared up to 400 THz, then light
+BANDS = ((3e11, "radio"), (4e14, "infrared"), (math.inf, "light"))
+
 _SUP = str.maketrans("0123456789-", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻")
 _WORDS = ((1e12, "trillion"), (1e9, "billion"), (1e6, "million"), (1e3, "thousand"))
 
@@ -39,6 +46,19 @@ _WORDS = ((1e12, "trillion"), (1e9, "billion"), (1e6, "million"), (1e3, "thousan
 def superscript(n: int) -> str:
     """An integer in superscript digits: 15 -> "¹⁵"."""
     return str(int(n)).translate(_SUP)
+
+
+def decade(e: int) -> str:
+    """A power of ten as a tick label: -17 -> "10⁻¹⁷", 0 -> "1", 1 -> "10"."""
+    return {0: "1", 1: "10"}.get(int(e), f"10{superscript(e)}")
+
+
+def radiation_band(omega: float) -> str:
+    """The everyday name of the radiation of a dipole turning at ``omega`` rad/s: "radio",
+    "infrared" or "light", judged at the rotation frequency |Omega|/2 pi (where a turning
+    dipole radiates; 7 GHz for the DAST cube: radio)."""
+    f = abs(float(omega)) / (2.0 * math.pi)
+    return next(name for top, name in BANDS if f < top)
 
 
 def sci(x: float, digits: int = 2) -> str:
@@ -107,7 +127,9 @@ class Texts:
     layout wraps it); legend : (key, symbol, name) per drawn arrow, and the body's entry when
     the drawn body is a stand-in; footer : the title line; scale : what the time bar's unit is
     ("" without one); bar_ticks : (position 0..1, label) of its marks; readouts : [panel][frame]
-    -> lines; time : per frame; notes : per frame -> lines (how time and spin are shown).
+    -> lines; time : per frame; notes : per frame -> lines (how time and spin are shown);
+    plot_titles : the title of each live plot shown ("angle", "omega" for ``inset``,
+    "power"), in the inset's order.
     """
 
     headings: list
@@ -119,6 +141,7 @@ class Texts:
     readouts: list
     time: list
     notes: list
+    plot_titles: dict = field(default_factory=dict)
 
 
 def texts_of(plan) -> Texts:
@@ -144,7 +167,8 @@ def texts_of(plan) -> Texts:
     return Texts(headings=[cap.heading(k) for k in range(n)], subtitles=[cap.subtitle(k) for k in range(n)],
                  legend=legend, footer=cap.footer(), scale=cap.scale_text(), bar_ticks=cap.bar_ticks(),
                  readouts=[[cap.readouts(k, f) for f in range(F)] for k in range(n)],
-                 time=[cap.time_text(f) for f in range(F)], notes=[cap.notes(f) for f in range(F)])
+                 time=[cap.time_text(f) for f in range(F)], notes=[cap.notes(f) for f in range(F)],
+                 plot_titles=cap.plot_titles(show))
 
 
 class Captions:
@@ -235,6 +259,28 @@ class Captions:
                 k = self.spec.knee(plan.t_end)
                 out.append(f"time axis logarithmic after {sim_time(k, plan.units, 'physics')}")
         return out
+
+    def plot_titles(self, show) -> dict[str, str]:
+        """The titles of the live plots ``show`` asks for: angle(d, L) and |Omega| / |Omega(0)|
+        ("inset"), the radiated power ("power")."""
+        out = {}
+        if "inset" in show:
+            out["angle"] = "∠(d, L)"
+            out["omega"] = "|Ω| / |Ω₀|" if self.cgs else "|ω| / |ω₀|"
+        if "power" in show:
+            out["power"] = self.power_title()
+        return out
+
+    def power_title(self) -> str:
+        """The title of the radiated-power plot, with its unit: "radio power (W)" (outreach; the
+        band named from the highest rotation rate shown), "P (W)" (physics); in I1/tau0^3 for a
+        dimensionless scene ("radiated power": no frequency is known there)."""
+        if not self.cgs:
+            return f"{'radiated power' if self.register == 'outreach' else 'P'} ({POWER_UNIT['dimensionless']})"
+        if self.register == "physics":
+            return f"P ({POWER_UNIT['cgs']})"
+        w = max(float(np.max(p.omega_mag)) for p in self.plan.panels)
+        return f"{radiation_band(w)} power ({POWER_UNIT['cgs']})"
 
     def footer(self) -> str:
         """The title line: the scene's title, or the body's name."""

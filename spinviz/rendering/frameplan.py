@@ -54,6 +54,8 @@ class Panel:
     angle_dL_deg : (F,) the instantaneous angle between d and L, deg (a body-frame quantity).
     angle_dL_range_deg : (F, 2) the lowest and highest angle over a precession turn, deg, shown
         instead when the phases on screen are re-timed (slowed spin) or not resolved.
+    power : (F,) the radiated (Larmor) power P, erg/s (CGS) or I1/tau0^3 (dimensionless),
+        averaged over the free precession for a symmetric top (``trajectory.radiated_power``).
     """
 
     model: str
@@ -66,6 +68,7 @@ class Panel:
     omega_body: np.ndarray | None = None
     angle_dL_deg: np.ndarray | None = None
     angle_dL_range_deg: np.ndarray | None = None
+    power: np.ndarray | None = None
 
 
 @dataclass

@@ -52,7 +52,8 @@ class Hud:
         return Image.fromarray(strip)
 
     def _inset(self, img):
-        """The inset's frames, bands and curves, drawn at INSET_SUPERSAMPLE x and reduced, then its labels."""
+        """The inset's frames, grid rules, bands and curves, drawn at INSET_SUPERSAMPLE x and reduced,
+        then its labels."""
         inset, ss = self.overlay.inset, INSET_SUPERSAMPLE
         y0, H = inset.y0, inset.height
         canvas = Image.new("RGB", (self.lay.W * ss, H * ss), tuple(self.overlay.background))
@@ -63,6 +64,9 @@ class Hud:
                 bx0, by0, bx1, by1 = geometry[0]
                 d.rectangle([bx0 * ss, (by0 - y0) * ss, bx1 * ss - 1, (by1 - y0) * ss - 1], outline=tuple(color),
                             width=max(1, ss // 2))
+            elif kind == "rule":
+                rx0, ry0, rx1, ry1 = geometry[0]
+                d.line([(rx0 * ss, (ry0 - y0) * ss), (rx1 * ss, (ry1 - y0) * ss)], fill=tuple(color), width=max(1, ss // 2))
             elif kind == "band":
                 xs, lo, hi = geometry
                 d.polygon(list(zip(xs * ss, (hi - y0) * ss)) + list(zip(xs[::-1] * ss, (lo[::-1] - y0) * ss)), fill=color)

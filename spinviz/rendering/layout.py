@@ -1,7 +1,8 @@
 """Where everything goes on a frame: bands that never overlap, in output pixels.
 
 Per panel a heading and a plain subtitle on top, the 3-D view, the panel's numbers under it;
-across the frame an inset of live plots, a legend of the arrows, a time bar, notes on how
+across the frame an inset of live plots (angle(d, L) and |Omega| for "inset", the radiated
+power for "power", side by side in one row), a legend of the arrows, a time bar, notes on how
 time and spin are shown, and the title.  Type scales with the frame height (15 px body text
 at 360 rows, never below 8 px); when a frame is too small for every band, the least needed
 bands are dropped so that the 3-D view keeps at least ``MIN_VIEW`` of the height.
@@ -27,6 +28,13 @@ HEADING_TEXT = 18 / 360
 MIN_BODY_TEXT_PX, MIN_HEADING_TEXT_PX = 8, 9
 # bands dropped in this order until the 3-D view is tall enough (least needed first);
 # "subtitle2" and "notes2" take a band down to one line before it goes
+# the live plots of the inset row, per ``[render].show`` item, left to right; each needs a
+# label column (as wide as PLOT_LABEL_SAMPLE, or its widest tick label), then room for its
+# title and at least PLOT_MIN_WIDTH body-text sizes of plot
+INSET_PLOTS = {"inset": ("angle", "omega"), "power": ("power",)}
+PLOT_LABEL_SAMPLE = "180°"
+PLOT_TICK_SAMPLE = {"power": "10⁻²⁰"}
+PLOT_MIN_WIDTH = 4
 DROP_ORDER = ("title", "subtitle2", "inset", "notes2", "subtitle", "notes", "legend", "timebar", "readouts", "headings")
 
 
@@ -84,7 +92,8 @@ def wrap(text: str, metrics: TextMetrics, width: float, lines: int = 2) -> list[
 @dataclass
 class Row:
     """A band across the frame: ``kind`` ("inset", "legend", "timebar", "notes", "title"),
-    its ``height`` and top ``y`` (px); ``payload``: the legend's chips, the notes' line count."""
+    its ``height`` and top ``y`` (px); ``payload``: the inset's plots (``INSET_PLOTS`` names,
+    left to right), the legend's chips, the notes' line count."""
 
     kind: str
     height: int
@@ -130,8 +139,9 @@ class Layout:
 
 @dataclass
 class _Wants:
-    """What the bands need, measured once: which are wanted, the wrapped subtitles, the lines
-    of numbers and notes, and the legend's chips."""
+    """What the bands need, measured once: which are wanted, the wrapped subtitles (on up to
+    two lines, and on one), the lines of numbers and notes, the legend's chips and the inset's
+    plots."""
 
     wanted: dict
     subtitles: list
@@ -139,6 +149,8 @@ class _Wants:
     notes_rows: int
     legend: list
     sub_lines: int = 2
+    plots: tuple = ()
+    short_subtitles: list = field(default_factory=list)
 
 
 def make_layout(plan, texts, metrics: TextMetrics) -> Layout:
@@ -167,12 +179,12 @@ def make_layout(plan, texts, metrics: TextMetrics) -> Layout:
     steps = DROP_ORDER if want.wanted["inset"] else tuple(x for x in DROP_ORDER if x != "subtitle2")
     for drop in (None, *steps):
         if drop == "subtitle2":
-            want.sub_lines = 1
+            # one line each, re-wrapped so that a cut subtitle ends with "…" (not mid-sentence)
+            want.sub_lines, want.subtitles = 1, want.short_subtitles
         elif drop == "notes2":
             want.notes_rows = 1
         elif drop:
             want.wanted[drop] = False
-        want.subtitles = [s[:want.sub_lines] for s in want.subtitles]
         top, rows, bottom = _bands(want, sizes, pad)
         if H - top - bottom >= (MIN_VIEW_INSET if want.wanted["inset"] else MIN_VIEW) * H:
             break
@@ -199,15 +211,34 @@ def _measure(plan, texts, metrics: TextMetrics, show, W: int, pad: int) -> _Want
     n = len(plan.panels)
     hud_on = "hud" in show
     subtitles = [wrap(texts.subtitles[k], metrics, W // n - 2 * pad) for k in range(n)]
+    short = [wrap(texts.subtitles[k], metrics, W // n - 2 * pad, lines=1) for k in range(n)]
     notes_n = len(texts.notes[0])
     F = plan.frames
     sample = sorted(set(np.linspace(0, F - 1, min(F, 24)).round().astype(int)))
     joined = max(metrics.width(NOTE_SEP.join(texts.notes[f])) for f in sample) if notes_n else 0.0
+    plots = _fitting_plots(texts, metrics, show, W, pad)
     wanted = {"headings": hud_on, "subtitle": hud_on, "readouts": hud_on, "legend": hud_on and bool(texts.legend),
               "timebar": hud_on, "notes": hud_on and notes_n > 0, "title": hud_on and bool(texts.footer),
-              "inset": "inset" in show}
+              "inset": bool(plots)}
     return _Wants(wanted=wanted, subtitles=subtitles, readout_lines=max(len(texts.readouts[k][0]) for k in range(n)),
-                  notes_rows=1 if joined <= W - 2 * pad else notes_n, legend=texts.legend)
+                  notes_rows=1 if joined <= W - 2 * pad else notes_n, legend=texts.legend, plots=plots,
+                  short_subtitles=short)
+
+
+def _fitting_plots(texts, metrics: TextMetrics, show, W: int, pad: int) -> tuple[str, ...]:
+    """The live plots ``show`` asks for that fit side by side across the frame, the rightmost
+    dropped first: each needs its label column, its title (or ``PLOT_MIN_WIDTH`` body-text
+    sizes) and a gap of two pads to the next."""
+    plots = [plot for item, names in INSET_PLOTS.items() if item in show for plot in names]
+    size = metrics.sizes.size
+
+    def need(name: str) -> float:
+        labels = max(metrics.width(PLOT_LABEL_SAMPLE), metrics.width(PLOT_TICK_SAMPLE.get(name, "")))
+        return labels + pad + max(metrics.width(texts.plot_titles.get(name, "")), PLOT_MIN_WIDTH * size)
+
+    while plots and sum(need(p) for p in plots) + 2 * pad * (len(plots) - 1) > W - 2 * pad:
+        plots.pop()
+    return tuple(plots)
 
 
 def _bands(want: _Wants, sizes: TextSizes, pad: int) -> tuple[int, list[Row], int]:
@@ -223,7 +254,7 @@ def _bands(want: _Wants, sizes: TextSizes, pad: int) -> tuple[int, list[Row], in
     bottom += sizes.line * want.readout_lines if wanted["readouts"] else 0
     rows = []
     if wanted["inset"]:
-        rows.append(Row("inset", 3 * sizes.line + pad))
+        rows.append(Row("inset", 3 * sizes.line + pad, payload=want.plots))
     if wanted["legend"]:
         rows.append(Row("legend", sizes.line + pad // 2, payload=want.legend))
     if wanted["timebar"]:

@@ -5,7 +5,8 @@ drawing instructions, for every frame at once: ``Text`` items and ``Fill`` boxes
 static layer (headings, divider, legend chips, title), ``Line`` items whose text changes
 from frame to frame (axis labels, the panels' numbers, the time, the notes), the
 ``TimeBar`` (ticks, and how much of it is filled at each frame) and the ``Inset`` (live plots
-of angle(d, L) and |Omega| against video time, their cursor and dots at each frame).  The
+of angle(d, L), |Omega| and the radiated power against video time, their cursor and dots at
+each frame).  The
 drawing layer only stamps them.
 
 Pure: widths come from the drawing layer's ``layout.TextMetrics``.  Output pixels (x right,
@@ -19,10 +20,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .layout import NOTE_SEP, Layout, TextMetrics
+from .. import units as U
+from .captions import decade
+from .layout import NOTE_SEP, PLOT_LABEL_SAMPLE, Layout, TextMetrics
 from .style import MODEL_COLORS, Palette
 
 WHITE = (255, 255, 255)
+POWER_DECADES = 12      # the power plot's depth: a reduced run's P may fall to 0 (its residual rotation is dark)
 
 
 @dataclass(frozen=True)
@@ -81,20 +85,26 @@ class TimeBar:
 
 @dataclass
 class Inset:
-    """Two small plots across the frame, against video time like the time bar: the angle
-    between d and L (its swing over a turn as a band where the phases are re-timed) and
-    |Omega| / |Omega(0)|, one colour per model, with a cursor and a dot on each curve.
+    """Small live plots side by side across the frame, against video time like the time bar
+    (a log-mapped video has a log time axis here too), one colour per model, with a cursor and
+    a dot on each curve: the angle between d and L (its swing over a turn as a band where the
+    phases are re-timed), |Omega| / |Omega(0)|, and the radiated power P on a log scale.
 
-    y0, height : the row, px; boxes : the two plot boxes; shapes : in drawing order,
-    ("frame", colour, box), ("band", fill colour, xs, lo, hi) the swing band between two rows
-    per column, ("curve", colour, xs, ys) a polyline, all in output pixels; labels : static
-    ``Text``; cursor : (2, F) the cursor's column in each plot; dots : [(colour, plot j,
-    rows (F,))]; dot_radius, px.
+    y0, height : the row, px; plots : the plots' names (``layout.INSET_PLOTS``), left to right;
+    boxes : their boxes, in the same order; scales : per plot ("linear", 0, top) in its unit
+    (deg, ratio) or ("log", lo, hi): decades of P in W (CGS) or I1/tau0^3 (dimensionless), the
+    box's bottom and top rows; shapes : in drawing order, ("frame", colour, box), ("rule",
+    colour, (x0, y0, x1, y1)) a one-pixel grid line, ("band", fill colour, xs, lo, hi) the
+    swing band between two rows per column, ("curve", colour, xs, ys) a polyline, all in output
+    pixels; labels : static ``Text``; cursor : (n, F) the cursor's column in each plot; dots :
+    [(colour, plot j, rows (F,))]; dot_radius, px.
     """
 
     y0: int
     height: int
     boxes: list
+    plots: tuple = ("angle", "omega")
+    scales: list = field(default_factory=list)
     shapes: list = field(default_factory=list)
     labels: list = field(default_factory=list)
     cursor: np.ndarray | None = None
@@ -149,6 +159,7 @@ def make_overlay(plan, layout: Layout, texts, theme, metrics: TextMetrics, axis_
     y0, y1 = layout.divider
     static += [Fill((layout.panel_x(k), y0, layout.panel_x(k) + 1, y1), pal.divider) for k in range(1, layout.n)]
     lines = labels + _readouts(layout, texts, pal)
+    inset_row = None
     for row in layout.rows:
         if row.kind == "legend":
             static += _legend(layout, row, metrics, theme.chips, pal)
@@ -161,7 +172,9 @@ def make_overlay(plan, layout: Layout, texts, theme, metrics: TextMetrics, axis_
         elif row.kind == "notes":
             lines += _note_lines(texts, layout, row, pal)
         elif row.kind == "inset":
-            inset = _inset(plan, layout, row, metrics, pal)
+            inset_row = row
+    if inset_row is not None:                  # after the time bar: a power plot alone lines up with it
+        inset = _inset(plan, texts, layout, inset_row, bar, metrics, pal)
     return Overlay(pal.bg, static, lines, bar, inset, _dynamic_boxes(layout, axis_labels))
 
 
@@ -255,63 +268,137 @@ def _time_bar(plan, texts, lay: Layout, row, metrics: TextMetrics, pal: Palette)
                    cursor=pal.fg, cuts=cuts)
 
 
-def _inset(plan, lay: Layout, row, metrics: TextMetrics, pal: Palette) -> Inset:
-    """The two plots' boxes (a label column left of each), curves and scales -- angles up to
-    the next 15 deg (180 at most), ratios up to max(1, highest) -- and their marks per frame."""
+def _inset(plan, texts, lay: Layout, row, bar: TimeBar | None, metrics: TextMetrics, pal: Palette) -> Inset:
+    """The plots' boxes (a label column left of each), scales, curves and marks per frame.
+
+    Scales: angles up to the next 15 deg (180 at most), ratios up to max(1, highest), the power
+    over whole decades (at most ``POWER_DECADES``, counted down from the highest value).  The
+    plots share the row equally; a power plot alone spans the time bar's columns instead, so
+    its cursor stands right above the bar's."""
+    plots = tuple(row.payload or ("angle", "omega"))
     pad, line = lay.pad, lay.sizes.line
-    gap = 2 * pad
-    label_w = int(metrics.width("180°")) + pad
-    w = (lay.W - 2 * pad - gap) // 2
-    boxes = [(pad + i * (w + gap) + label_w, row.y + line, pad + i * (w + gap) + w, row.y + row.height - pad)
-             for i in range(2)]
-    w0 = float(plan.panels[0].omega_mag[0]) or 1.0
-    series = []
-    for p in plan.panels:
-        band = p.angle_dL_range_deg
-        ang = p.angle_dL_deg if p.angle_dL_deg is not None else (band.mean(axis=1) if band is not None else None)
-        series.append((MODEL_COLORS.get(p.model, pal.fg), ang, band, p.omega_mag / w0))
-    angles = [a for _, a, b, _ in series if a is not None] + [b[:, 1] for _, _, b, _ in series if b is not None]
-    top_deg = max([float(np.max(a)) for a in angles] + [1.0])
-    ymax = (min(180.0, 15.0 * math.ceil(top_deg / 15.0)), max(1.0, float(max(np.max(s[3]) for s in series))))
-    inset = Inset(y0=row.y, height=row.height, boxes=boxes, cursor_color=pal.muted, dot_radius=max(2, lay.H // 180))
-    _inset_marks(inset, plan.frames, series, ymax, pal)
-    names = ("∠(d, L)", "|Ω| / |Ω₀|") if plan.units == "cgs" else ("∠(d, L)", "|ω| / |ω₀|")
-    tops = (f"{ymax[0]:.0f}°", f"{ymax[1]:g}")
-    for (bx0, by0, _, by1), name, top in zip(boxes, names, tops):
-        inset.labels += [Text(name, (bx0, row.y), pal.fg), Text(top, (bx0 - pad // 2, by0), pal.muted, anchor="ra"),
-                         Text("0", (bx0 - pad // 2, by1), pal.muted, anchor="rd")]
-    # which colour is which model, right-aligned on the title line of the second plot
-    x = lay.W - pad
-    for p in reversed(plan.panels):
-        inset.labels.append(Text(p.model, (x, row.y), MODEL_COLORS.get(p.model, pal.fg), anchor="ra"))
-        x -= int(metrics.width(p.model)) + lay.sizes.size
+    y0, y1 = row.y + line, row.y + row.height - pad
+    series = {name: _plot_series(name, plan, pal) for name in plots}
+    scales = {name: _plot_scale(name, series[name]) for name in plots}
+    ticks = {name: _scale_labels(name, scales[name]) for name in plots}
+    # a label column as wide as "180°" (angle, ratio) or the widest decade (power)
+    label_w = {name: int(max(metrics.width(t) for t in (*ticks[name], PLOT_LABEL_SAMPLE))) + pad for name in plots}
+    if plots == ("power",) and bar is not None and label_w["power"] <= bar.x0 - pad:
+        boxes = [(bar.x0, y0, bar.x1, y1)]
+    else:
+        gap = 2 * pad
+        w = (lay.W - 2 * pad - (len(plots) - 1) * gap) // len(plots)
+        boxes = [(pad + i * (w + gap) + label_w[name], y0, pad + i * (w + gap) + w, y1) for i, name in enumerate(plots)]
+    inset = Inset(y0=row.y, height=row.height, boxes=boxes, plots=plots, scales=[scales[n] for n in plots],
+                  cursor_color=pal.muted, dot_radius=max(2, lay.H // 180))
+    _inset_marks(inset, plan.frames, [series[n] for n in plots], texts, pal)
+    titles = texts.plot_titles
+    for (bx0, by0, _, by1), name in zip(boxes, plots):
+        top, bottom = ticks[name]
+        inset.labels += [Text(titles[name], (bx0, row.y), pal.fg), Text(top, (bx0 - pad // 2, by0), pal.muted, anchor="ra"),
+                         Text(bottom, (bx0 - pad // 2, by1), pal.muted, anchor="rd")]
+    # which colour is which model, right-aligned on the title line of the last plot, where it
+    # clears that plot's title (the panels' headings say it in the same colours anyway)
+    names = [(p.model, MODEL_COLORS.get(p.model, pal.fg)) for p in plan.panels]
+    width = sum(metrics.width(m) for m, _ in names) + lay.sizes.size * (len(names) - 1)
+    x = boxes[-1][2]
+    if x - width >= boxes[-1][0] + metrics.width(titles[plots[-1]]) + lay.sizes.size:
+        for model, color in reversed(names):
+            inset.labels.append(Text(model, (x, row.y), color, anchor="ra"))
+            x -= int(metrics.width(model)) + lay.sizes.size
     return inset
 
 
-def _inset_marks(inset: Inset, F: int, series, ymax, pal: Palette) -> None:
-    """The inset's bands and curves in pixels, and its cursor and dots at every frame."""
+def _plot_series(name: str, plan, pal: Palette) -> list:
+    """Per panel (colour, values (F,) in the plot's unit, swing band (F, 2) or None): degrees,
+    |Omega| / |Omega(0)| of the first panel, or P in W (CGS; the plan keeps erg/s) or I1/tau0^3."""
+    out = []
+    w0 = float(plan.panels[0].omega_mag[0]) or 1.0
+    to_display = U.ERG_PER_S_IN_W if plan.units == "cgs" else 1.0
+    for p in plan.panels:
+        color = MODEL_COLORS.get(p.model, pal.fg)
+        if name == "angle":
+            band = p.angle_dL_range_deg
+            ang = p.angle_dL_deg if p.angle_dL_deg is not None else (band.mean(axis=1) if band is not None else None)
+            out.append((color, ang, band))
+        elif name == "omega":
+            out.append((color, p.omega_mag / w0, None))
+        else:
+            out.append((color, None if p.power is None else np.asarray(p.power, dtype=float) * to_display, None))
+    return out
+
+
+def _plot_scale(name: str, series) -> tuple:
+    """("linear", 0, top) or ("log", lo, hi) (decades) for a plot's values."""
+    if name == "angle":
+        angles = [v for _, v, _ in series if v is not None] + [b[:, 1] for _, _, b in series if b is not None]
+        top_deg = max([float(np.max(a)) for a in angles] + [1.0])
+        return ("linear", 0.0, min(180.0, 15.0 * math.ceil(top_deg / 15.0)))
+    if name == "omega":
+        return ("linear", 0.0, max(1.0, max(float(np.max(v)) for _, v, _ in series)))
+    values = np.concatenate([v for _, v, _ in series if v is not None] or [np.zeros(0)])
+    values = values[np.isfinite(values) & (values > 0.0)]
+    if values.size == 0:                    # nothing radiates (a free top): an empty decade
+        return ("log", -1, 0)
+    hi = math.ceil(math.log10(float(values.max())))
+    lo = max(math.floor(math.log10(float(values.min()))), hi - POWER_DECADES)
+    return ("log", min(lo, hi - 1), hi)
+
+
+def _scale_labels(name: str, scale) -> tuple[str, str]:
+    """The (top, bottom) tick labels of a plot's scale: "45°" and "0" for angles, "1" and "0"
+    for ratios, decades ("10⁻¹⁶", "10⁻²³") for the power."""
+    kind, lo, hi = scale
+    if kind == "log":
+        return decade(hi), decade(lo)
+    return (f"{hi:.0f}°" if name == "angle" else f"{hi:g}"), "0"
+
+
+def _inset_marks(inset: Inset, F: int, series, texts, pal: Palette) -> None:
+    """The inset's frames, grid rules, bands and curves in pixels, and its cursor and dots at
+    every frame."""
     x = np.arange(F) / max(1, F - 1)
+    faint = tuple(int(c + 0.6 * (b - c)) for c, b in zip(pal.divider, pal.bg))
 
     def xy(j, xs, ys):
         """Pixel columns and rows of points (video fraction, value in plot j's unit) in plot j."""
         x0, y0, x1, y1 = inset.boxes[j]
-        return x0 + xs * (x1 - x0 - 1), y1 - 1 - np.clip(ys / ymax[j], 0.0, 1.0) * (y1 - y0 - 1)
+        kind, lo, hi = inset.scales[j]
+        if kind == "log":
+            with np.errstate(divide="ignore", invalid="ignore"):
+                frac = (np.log10(np.where(ys > 0.0, ys, np.nan)) - lo) / (hi - lo)
+            frac = np.nan_to_num(frac, nan=0.0)      # P = 0 (no radiation) sits on the bottom edge
+        else:
+            frac = ys / hi
+        return x0 + xs * (x1 - x0 - 1), y1 - 1 - np.clip(frac, 0.0, 1.0) * (y1 - y0 - 1)
 
     cursor = []
     for j, box in enumerate(inset.boxes):
         inset.shapes.append(("frame", pal.divider, box))
-        cursor.append([int(round(box[0] + x[f] * (box[2] - box[0] - 1))) for f in range(F)])
-        for color, ang, band, ratio in series:
-            if j == 0 and band is not None:
-                xs, lo = xy(j, x, band[:, 0])
-                _, hi = xy(j, x, band[:, 1])
-                inset.shapes.append(("band", tuple(int(c + 0.75 * (b - c)) for c, b in zip(color, pal.bg)), xs, lo, hi))
-            y = ang if j == 0 else ratio
+        x0, y0, x1, y1 = box
+        cursor.append([int(round(x0 + x[f] * (x1 - x0 - 1))) for f in range(F)])
+        kind, lo, hi = inset.scales[j]
+        if kind == "log":
+            # one rule per decade (where they stay 3 px apart), and one at each of the time bar's ticks
+            if (y1 - y0 - 1) / (hi - lo) >= 3.0:
+                for e in range(lo + 1, hi):
+                    yr = int(round(xy(j, np.zeros(1), np.array([10.0 ** e]))[1][0]))
+                    inset.shapes.append(("rule", faint, (x0 + 1, yr, x1 - 2, yr)))
+            for pos, _ in texts.bar_ticks:
+                col = int(round(x0 + pos * (x1 - x0 - 1)))
+                if x0 < col < x1 - 1:
+                    inset.shapes.append(("rule", faint, (col, y0 + 1, col, y1 - 2)))
+        for color, y, band in series[j]:
+            if band is not None:
+                xs, lo_rows = xy(j, x, band[:, 0])
+                _, hi_rows = xy(j, x, band[:, 1])
+                inset.shapes.append(("band", tuple(int(c + 0.75 * (b - c)) for c, b in zip(color, pal.bg)), xs,
+                                     lo_rows, hi_rows))
             if y is None:
                 continue
             inset.shapes.append(("curve", color) + xy(j, x, y))
-            rows = [int(round(xy(j, x[f:f + 1], y[f:f + 1])[1][0])) for f in range(F)]
-            inset.dots.append((color, j, np.array(rows)))
+            rows = np.rint(xy(j, x, y)[1]).astype(int)
+            inset.dots.append((color, j, rows))
     inset.cursor = np.array(cursor)
 
 

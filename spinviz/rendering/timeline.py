@@ -30,6 +30,7 @@ import numpy as np
 
 from .. import rotations as R
 from ..physics.free_top import pose_about_L
+from ..trajectory import radiated_power
 from .frameplan import FramePlan, Panel, ShapeInfo
 from .spec import RenderSpec
 
@@ -180,6 +181,11 @@ def plan_frames(spec: RenderSpec, trajs: list[Trajectory], frames: int | None = 
              float(np.linalg.norm(np.asarray(body.inertia, dtype=float) * ref)) or 1.0)
     panels = [_panel(spec, s, motion, body, scale, exact_angle=mode == "true" and resolved)
               for s, motion in zip(samples, shown)]
+    if "power" in spec.show:
+        # once per trajectory, here in the parent (the workers only draw); one call per run,
+        # since two panels may show the same model
+        for panel, s in zip(panels, samples):
+            panel.power = radiated_power([s])[s.model]
     return FramePlan(
         spec=spec, video_t=video_t, sim_t=sim_t, panels=panels, units=body.units, body_name=body.name,
         shape=ShapeInfo.of(body.shape), d_body=np.asarray(body.dipole_direction, dtype=float), spin_mode=mode,

@@ -1,0 +1,320 @@
+"""The tables of a scene file: ``[body]``, ``[initial]``, ``[simulation]``, ``[observe]`` and
+the top level (``[render]`` is ``inputs.render.RenderSpec``).
+
+Each table is a request class whose fields are its TOML keys; ``spinviz.scene.parse_scene``
+validates each table with it (``toml.table``: errors name the file, table and key) and then
+checks what joins tables -- units, the spin scale, the horizon -- by building one
+``SimulationRequest`` per model, the very object ``spinviz.simulate`` checks its arguments
+with.  Lengths are in nm, densities g/cm^3, dipoles D (``_debye``) or statC cm, angles rad
+unless the key ends in ``_deg``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import PlainValidator, model_validator
+
+from .. import rotations as R
+from .. import units as U
+from ..errors import SpecError, brief
+from ..physics import bodies as B
+from ..physics import presets as P
+from .base import Line, Positive, Real, Text, between, check_vector, one_line, request, wrong_type
+from .render import MAX_TITLE
+from .simulation import MODELS, Atol, Method, Quaternion, Rtol, Samples, Vector3
+from .toml import Table
+
+# Physical ranges of the CGS inputs: wide enough for any nanoparticle and for a metre-sized
+# crystal, narrow enough that every derived quantity (I ~ rho L^5, tau0 ~ d^2/I) is a float64.
+LENGTH_NM = (0.1, 1e9, "from an atom to a metre")
+DENSITY = (1e-3, 1e3, "g/cm^3")
+DIPOLE_DEBYE = (1e-6, 1e30, "D")
+ASPECT = (1e-3, 1e3, "L/D")
+DISTANCE_CM = (1e-4, 1e30, "from a micron to a megaparsec")
+PRESET_NAMES = tuple(P.PRESETS) + ("dast_box",)
+
+Length = Annotated[Real, between(*LENGTH_NM)]
+Density = Annotated[Real, between(*DENSITY)]
+
+
+def _number_or_vector(v):
+    """A rod's dipole is one number (D); a box's or a custom body's a body-frame vector."""
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return check_vector(v, 3)
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise wrong_type(f"must be a number (a rod) or a list of 3 numbers, got {brief(v)}")
+    if not math.isfinite(v):
+        raise ValueError(f"must be finite, got {v}")
+    return float(v)
+
+
+def _title(v):
+    v = one_line(v)
+    if len(v) > MAX_TITLE:
+        raise ValueError(f"must be at most {MAX_TITLE} characters, got {len(v)}")
+    return v
+
+
+def _models(v):
+    if not isinstance(v, list | tuple) or not 1 <= len(v) <= 2 or not all(isinstance(m, str) for m in v):
+        raise wrong_type(f"must be a list of one or two model names, got {brief(v)}")
+    for m in v:
+        if m not in MODELS:
+            raise ValueError(f"unknown model {brief(m)}; valid: {', '.join(MODELS)}")
+    if len(set(v)) != len(v):
+        raise ValueError(f"{v[0]!r} named twice")
+    return tuple(v)
+
+
+def one_of(table, *keys: str) -> str | None:
+    """The one of ``keys`` that is set (None if none); ``SpecError`` if more than one is."""
+    present = [k for k in keys if getattr(table, k) is not None]
+    if len(present) > 1:
+        raise SpecError(present[1], f"give only one of {', '.join(keys)}")
+    return present[0] if present else None
+
+
+# --- [body] --------------------------------------------------------------------------------
+BODY_FORMS = ("preset", "shape", "delta", "inertia")
+_FORM_KEYS = {            # which keys each way of giving a body takes (besides "name")
+    "cellulose_rod": {"preset", "density"},
+    "dast_cube": {"preset", "density", "a_nm"},
+    "dast_family1": {"preset", "density", "a_nm", "c_nm"},
+    "dast_box": {"preset", "density", "a_nm", "b_nm", "c_nm"},
+    "rod": {"shape", "density", "length_nm", "diameter_nm", "aspect", "dipole_debye", "chi", "chi_deg"},
+    "box": {"shape", "density", "a_nm", "b_nm", "c_nm", "dipole_debye"},
+    "delta": {"delta", "chi", "chi_deg"},
+    "inertia": {"inertia", "dipole", "dipole_debye"},
+}
+
+
+@request
+class BodyTable:
+    """``[body]``: a preset, a shape (CGS), a dimensionless symmetric top (delta, chi) or any
+    principal moments and dipole (inertia, dipole; ``units`` from ``[simulation]``)."""
+
+    preset: Literal["cellulose_rod", "dast_cube", "dast_family1", "dast_box"] | None = None
+    shape: Literal["rod", "box"] | None = None
+    delta: Real | None = None
+    chi: Real | None = None
+    chi_deg: Real | None = None
+    inertia: Vector3 | None = None
+    dipole: Vector3 | None = None
+    dipole_debye: Annotated[float | tuple, PlainValidator(_number_or_vector)] | None = None
+    a_nm: Length | None = None
+    b_nm: Length | None = None
+    c_nm: Length | None = None
+    length_nm: Length | None = None
+    diameter_nm: Length | None = None
+    aspect: Annotated[Real, between(*ASPECT)] | None = None
+    density: Density | None = None
+    name: Line | None = None
+
+    @model_validator(mode="after")
+    def _form(self):
+        form = one_of(self, *BODY_FORMS)
+        if form is None:
+            raise SpecError("preset", "missing value: give preset, shape, delta (with chi) or inertia (with dipole)")
+        if self.chi is not None and self.chi_deg is not None:
+            raise SpecError("chi", "give chi (rad) or chi_deg, not both")
+        kind = self.preset or self.shape or form
+        allowed = _FORM_KEYS[kind] | {"name"}
+        for k in type(self).__pydantic_fields__:
+            if getattr(self, k) is not None and k not in allowed:
+                raise SpecError(k, f"unknown key for a body given by {form} = {kind!r}" if form in ("preset", "shape")
+                                else f"unknown key for a body given by {form}")
+        return self
+
+    @property
+    def form(self) -> str:
+        return next(k for k in BODY_FORMS if getattr(self, k) is not None)
+
+    def _need(self, *keys: str):
+        for k in keys:
+            if getattr(self, k) is None:
+                raise SpecError(k, "missing value")
+        return [getattr(self, k) for k in keys]
+
+    def _chi(self, default=None) -> float:
+        if self.chi_deg is not None:
+            return float(U.deg_to_rad(self.chi_deg))
+        if self.chi is None and default is None:
+            raise SpecError("chi", "missing value")
+        return self.chi if self.chi is not None else default
+
+    def build(self, units_hint: str | None) -> B.Body:
+        """The body (``SpecError`` naming the key when it is not physical)."""
+        try:
+            return self._build(units_hint)
+        except B.BodyError as e:
+            raise SpecError(e.key, e.reason) from None
+
+    def _build(self, units_hint):
+        form = self.form
+        if form == "preset":
+            name = self.preset
+            if name == "cellulose_rod":
+                return P.cellulose_rod(density=self.density)
+            if name == "dast_cube":
+                return P.dast_cube(self.a_nm if self.a_nm is not None else 100.0, density=self.density)
+            if name == "dast_family1":
+                return P.dast_family1(self.a_nm if self.a_nm is not None else 100.0,
+                                      self.c_nm if self.c_nm is not None else 50.0, density=self.density)
+            return P.dast_box(*self._need("a_nm", "b_nm", "c_nm"), density=self.density)
+        if form == "shape":
+            (density,) = self._need("density")
+            name = self.name or self.shape
+            if self.shape == "rod":
+                (length,) = self._need("length_nm")
+                if (self.diameter_nm is None) == (self.aspect is None):
+                    raise SpecError("diameter_nm", "give diameter_nm or aspect (L/D), exactly one")
+                diameter = self.diameter_nm * U.NM if self.diameter_nm is not None else length * U.NM / self.aspect
+                (d,) = self._need("dipole_debye")
+                if isinstance(d, tuple):
+                    raise SpecError("dipole_debye", f"a rod's dipole is one number (D, at chi from the axis), got {brief(d)}")
+                if not DIPOLE_DEBYE[0] <= d <= DIPOLE_DEBYE[1]:
+                    raise SpecError("dipole_debye", f"must lie in [{DIPOLE_DEBYE[0]:g}, {DIPOLE_DEBYE[1]:g}] (D), got {d:g}")
+                return B.rod(length * U.NM, diameter, density, d * U.DEBYE, self._chi(0.0), name=name)
+            a, b, c = self._need("a_nm", "b_nm", "c_nm")
+            (d,) = self._need("dipole_debye")
+            if not isinstance(d, tuple):
+                raise SpecError("dipole_debye", f"a box's dipole is [d1, d2, d3] (D, body frame), got {d:g}")
+            size = max(abs(x) for x in d)
+            if not DIPOLE_DEBYE[0] <= size <= DIPOLE_DEBYE[1]:
+                raise SpecError("dipole_debye", f"the largest component must lie in [{DIPOLE_DEBYE[0]:g}, "
+                                                f"{DIPOLE_DEBYE[1]:g}] D, got {size:g}")
+            return B.box(a * U.NM, b * U.NM, c * U.NM, density, np.array(d) * U.DEBYE, name=name)
+        if form == "delta":
+            return B.symmetric_top(self.delta, self._chi(), name=self.name or "symmetric top")
+        units = units_hint or "dimensionless"
+        if units == "cgs":
+            key = one_of(self, "dipole_debye", "dipole")
+            if key is None:
+                raise SpecError("dipole_debye", "missing value (statC cm as dipole, or Debye as dipole_debye)")
+            d = getattr(self, key)
+            if not isinstance(d, tuple):
+                raise SpecError(key, f"must be a list of 3 numbers, got {d:g}")
+            dipole = np.array(d) * (U.DEBYE if key == "dipole_debye" else 1.0)
+        else:
+            if self.dipole_debye is not None:
+                raise SpecError("dipole_debye", "a dimensionless body's dipole is a direction: give dipole")
+            dipole = np.array(self._need("dipole")[0])
+        return B.custom(np.array(self.inertia), dipole, units=units, name=self.name or "custom body")
+
+
+# --- [initial] -----------------------------------------------------------------------------
+@request
+class InitialTable:
+    """``[initial]``: omega (body frame; rad/s or 1/tau0) and the orientation: euler_zxz (rad),
+    euler_zxz_deg or quaternion (w, x, y, z); identity by default."""
+
+    omega: Vector3
+    euler_zxz: Vector3 | None = None
+    euler_zxz_deg: Vector3 | None = None
+    quaternion: Quaternion | None = None
+
+    @model_validator(mode="after")
+    def _orientation(self):
+        one_of(self, "euler_zxz", "euler_zxz_deg", "quaternion")
+        if self.quaternion is not None and not math.hypot(*self.quaternion) > 0.0:
+            raise SpecError("quaternion", "must not be zero")
+        return self
+
+    @property
+    def orientation_key(self) -> str:
+        return one_of(self, "euler_zxz", "euler_zxz_deg", "quaternion") or "quaternion"
+
+    def q0(self) -> np.ndarray:
+        """The initial orientation, (w, x, y, z), unit norm."""
+        if self.euler_zxz is not None:
+            return R.quat_from_euler_zxz(np.array(self.euler_zxz))
+        if self.euler_zxz_deg is not None:
+            return R.quat_from_euler_zxz(U.deg_to_rad(np.array(self.euler_zxz_deg)))
+        if self.quaternion is not None:
+            return R.normalize(np.array(self.quaternion))
+        return np.array([1.0, 0.0, 0.0, 0.0])
+
+
+# --- [simulation] --------------------------------------------------------------------------
+HORIZON_KEYS = ("t_end", "t_end_T", "t_end_Theta")
+
+
+@request
+class SimulationTable:
+    """``[simulation]``: model(s), horizon (t_end in the body's time unit, or t_end_T /
+    t_end_Theta in the paper's T or Theta), samples, units and the integrator settings."""
+
+    samples: Samples
+    model: Literal["reduced", "truncated", "free"] | None = None
+    models: Annotated[tuple, PlainValidator(_models)] | None = None
+    t_end: Positive | None = None
+    t_end_T: Positive | None = None
+    t_end_Theta: Positive | None = None
+    units: Literal["cgs", "dimensionless"] | None = None
+    method: Method = "auto"
+    rtol: Rtol = 1e-10
+    atol: Atol = 1e-12
+    step: Positive | None = None
+
+    @model_validator(mode="after")
+    def _choices(self):
+        if one_of(self, "model", "models") is None:
+            raise SpecError("model", f"missing value; valid: {', '.join(MODELS)}")
+        if one_of(self, *HORIZON_KEYS) is None:
+            raise SpecError("t_end", "missing value (or give t_end_T / t_end_Theta)")
+        return self
+
+    @property
+    def model_names(self) -> tuple[str, ...]:
+        return self.models if self.models is not None else (self.model,)
+
+    @property
+    def horizon_key(self) -> str:
+        return one_of(self, *HORIZON_KEYS)
+
+
+# --- [observe] -----------------------------------------------------------------------------
+@request
+class ObserveTable:
+    """``[observe]``: how a detector watches the scene (``spinviz observe``, ``listen``) -- the
+    same keys are the command's options (``--distance-cm`` ...)."""
+
+    t_end: Positive | None = None
+    t_end_T: Positive | None = None
+    t_end_Theta: Positive | None = None
+    line_of_sight: Vector3 | None = None
+    distance_cm: Annotated[Real, between(*DISTANCE_CM)] = 1.0
+    power_factor: Annotated[Real, between(1.0001, 1e6, "a ratio above 1")] = 2.0
+    frequency_resolution: Annotated[Real, between(1e-12, 0.5, "a relative difference")] = 0.01
+    polarization_deg: Annotated[Real, between(0.01, 89.0, "degrees")] = 5.0
+
+    @model_validator(mode="after")
+    def _check(self):
+        one_of(self, *HORIZON_KEYS)
+        if self.line_of_sight is not None and not math.hypot(*self.line_of_sight) > 0.0:
+            raise SpecError("line_of_sight", "must not be zero")
+        return self
+
+    @property
+    def horizon_key(self) -> str | None:
+        return one_of(self, *HORIZON_KEYS)
+
+
+# --- the file ------------------------------------------------------------------------------
+@request
+class SceneFile:
+    """The top level of a scene file: its tables and free text."""
+
+    body: Table
+    initial: Table
+    simulation: Table
+    title: Annotated[str, PlainValidator(_title)] | None = None
+    description: Text | None = None
+    render: Table | None = None
+    observe: Table | None = None
+
+
+SUBTABLES = ("body", "initial", "simulation", "render", "observe")

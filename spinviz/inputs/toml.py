@@ -1,0 +1,85 @@
+"""TOML at the boundary: reading a file safely, and validating one of its tables as a request
+class, with errors naming the file, the table and the key."""
+
+from __future__ import annotations
+
+import os
+import stat
+import tomllib
+from typing import Annotated
+
+from pydantic import PlainValidator
+
+from ..errors import SceneError, SpecError
+from .base import terms, wrong_type
+
+MAX_FILE_BYTES = 16_000_000     # a scene is a few hundred bytes; this bounds what a bad path can make us read
+
+
+def _table(v):
+    if not isinstance(v, dict):
+        raise wrong_type(f"must be a table, got {type(v).__name__}")
+    return v
+
+
+Table = Annotated[dict, PlainValidator(_table)]     # a sub-table, validated later by its own class
+
+
+def key_name(table: str, key: str) -> str:
+    """How a key is named in messages: ``[simulation].samples``, ``[grid.delta].cells``, ``title``."""
+    if not key:
+        return f"[{table}]" if table else "(file)"
+    return f"[{table}].{key}" if table else key
+
+
+def table(cls, data, name: str, path: str, subtables: tuple = ()):
+    """``data`` (a parsed TOML table; ``name`` "" for the top level) validated as ``cls``.
+
+    ``subtables``: the fields of ``cls`` that are themselves tables, so that a missing or
+    mistyped one is named ``[name]`` ("missing table").  Raises ``SceneError(path, key, reason)``."""
+    if not isinstance(data, dict):
+        raise SceneError(path, key_name(name, ""), f"must be a table, got {type(data).__name__}")
+    try:
+        with terms("key"):
+            return cls(**data)
+    except SpecError as e:
+        head = e.key.split(".")[0]
+        if head in subtables:
+            full = f"{name}.{head}" if name else head
+            reason = "missing table" if e.reason == "missing value" else e.reason
+            raise SceneError(path, f"[{full}]", reason) from None
+        raise SceneError(path, key_name(name, e.key), e.reason) from None
+
+
+def read_toml(path, kind: str = "scene") -> dict:
+    """The parsed TOML document at ``path``; ``SceneError(path, "(file)", reason)`` for anything
+    that is not a readable regular UTF-8 TOML file of sensible size (a FIFO or a device would
+    block or never end; nesting thousands deep would exhaust the parser's recursion)."""
+    path = os.fspath(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)         # never blocks on a FIFO
+    except FileNotFoundError:
+        raise SceneError(path, "(file)", "no such file") from None
+    except (OSError, ValueError) as e:                           # ValueError: an embedded NUL
+        raise SceneError(path, "(file)", getattr(e, "strerror", None) or str(e)) from None
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            raise SceneError(path, "(file)", f"is a directory, not a {kind} file")
+        if not stat.S_ISREG(st.st_mode):
+            raise SceneError(path, "(file)", f"not a regular file (a pipe, device or socket); a {kind} is a TOML file")
+        if st.st_size > MAX_FILE_BYTES:
+            raise SceneError(path, "(file)", f"{st.st_size} bytes is too large for a {kind} file (limit {MAX_FILE_BYTES})")
+        raw = os.read(fd, MAX_FILE_BYTES + 1)
+    except OSError as e:
+        raise SceneError(path, "(file)", e.strerror or str(e)) from None
+    finally:
+        os.close(fd)
+    try:
+        return tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise SceneError(path, "(file)", f"not a text (UTF-8) file; a {kind} is TOML") from None
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(path, "(file)", f"invalid TOML: {e}") from None
+    except RecursionError:
+        raise SceneError(path, "(file)", f"values nested too deeply to be a {kind}") from None

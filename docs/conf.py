@@ -36,6 +36,9 @@ extensions = [
     "myst_parser",
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
+    # numpydoc sections (Parameters / Returns / Raises, with a line of dashes) become field
+    # lists; docstrings without sections keep the "name : meaning" lines handled below.
+    "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
     "sphinx.ext.viewcode",
     "sphinx_copybutton",
@@ -71,6 +74,9 @@ autodoc_default_options = {"members": True, "show-inheritance": True, "member-or
 autodoc_typehints = "signature"
 autodoc_preserve_defaults = True      # the signature shows ``method='auto'``, not a repr
 add_module_names = False
+napoleon_google_docstring = False     # only numpydoc sections: a line ending in ":" stays prose
+napoleon_numpy_docstring = True
+napoleon_use_rtype = False            # "Returns: (type) -- meaning" on one line, as the docstrings read
 # Heavy optional stacks are installed for the docs build (the "docs" extra pulls the render
 # and ensemble extras), so nothing is mocked: what the reference shows is what imports.
 

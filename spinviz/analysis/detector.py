@@ -33,8 +33,6 @@ from .. import units as U
 from ..physics import radiation as RA
 from ..trajectory import Trajectory
 
-MIN_LINE_SHARE = 1e-12        # lines weaker than this share of a sample's strongest carry nothing shown
-
 
 @dataclass
 class Detection:

@@ -30,7 +30,6 @@ import numpy as np
 
 from .. import __version__
 from .. import units as U
-from ..atomic import atomic_path
 from .detector import Detection
 
 RATE = 44_100
@@ -208,12 +207,6 @@ def wav_bytes(samples: np.ndarray, rate: int, title: str, mapping: Mapping) -> b
     data = pcm.tobytes()
     chunks = b"fmt " + struct.pack("<I", len(fmt)) + fmt + info + b"data" + struct.pack("<I", len(data)) + data
     return b"RIFF" + struct.pack("<I", 4 + len(chunks)) + b"WAVE" + chunks
-
-
-def write_wav(path, samples, rate: int, title: str, mapping: Mapping) -> None:
-    """The WAV of ``wav_bytes``, written atomically."""
-    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
-        fh.write(wav_bytes(samples, rate, title, mapping))
 
 
 def read_info(path) -> dict:

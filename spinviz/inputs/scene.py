@@ -34,7 +34,6 @@ DENSITY = (1e-3, 1e3, "g/cm^3")
 DIPOLE_DEBYE = (1e-6, 1e30, "D")
 ASPECT = (1e-3, 1e3, "L/D")
 DISTANCE_CM = (1e-4, 1e30, "from a micron to a megaparsec")
-PRESET_NAMES = tuple(P.PRESETS) + ("dast_box",)
 
 Length = Annotated[Real, between(*LENGTH_NM)]
 Density = Annotated[Real, between(*DENSITY)]

@@ -174,19 +174,20 @@ def initial_orientation(q0=None, euler_zxz0=None):
     return R.quat_from_euler_zxz(euler), euler
 
 
-def truncated_margin(system: System, omega) -> float:
-    """1 + (g x omega).J^-1 g for the dimensionless (tau0 = 1) or spin-unit system: (2.5) is
+def truncated_margin(system: System, omega_body) -> float:
+    """1 + (g x omega).J^-1 g at the body-frame state ``omega_body`` (3,) of the dimensionless
+    (tau0 = 1) or spin-unit system: (2.5) is
     linear in Omega_dot with the factor J + g (g x Omega)^T, whose determinant is det J times
     this.  1 at rest and 1 + O(tau0 |Omega|) for any real particle."""
-    w = np.asarray(omega, dtype=float)
+    w = np.asarray(omega_body, dtype=float)
     return float(truncated_singularity(w[0], w[1], w[2], system.inertia, system.coupling))
 
 
-def check_truncated_solvable(system: System, omega, margin: float = 1e-12) -> None:
+def check_truncated_solvable(system: System, omega_body, margin: float = 1e-12) -> None:
     """Refuse a truncated start where ``truncated_margin`` <= ``margin``: such a state is cut
     off from rest by the singular surface, and runs started there fall into it (the stress
     case shows one)."""
-    den = truncated_margin(system, omega)
+    den = truncated_margin(system, omega_body)
     if not den > margin:
         raise SimulationError(
             f"the truncated equation (2.5) is singular at the initial state: 1 + (g x Omega).J^-1 g = {den:.3g} "
@@ -271,7 +272,7 @@ def _check_finite(sol: Solution) -> None:
 class Run:
     """One run of ``solve_many``, in the dimensionless units (4.1) of its request.
 
-    tau : (N,) the output grid; omega : (N, 3) body frame, NaN after ``reached`` samples;
+    tau : (N,) the output grid; omega (``omega_body``) : (N, 3) body frame, NaN after ``reached`` samples;
     status : how it ended (``integrators.status``; OK = 0); reason : one line when not OK;
     t_stop : where it stopped (tau); nsteps : integrator steps (a batch's, for batched runs);
     seconds : wall time of its share of the work.
@@ -285,6 +286,11 @@ class Run:
     nsteps: int
     seconds: float
     reason: str = ""
+
+    @property
+    def omega_body(self) -> np.ndarray:
+        """Body-frame omega, shape (N, 3), 1/tau0: the documented name of the field ``omega``."""
+        return self.omega
 
 
 SINGULAR_START = ST.SINGULAR_START

@@ -121,8 +121,8 @@ def detect(traj: Trajectory, line_of_sight=None, distance_cm: float = 1.0, M: in
     e, psr = lines.toward(n)
     stokes = lines.stokes(n)
     to_hz = 1.0 / (2.0 * math.pi * tau0)                 # rad per tau0 -> Hz (cycles per tau0 if dimensionless)
-    freq = np.abs(lines.omega) * to_hz
-    e = np.where((lines.omega < 0)[..., None], np.conj(e), e)
+    freq = np.abs(lines.angular_frequency) * to_hz
+    e = np.where((lines.angular_frequency < 0)[..., None], np.conj(e), e)
     line_power_sr = U.radiation_from_dimensionless(psr, "power_per_sr", I1, tau0)
     sig = math.sqrt(I1 / tau0**3) if cgs else 1.0        # g-unit signal -> (erg/s)^1/2
     to_field = (math.sqrt(1.5 / U.C_LIGHT) / distance_cm * U.STATV_PER_CM_IN_V_PER_M) if cgs else 1.0

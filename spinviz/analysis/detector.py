@@ -69,18 +69,22 @@ class Detection:
 
     @property
     def freq_unit(self) -> str:
+        """Unit of ``freq``: Hz (CGS) or cycles per tau0 (dimensionless)."""
         return "Hz" if self.units == "cgs" else "1/tau0"
 
     @property
     def power_unit(self) -> str:
+        """Unit of the powers: erg/s (CGS) or I1/tau0^3 (``units.RADIATION_UNITS``)."""
         return U.radiation_unit("power", self.units)
 
     @property
     def power_sr_unit(self) -> str:
+        """Unit of the powers per solid angle: erg/s/sr (CGS) or I1/tau0^3/sr."""
         return U.radiation_unit("power_per_sr", self.units)
 
     @property
     def field_unit(self) -> str:
+        """Unit of the field amplitudes: V/m at ``distance_cm`` (CGS) or (I1/tau0^3)^1/2."""
         return "V/m" if self.units == "cgs" else "(I1/tau0^3)^1/2"
 
     def record(self, i: int) -> dict:

@@ -129,6 +129,8 @@ class BodyTable:
 
     @property
     def form(self) -> str:
+        """Which way the table gives the body: the first of ``BODY_FORMS`` it sets ("preset",
+        "shape", "delta" or "inertia")."""
         return next(k for k in BODY_FORMS if getattr(self, k) is not None)
 
     def _need(self, *keys: str):
@@ -224,6 +226,9 @@ class InitialTable:
 
     @property
     def orientation_key(self) -> str:
+        """The key the initial orientation was given by ("euler_zxz", "euler_zxz_deg" or
+        "quaternion", the default).
+        """
         return one_of(self, "euler_zxz", "euler_zxz_deg", "quaternion") or "quaternion"
 
     def q0(self) -> np.ndarray:
@@ -268,10 +273,14 @@ class SimulationTable:
 
     @property
     def model_names(self) -> tuple[str, ...]:
+        """The scene's models in order: ``models``, or the one ``model``."""
         return self.models if self.models is not None else (self.model,)
 
     @property
     def horizon_key(self) -> str:
+        """The key the horizon was given by ("t_end", "t_end_T" or "t_end_Theta"), to name it in
+        messages.
+        """
         return one_of(self, *HORIZON_KEYS)
 
 
@@ -299,6 +308,7 @@ class ObserveTable:
 
     @property
     def horizon_key(self) -> str | None:
+        """The key the detector's horizon was given by, or None (the scene's horizon)."""
         return one_of(self, *HORIZON_KEYS)
 
 

@@ -257,7 +257,7 @@ def _stats(setup: Setup, cnt, switches, rtol: float, t) -> dict:
     """What the run did and how sure it is, before the resonance scan.
 
     The error statements are bounds fitted to measurements against full integration on random
-    bodies (README; ``python -m spinviz.validation.secular_sweep``, and a seed of it in
+    bodies (README; ``spinviz check --sweep``, and a seed of it in
     tests/test_secular_real_scale.py): where averaged, the phases drift by ~ integral of
     mu^2 dt and at least 2 eps max(1, t/T), the slow variables are off by ~ max(15 eps^2,
     mu^2), with mu = eps |w|^2 / |delta w3| the radiation rate over the precession rate (small

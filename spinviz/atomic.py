@@ -52,8 +52,7 @@ class AtomicPath:
 
     def commit(self):
         """Rename the finished temporary file over ``path`` (one atomic ``os.replace``), with the
-        permissions a new file would get.
-        """
+        permissions a new file would get."""
         os.chmod(self.tmp, 0o666 & ~_umask())
         os.replace(self.tmp, self.path)
 

@@ -75,6 +75,8 @@ class Trajectory:
     # -- units ---------------------------------------------------------------------------
     @property
     def units(self) -> str:
+        """The body's unit system: "cgs" (t in s, Omega in rad/s) or "dimensionless" (tau, omega of
+        (4.1))."""
         return self.body.units
 
     @property
@@ -103,6 +105,7 @@ class Trajectory:
 
     @property
     def omega_magnitude(self) -> np.ndarray:
+        """|Omega|, shape (N,), rad/s (CGS) or 1/tau0: the same in every frame."""
         return np.linalg.norm(self.omega, axis=-1)
 
     def dipole_world(self) -> np.ndarray:
@@ -291,6 +294,8 @@ class Trajectory:
         return out
 
     def metadata(self) -> dict:
+        """The JSON record saved beside the arrays (``save``): format, units, conventions
+        (quaternion order, Euler convention), model, body and its full description, and stats."""
         b = self.body
         return {
             "format": FORMAT,

@@ -227,8 +227,7 @@ class InitialTable:
     @property
     def orientation_key(self) -> str:
         """The key the initial orientation was given by ("euler_zxz", "euler_zxz_deg" or
-        "quaternion", the default).
-        """
+        "quaternion", the default)."""
         return one_of(self, "euler_zxz", "euler_zxz_deg", "quaternion") or "quaternion"
 
     def q0(self) -> np.ndarray:
@@ -279,8 +278,7 @@ class SimulationTable:
     @property
     def horizon_key(self) -> str:
         """The key the horizon was given by ("t_end", "t_end_T" or "t_end_Theta"), to name it in
-        messages.
-        """
+        messages."""
         return one_of(self, *HORIZON_KEYS)
 
 

@@ -107,6 +107,8 @@ class Body:
 
     @classmethod
     def from_dict(cls, d: dict) -> Body:
+        """The body ``to_dict`` described (as saved in a trajectory file's metadata), rebuilt
+        exactly."""
         sh = d.get("shape")
         shape = None if sh is None else Shape(sh["kind"], tuple(sh["dims"]), tuple(sh["q_body_from_shape"]), sh["label"])
         return cls(name=d["name"], units=d["units"], inertia=tuple(d["inertia"]), dipole=tuple(d["dipole"]),
@@ -117,14 +119,18 @@ class Body:
     # -- derived quantities --------------------------------------------------------------
     @property
     def I1(self) -> float:
+        """I1, the first principal moment: g cm^2 (CGS) or 1 (dimensionless, the unit of inertia)."""
         return float(self.inertia[0])
 
     @property
     def I2(self) -> float:
+        """I2, the second principal moment, in the units of ``I1``."""
         return float(self.inertia[1])
 
     @property
     def I3(self) -> float:
+        """I3, the third principal moment (about e3, the symmetry axis of a symmetric top), in the
+        units of ``I1``."""
         return float(self.inertia[2])
 
     @property

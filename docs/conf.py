@@ -77,12 +77,15 @@ add_module_names = False
 napoleon_google_docstring = False     # only numpydoc sections: a line ending in ":" stays prose
 napoleon_numpy_docstring = True
 napoleon_use_rtype = False            # "Returns: (type) -- meaning" on one line, as the docstrings read
+napoleon_use_ivar = True              # "Attributes" as a field list: no second target beside autodoc's members
 # Heavy optional stacks are installed for the docs build (the "docs" extra pulls the render
 # and ensemble extras), so nothing is mocked: what the reference shows is what imports.
 
-# The project's docstrings (see STYLE.md) list parameters as lines ``name : meaning`` (shape,
-# units and frame on the line), not in numpydoc sections; shown as reST they would run
-# together into one paragraph.  This turns such a paragraph into a definition list.
+# Many of the project's docstrings (see STYLE.md) list parameters as lines ``name : meaning``
+# (shape, units and frame on the line) outside any numpydoc section; shown as reST they would
+# run together into one paragraph.  This turns such a paragraph into a definition list.  (The
+# public entry points use numpydoc sections, which napoleon renders; once every docstring
+# does, this hook can go.  Napoleon runs first and its output never matches ``_PARAM``.)
 _PARAM = re.compile(r"^(?P<names>[A-Za-z_*][\w*]*(?:\s*,\s*[A-Za-z_*][\w*]*)*)\s+:\s+(?P<text>\S.*)$")
 
 

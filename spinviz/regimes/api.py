@@ -114,7 +114,7 @@ def plan(spec: AtlasSpec, chunks: tuple, done: np.ndarray, runs_per_task: int = 
                                 batches.append(RN.Batch(model, (float(spec.deltas[di]),),
                                                         tuple(float(x) for x in spec.chis[pa:pb]),
                                                         np.asarray(spec.omega0[pma:pmb]), spec.settings,
-                                                        (mi, (di, di + 1), (pa, pb), (pma, pmb))))
+                                                        (mi, (di, di + 1), (pa, pb), (pma, pmb)), spec.series))
                                 keys.append(key)
                                 expected[key] = expected.get(key, 0) + 1
     return batches, keys, expected
@@ -273,7 +273,7 @@ def _resume(spec: AtlasSpec, out: str, say) -> tuple:
     repaired = 0
     if bad:
         with deferred():
-            IN.discard(out, ST.RUN_VARIABLES, bad, rep.leftovers)
+            IN.discard(out, ST.run_variables(out), bad, rep.leftovers)
         n = sum(int(np.prod([r.stop - r.start for r in IN.chunk_region(k, shape, chunks)])) for k in bad)
         repaired = n
         what = "damaged" if rep.damaged else "unverified"
@@ -283,7 +283,7 @@ def _resume(spec: AtlasSpec, out: str, say) -> tuple:
                        f"{'their' if len(bad) != 1 else 'its'} {n} runs are recomputed")
     elif rep.leftovers:
         with deferred():
-            IN.discard(out, ST.RUN_VARIABLES, [], rep.leftovers)
+            IN.discard(out, ST.run_variables(out), [], rep.leftovers)
     if rep.leftovers and not bad:
         notices.append(f"{out}: removed {len(rep.leftovers)} temporary file{'s' if len(rep.leftovers) != 1 else ''} "
                        f"of an interrupted write ({IN.summary([IN.Problem(x, 'leftover') for x in rep.leftovers], 3)})")

@@ -399,6 +399,20 @@ class Stats:
     checksum_s: float = 0.0                               # of which: hashing the chunk files, recording the sums
     chunk_writes: int = 0
 
+    def merged(self, other: Stats | None) -> Stats:
+        """The measurements of two executions one after the other (refinement levels on one
+        cluster): counts and times added, the later one's incomplete state kept."""
+        if other is None:
+            return self
+        out = Stats(threads=max(self.threads, other.threads), incomplete=other.incomplete)
+        for name in ("runs", "tasks", "failed_tasks", "wall_s", "compute_s", "cpu_s", "write_s", "checksum_s",
+                     "chunk_writes"):
+            setattr(out, name, getattr(self, name) + getattr(other, name))
+        out.task_compute_s = self.task_compute_s + other.task_compute_s
+        out.max_rss_mb = {pid: max(self.max_rss_mb.get(pid, 0), other.max_rss_mb.get(pid, 0))
+                          for pid in {*self.max_rss_mb, *other.max_rss_mb}}
+        return out
+
     @property
     def overhead_share(self) -> float:
         """1 - (time inside the tasks) / (wall time x threads): scheduling, transfer, writing,

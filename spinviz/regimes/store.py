@@ -213,6 +213,20 @@ def _same_spec(attrs: dict, spec) -> bool:
         return False
 
 
+def level_path(out: str, k: int) -> str:
+    """Where level ``k`` of the atlas at ``out`` is kept (inside it: a Zarr subgroup)."""
+    return out if k == 0 else os.path.join(out, f"level{k}")
+
+
+def stored_levels(out: str) -> list[str]:
+    """The stores of an atlas's levels that exist: ``out`` itself, then ``levelK`` for
+    K = 1, 2, ... up to the first one missing."""
+    paths = [out]
+    while os.path.exists(os.path.join(level_path(out, len(paths)), ".zgroup")):
+        paths.append(level_path(out, len(paths)))
+    return paths
+
+
 def done_mask(path: str) -> np.ndarray:
     """Which runs are on disk, shape (model, delta, chi, member), bool."""
     import zarr

@@ -297,7 +297,7 @@ class _LazyCluster:
     """The Dask cluster, started on the first level that has work (and then kept for the others)."""
 
     def __init__(self, stack, scheduler, workers, processes):
-        self.stack, self.args, self.cl = stack, (scheduler, workers, processes), None
+        self.stack, self.args, self.cl, self.where = stack, (scheduler, workers, processes), None, "nothing to compute"
 
     def get(self):
         from .cluster import Cluster
@@ -305,11 +305,12 @@ class _LazyCluster:
         if self.cl is None:
             scheduler, workers, processes = self.args
             self.cl = self.stack.enter_context(Cluster(scheduler, workers, processes=processes))
+            self.where = self.cl.describe          # asked now: a cluster lost later cannot answer
         return self.cl
 
     @property
     def describe(self) -> str:
-        return self.cl.describe if self.cl is not None else "nothing to compute"
+        return self.where
 
     def close_fast(self) -> None:
         if self.cl is not None:

@@ -1,5 +1,5 @@
-"""The atlas benchmark (a command, not a test): ``spinviz atlas SPEC --bench`` or
-``python -m spinviz.regimes.bench SPEC [--json PATH]``.
+"""The atlas benchmark (a command, not a test): ``spinviz atlas SPEC --bench [--json]``, and
+``spinviz atlas SPEC --bench --write-path`` for the store's write path alone.
 
 Measured on the spec as given, each time into a fresh temporary store, one after the other:
 
@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import sys
 import tempfile
 import time
 
@@ -203,34 +202,3 @@ def format_table(r: dict) -> str:
         f"{max(p['max_task_s'] for p in r['by_workers'].values()):.0f} s, as the tail)",
     ]
     return "\n".join(lines)
-
-
-def main(argv=None) -> int:
-    import argparse
-    import json
-
-    from ..atomic import write_json
-
-    ap = argparse.ArgumentParser(prog="python -m spinviz.regimes.bench")
-    ap.add_argument("spec")
-    ap.add_argument("--workers", type=int, default=None)
-    ap.add_argument("--json", metavar="PATH")
-    ap.add_argument("--quiet", action="store_true")
-    ap.add_argument("--store", action="store_true", help="only the store's write path at the spec's size (no runs)")
-    a = ap.parse_args(argv)
-    if a.store:
-        r = store_cost(a.spec)
-        print(format_store_cost(r))
-    else:
-        r = run(a.spec, a.workers, progress=not a.quiet)
-        print(format_table(r))
-    if a.json:
-        write_json(a.json, r)
-    else:
-        print(json.dumps(r, default=float), file=sys.stderr)
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
-

@@ -1,5 +1,6 @@
-"""``spinviz atlas SPEC.toml [--out PATH] [--scheduler ADDRESS] [--workers N] [--plot PATH]``
-and ``spinviz atlas --verify STORE``.
+"""``spinviz atlas SPEC.toml [--out PATH] [--scheduler ADDRESS] [--workers N] [--plot PATH]``,
+``spinviz atlas --verify STORE``, ``spinviz atlas SPEC --bench [--write-path]`` and
+``spinviz atlas --evidence KIND`` (``evidence``).
 
 ``add_parser(subparsers)`` adds the subcommand to spinviz's parser; ``run(args) -> int`` does
 the work and raises spinviz's errors (``SceneError`` for the spec, ``UsageError`` for the
@@ -51,6 +52,19 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     a.add_argument("--bench", action="store_true",
                    help="instead: measure runs per second on 1 and 2 workers, the scheduling overhead and the memory "
                         "per worker on this spec (temporary stores), and project a 64 x 64 x 32 atlas")
+    a.add_argument("--write-path", action="store_true",
+                   help="with --bench: only the store's write path at the spec's size (chunk writes, checksums, "
+                        "verification; no runs)")
+    ev = a.add_argument_group("evidence (instead of an atlas; no spec: the points are built in)")
+    ev.add_argument("--evidence", metavar="KIND", choices=("validate", "crosscheck", "physical", "convergence",
+                                                           "tolerance"),
+                    help="validate (every domain against the paper's formulas), crosscheck (the disputed points with "
+                         "SciPy), physical (against physical-unit simulate runs), convergence (horizon x 100, x 1e4 "
+                         "and 4x members; --out STORE keeps the rows in that atlas), tolerance (labels against rtol)")
+    ev.add_argument("--members", type=_count, help="starts per point (default: validate 32, crosscheck 3, physical 4, "
+                                                   "convergence 32, tolerance 8)")
+    ev.add_argument("--tau-end", type=float, help="physical: the horizon (default 1e10)")
+    ev.add_argument("--horizons", metavar="LIST", help="convergence: the horizons (default 1e10,1e12,1e14)")
     return a
 
 
@@ -83,8 +97,22 @@ def _run(args) -> int:
         if args.spec is not None or args.out or args.scheduler or args.plot or args.bench:
             raise UsageError("--verify: checks a store on its own; give no spec and no other option")
         return verify(args.verify, as_json=args.json)
+    evidence_only = (args.members, args.tau_end, args.horizons)
+    if args.evidence is not None:
+        from . import evidence
+
+        if args.spec is not None or args.scheduler or args.plot or args.bench or args.retry_failed:
+            raise UsageError("--evidence: runs its own points; give no spec, --scheduler, --plot, --bench or "
+                             "--retry-failed")
+        return evidence.run(args.evidence, args.members, workers=args.workers, tau_end=args.tau_end,
+                            horizons=args.horizons, out=args.out, as_json=args.json)
+    if any(v is not None for v in evidence_only):
+        raise UsageError("--members, --tau-end and --horizons go with --evidence")
+    if args.write_path and not args.bench:
+        raise UsageError("--write-path goes with --bench")
     if args.spec is None:
-        raise UsageError("atlas: the spec is missing (spinviz atlas SPEC.toml, or spinviz atlas --verify STORE)")
+        raise UsageError("atlas: the spec is missing (spinviz atlas SPEC.toml, spinviz atlas --verify STORE, or "
+                         "spinviz atlas --evidence KIND)")
     spec = load_spec(args.spec)                       # SceneError: file, key, reason
     if args.bench:
         from . import bench
@@ -92,6 +120,10 @@ def _run(args) -> int:
         if args.out or args.scheduler or args.plot:
             raise UsageError("--bench: measures on temporary stores and the embedded cluster; drop --out, --scheduler "
                              "and --plot")
+        if args.write_path:
+            rows = bench.store_cost(spec)
+            print(bench.format_store_cost(rows) if not args.json else json.dumps(rows, indent=2, default=float))
+            return 0
         rows = bench.run(spec, workers=args.workers, progress=not args.quiet)
         print(bench.format_table(rows) if not args.json else json.dumps(rows, indent=2, default=float))
         return 0

@@ -1,6 +1,7 @@
-"""Convergence evidence for the atlas's labels (issue 18.3): horizon and member count.
+"""Convergence evidence for the atlas's labels (issue 18.3): horizon, member count and tolerance.
 
-    python -m spinviz.regimes.convergence [--members 32] [--out atlas_convergence.zarr] [--json PATH]
+    spinviz atlas --evidence convergence [--members 32] [--horizons 1e10,1e12,1e14] [--out STORE] [--json]
+    spinviz atlas --evidence tolerance [--members 8]
 
 For a validation subset -- the points of ``validate.POINTS`` (every domain of figure 2 and
 the truncated types) and the four points where the paper is disputed -- each point's starts
@@ -17,15 +18,20 @@ members at tau_end.  Per point the table says:
 * the "other" share per horizon and what those runs are (the classifier's reasons).
 
 The rows are written as JSON (``--json``), into an atlas store as its ``convergence``
-attribute (``--store``: the figure atlas keeps the evidence it rests on), and as a Markdown
+attribute (``--out STORE``: the figure atlas keeps the evidence it rests on), and as a Markdown
 table for docs/atlas.md.
+
+``tolerance`` asks the other question: on the quick atlas's 12 x 12 grid (every domain of
+figure 2), how many labels does rtol change, and what does a looser one save?  Per model and
+rtol: the share of labels equal to the tightest rtol's, the end states' relative difference
+from it, and the integration and classification time per run (one thread).
 """
 
 from __future__ import annotations
 
 import math
-import sys
 import time
+import warnings
 from collections import Counter
 
 import numpy as np
@@ -128,37 +134,72 @@ def format_table(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def main(argv=None) -> int:
-    import argparse
-
-    from ..atomic import write_json
-
-    ap = argparse.ArgumentParser(prog="python -m spinviz.regimes.convergence")
-    ap.add_argument("--members", type=int, default=32)
-    ap.add_argument("--horizons", default=",".join(f"{h:g}" for h in HORIZONS))
-    ap.add_argument("--json")
-    ap.add_argument("--store", help="an atlas store to record the rows in (attribute 'convergence')")
-    a = ap.parse_args(argv)
-    rows = study(a.members, tuple(float(x) for x in a.horizons.split(",")),
-                 progress=lambda m: print(f"  {m}", file=sys.stderr, flush=True))
-    print(format_table(rows))
-    if a.json:
-        write_json(a.json, rows)
-    if a.store:
-        record(a.store, rows)
-    return 0
-
-
 def record(store: str, rows: list[dict]) -> None:
-    """Keep the rows in an atlas store (root attribute ``convergence``, JSON)."""
+    """Keep the rows in an atlas store (root attribute ``convergence``, JSON), its metadata's
+    checksums recorded again (the store stays verifiable)."""
     import json
 
     import zarr
 
-    g = zarr.open_group(store, mode="r+", zarr_format=2)
-    g.attrs["convergence"] = json.dumps(rows, default=float)
-    zarr.consolidate_metadata(store)
+    from . import integrity as IN
+
+    def write():
+        g = zarr.open_group(store, mode="r+", zarr_format=2)
+        g.attrs["convergence"] = json.dumps(rows, default=float)
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message=".*checksums is not recognized")   # our record, not Zarr's
+            zarr.consolidate_metadata(store)
+
+    IN.rewrite_metadata(store, [".zattrs", ".zmetadata"], write)
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+TOLERANCES = (1e-6, 1e-7, 1e-8, 1e-10)
+
+
+def tolerance(members: int = 8, rtols=TOLERANCES, cells: int = 12, seed: int = 12, omega: float = 0.04,
+              tau_end: float = 1e10, progress=None) -> list[dict]:
+    """Labels and end states against rtol on a ``cells`` x ``cells`` grid (both models),
+    against the tightest rtol of ``rtols``; see the module docstring."""
+    from .refine import centres
+    from .runs import warm
+
+    say = progress or (lambda m: None)
+    grid = [(d, math.radians(c)) for d in centres(-1.0, 1.0, cells, 0) for c in centres(0.0, 90.0, cells, 0)]
+    starts = directions(members, seed) * omega
+    where = [cell for cell in grid for _ in range(members)]
+    w0 = [w for _ in grid for w in starts]
+    rows = []
+    for model in ("reduced", "truncated"):
+        found = {}
+        for rt in sorted(rtols):
+            st = Settings(tau_end=tau_end, rtol=rt)
+            warm(st)
+            say(f"{model}: rtol {rt:g}, {len(where)} runs")
+            t0 = time.perf_counter()
+            runs = integrate_many(model, where, w0, st)
+            t1 = time.perf_counter()
+            labels = [classify_run(r, model, d, c, st).label for r, (d, c) in zip(runs, where)]
+            t2 = time.perf_counter()
+            found[rt] = (labels, np.array([r.omega[-1] for r in runs]), t1 - t0, t2 - t1)
+        ref_rt = min(rtols)
+        ref_lab, ref_w = found[ref_rt][0], found[ref_rt][1]
+        norm = np.linalg.norm(ref_w, axis=1)
+        for rt in sorted(rtols, reverse=True):
+            labels, w, t_int, t_cls = found[rt]
+            diff = np.linalg.norm(w - ref_w, axis=1) / np.where(norm > 0, norm, 1.0)
+            rows.append({"model": model, "rtol": rt, "reference_rtol": ref_rt, "runs": len(labels),
+                         "same_label": float(np.mean([a == b for a, b in zip(labels, ref_lab)])),
+                         "end_state_median": float(np.median(diff)), "end_state_max": float(np.max(diff)),
+                         "ms_per_run": 1e3 * t_int / len(labels), "classify_ms_per_run": 1e3 * t_cls / len(labels)})
+    return rows
+
+
+def format_tolerance(rows: list[dict]) -> str:
+    """The tolerance rows as a Markdown table."""
+    out = ["| model | rtol | labels as at the tightest rtol | end state rel. diff. median / max | integration ms/run "
+           "| classification ms/run |", "|---|---|---|---|---|---|"]
+    for r in rows:
+        out.append(f"| {r['model']} | {r['rtol']:g} | {100 * r['same_label']:.2f} % (rtol {r['reference_rtol']:g}) | "
+                   f"{r['end_state_median']:.1e} / {r['end_state_max']:.1e} | {r['ms_per_run']:.2f} | "
+                   f"{r['classify_ms_per_run']:.2f} |")
+    return "\n".join(out)

@@ -1,11 +1,11 @@
 """The atlas's disagreements with the paper, re-checked with an independent integrator.
 
-    python -m spinviz.regimes.crosscheck [--members 3] [--json PATH]
+    spinviz atlas --evidence crosscheck [--members 3] [--json]
 
 Independent of the atlas in two ways: the equations are (4.2)-(4.4) typed in from the paper
 (with omega_a, omega_b, omega_c of section 3), not spinviz's general reduced equation; and
 they are integrated by SciPy's ``solve_ivp`` (DOP853, and Radau for one point), not by the
-compiled Lie-group kernel.  Only the classifier is shared, and every claim is also shown by
+atlas's heyoka Taylor integrator.  Only the classifier is shared, and every claim is also shown by
 a number computed here directly (omega_perp sqrt(tau), omega2 tau, a fitted slope).
 
 The points (|omega0| = 0.1, tau_end = 1e10, starts from the atlas's seeded directions):
@@ -24,7 +24,6 @@ The points (|omega0| = 0.1, tau_end = 1e10, starts from the atlas's seeded direc
 from __future__ import annotations
 
 import math
-import sys
 import time
 
 import numpy as np
@@ -141,23 +140,3 @@ def format_rows(rows: list[dict]) -> str:
                    f"p={r['slope_perp']:.4f}{extra}  [{devs}]  {r['seconds']:.1f} s")
     return "\n".join(out)
 
-
-def main(argv=None) -> int:
-    import argparse
-
-    from ..atomic import write_json
-
-    ap = argparse.ArgumentParser(prog="python -m spinviz.regimes.crosscheck")
-    ap.add_argument("--members", type=int, default=3)
-    ap.add_argument("--json", metavar="PATH")
-    a = ap.parse_args(argv)
-    rows = run(a.members, progress=lambda r: print(f"  {r['point']} member {r['member']}: {r['label']} "
-                                                    f"({r['seconds']:.1f} s)", file=sys.stderr, flush=True))
-    print(format_rows(rows))
-    if a.json:
-        write_json(a.json, rows)
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

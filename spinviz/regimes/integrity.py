@@ -94,6 +94,23 @@ def record_skeleton(path: str) -> None:
     write_text(os.path.join(path, DIR, SKELETON), json.dumps({"sha256": files}, sort_keys=True, indent=0))
 
 
+def rewrite_metadata(path: str, files, write) -> None:
+    """Let spinviz itself rewrite metadata ``files`` (relative paths) of a finished store --
+    an attribute added -- and record their new sha256: the record is checked first, so a
+    file damaged before is never blessed (``ValueError``, nothing written); ``write()`` does
+    the rewriting."""
+    damaged = verify_skeleton(path)
+    if damaged is None or damaged:
+        raise ValueError(f"{path}: its metadata do not match their checksums; nothing recorded")
+    rec_path = os.path.join(path, DIR, SKELETON)
+    with open(rec_path) as fh:
+        recorded = json.load(fh)["sha256"]
+    write()
+    for rel in files:
+        recorded[rel] = sha256_file(os.path.join(path, rel))
+    write_text(rec_path, json.dumps({"sha256": recorded}, sort_keys=True, indent=0))
+
+
 def _walk(path: str):
     """Relative paths of the store's files (the record itself excluded), sorted."""
     out = []
@@ -174,7 +191,7 @@ def verify(path: str, variables) -> Report:
     with _suppress_os():
         rep.leftovers += [f"{DIR}/{CHUNKS}/{n}" for n in sorted(os.listdir(os.path.join(path, DIR, CHUNKS)))
                           if PARTIAL in n]
-    rep.skeleton = _verify_skeleton(path)
+    rep.skeleton = verify_skeleton(path)
     if not rep.skeleton_ok:
         return rep
     shape, chunks = layout(path)
@@ -221,7 +238,7 @@ def layout(path: str) -> tuple:
     return tuple(meta["shape"]), tuple(meta["chunks"])
 
 
-def _verify_skeleton(path: str) -> list | None:
+def verify_skeleton(path: str) -> list | None:
     try:
         with open(os.path.join(path, DIR, SKELETON)) as fh:
             recorded = json.load(fh)["sha256"]

@@ -1,6 +1,6 @@
 """The atlas's dimensionless system against the full physical-unit equation (issue 18.4).
 
-    python -m spinviz.regimes.physical_check [--members 4] [--tau-end 1e10] [--json PATH]
+    spinviz atlas --evidence physical [--members 4] [--tau-end 1e10] [--json]
 
 The atlas integrates (4.2)-(4.4) -- and, for the truncated model, spinviz's analogue of them
 (``physics.equations.symmetric_truncated_rate``) -- in the dimensionless variables (4.1),
@@ -19,7 +19,6 @@ particle's are.
 from __future__ import annotations
 
 import math
-import sys
 import time
 
 import numpy as np
@@ -104,25 +103,3 @@ def format_table(rows: list[dict]) -> str:
     lines += ["", f"same label in {same} of {len(rows)} runs; largest relative difference of the end states {worst:.1e}"]
     return "\n".join(lines)
 
-
-def main(argv=None) -> int:
-    import argparse
-
-    from ..atomic import write_json
-
-    ap = argparse.ArgumentParser(prog="python -m spinviz.regimes.physical_check")
-    ap.add_argument("--members", type=int, default=4)
-    ap.add_argument("--tau-end", type=float, default=1e10)
-    ap.add_argument("--rtol", type=float, default=1e-10)
-    ap.add_argument("--json")
-    a = ap.parse_args(argv)
-    rows = compare(members=a.members, tau_end=a.tau_end, rtol=a.rtol,
-                   progress=lambda m: print(f"  {m}", file=sys.stderr, flush=True))
-    print(format_table(rows))
-    if a.json:
-        write_json(a.json, rows)
-    return 0 if all(r["label_atlas"] == r["label_physical"] for r in rows) else 1
-
-
-if __name__ == "__main__":
-    sys.exit(main())

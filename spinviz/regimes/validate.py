@@ -1,7 +1,7 @@
 """The atlas at single points inside each domain: label shares, exponents and amplitudes
 against the paper's formulas (the README's validation table).
 
-    python -m spinviz.regimes.validate [--members 32] [--workers 2] [--json PATH]
+    spinviz atlas --evidence validate [--members 32] [--workers 2] [--json]
 
 Each point is an atlas of one cell (built with ``parse_spec``, run with ``atlas`` into a
 temporary store), so the table is made by exactly the code that makes the diagrams.
@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 import os
 import shutil
-import sys
 import tempfile
 from collections import Counter
 
@@ -98,23 +97,6 @@ def format_table(rows) -> str:
     return "\n".join(lines)
 
 
-def main(argv=None) -> int:
-    import argparse
-
-    from ..atomic import write_json
-
-    ap = argparse.ArgumentParser(prog="python -m spinviz.regimes.validate")
-    ap.add_argument("--members", type=int, default=32)
-    ap.add_argument("--workers", type=int, default=None)
-    ap.add_argument("--json", metavar="PATH")
-    a = ap.parse_args(argv)
-    rows = run(a.members, a.workers, progress=False)
-    print(format_table(rows))
-    if a.json:
-        write_json(a.json, rows)
-    return 0
-
-
 # --- the diagram against the domains ---------------------------------------------------------
 def paper_domain(delta: float, chi: float) -> str:
     """The type figure 2 assigns to a cell: (4.15) "2", (4.17) "3", (4.19) "4", (4.20) "?",
@@ -164,6 +146,3 @@ def compare_domains(ds, model: str = "reduced") -> dict:
     out["share_other"] = float(np.isin(lab, ["other", "1|2", "4|5"]).mean())
     return out
 
-
-if __name__ == "__main__":
-    sys.exit(main())

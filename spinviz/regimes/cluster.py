@@ -52,6 +52,7 @@ START_TIMEOUT_S = 120.0          # LocalCluster workers (spawned Python, imports
 NO_WORKER_S = 60.0               # an existing cluster without any worker this long: the atlas gives up
 POLL_S = 0.05                    # how often the client looks at a stop signal while it waits
 HEALTH_S = 0.5                   # how often the monitor asks the scheduler how many workers it has
+STALL_S = 10.0                   # nothing arrived this long: ask the scheduler whether a task erred unreported
 
 
 def worker_info() -> dict:
@@ -254,6 +255,24 @@ class Cluster:
         """Why the cluster cannot go on (the scheduler gone, no worker for ``NO_WORKER_S``), or None."""
         return self._monitor.problem(self.where) if self._monitor is not None else None
 
+    def erred_unreported(self, keys) -> list:
+        """Of ``keys`` (tasks this client still sees pending), those the scheduler has marked
+        erred: the report of their error did not arrive (distributed can fail to read it --
+        seen with a deep RecursionError's traceback -- and the future then waits forever).
+        From the scheduler's transition log, an RPC that runs no code of ours there."""
+        if not keys:
+            return []
+        try:
+            story = polled(self.client.sync, self.client.scheduler.get_story, keys_or_stimuli=list(keys))
+        except Exception:
+            return []
+        last = {}
+        for entry in story:
+            key, finish, stamp = entry[0], entry[2], entry[-1]
+            if key not in last or stamp >= last[key][1]:
+                last[key] = (finish, stamp)
+        return [k for k in keys if last.get(k, ("", 0))[0] == "erred"]
+
     def close(self, fast: bool = False) -> None:
         """Close the client and stop the LocalCluster.  ``fast`` (an exception, a stop signal, a
         lost cluster): kill the LocalCluster's worker processes first instead of waiting for
@@ -424,7 +443,8 @@ def _why_not_finished(f) -> str:
         except Exception as e:                     # the error could not even be fetched
             return f"a task's error could not be fetched ({type(e).__name__})"
         if isinstance(err, KilledWorker):
-            return f"a task killed the workers that ran it ({err.allowed_failures + 1} times)"
+            n = err.allowed_failures + 1
+            return f"a task killed the worker{'s' if n != 1 else ''} that ran it ({n} time{'s' if n != 1 else ''})"
         return f"a task raised {type(err).__name__}: {printable(str(err), 160)}"
     return f"a task was {f.status}"
 
@@ -450,6 +470,7 @@ def execute(cluster: Cluster, batches: list, keys: list, writer, progress: Progr
     not_done = 0                                  # runs of tasks that did not finish
     cause = None
     cluster_lost = False
+    last_seen = time.monotonic()                  # when a task last came back
 
     def submit_one():
         i = todo.pop()
@@ -472,7 +493,19 @@ def execute(cluster: Cluster, batches: list, keys: list, writer, progress: Progr
                     if problem:
                         cause, cluster_lost = problem, True
                         break
+                    if time.monotonic() - last_seen > STALL_S:
+                        last_seen = time.monotonic()
+                        pending = [k for k, (g, _) in in_flight.items() if g.status == "pending"]
+                        for key in cluster.erred_unreported(pending):
+                            i = in_flight.pop(key)[1]
+                            cause = cause or "a task failed on the cluster and its error never reached this client"
+                            not_done += batches[i].runs
+                            stats.failed_tasks += 1
+                            stats.tasks += 1
+                            if todo:
+                                submit_one()
                     continue
+            last_seen = time.monotonic()
             if f.key not in in_flight:
                 continue
             relost.pop(f.key, None)

@@ -175,7 +175,7 @@ def test_verify_a_clean_store(reference, capsys):
     """One line per variable with its chunks, the metadata, the verdict; exit 0."""
     rc, lines = verify(reference, capsys)
     assert rc == 0
-    assert lines == ["metadata: ok"] + [f"{v}: ok (4 chunks)" for v in store.RUN_VARIABLES] + [
+    assert lines == ["metadata: ok"] + [f"{v}: ok (4 chunks)" for v in store.run_variables(str(reference))] + [
         f"{reference}: ok: 36 runs verified"]
 
 

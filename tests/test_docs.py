@@ -12,24 +12,17 @@ import html
 import importlib.util
 import os
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from browser import CHROMIUM, page_text, screenshot
 
 ROOT = Path(__file__).resolve().parents[1]
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 DOCS_EXTRA = ("sphinx", "myst_parser", "pydata_sphinx_theme", "sphinx_copybutton")
 MISSING = [m for m in DOCS_EXTRA if importlib.util.find_spec(m) is None] + ([] if CHROMIUM else ["chromium"])
-
-# Flags for a root user on a machine whose network is closed: without the background
-# networking ones Chromium keeps trying (and failing) to reach Google's hosts.
-CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                  "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                  "--hide-scrollbars", "--virtual-time-budget=10000"]
 
 pytestmark = pytest.mark.slow
 if MISSING:
@@ -54,31 +47,6 @@ def site(tmp_path_factory) -> Path:
                        capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, f"sphinx-build -W failed:\n{r.stderr[-4000:]}"
     return out
-
-
-def chromium(page: Path, tmp_path: Path, *args: str) -> subprocess.CompletedProcess:
-    profile = tmp_path / f"profile-{page.stem}-{len(list(tmp_path.iterdir()))}"
-    r = subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, f"--user-data-dir={profile}", *args, page.as_uri()],
-                       capture_output=True, text=True, timeout=120)
-    assert r.returncode == 0, r.stderr[-2000:]
-    return r
-
-
-def screenshot(page: Path, tmp_path: Path) -> np.ndarray:
-    from PIL import Image
-
-    png = tmp_path / f"{page.stem}.png"
-    chromium(page, tmp_path, f"--screenshot={png}", "--window-size=1280,900")
-    return np.asarray(Image.open(png).convert("RGB"))
-
-
-def page_text(page: Path, tmp_path: Path) -> tuple[str, str]:
-    """The DOM after the page's scripts ran (MathJax included), and its visible text."""
-    dom = chromium(page, tmp_path, "--dump-dom").stdout
-    text = re.sub(r"<(script|style)\b.*?</\1>", " ", dom, flags=re.S)
-    text = re.sub(r"</?(?:p|div|dt|dd|li|h[1-6]|br|td|th|pre|section|nav|header|footer)\b[^>]*>", " ", text)
-    text = html.unescape(re.sub(r"<[^>]+>", "", text))          # inline markup: no space added
-    return dom, re.sub(r"\s+", " ", text)
 
 
 def readme_after(marker: str) -> str:
@@ -119,9 +87,11 @@ def test_api_page_of_simulate(site, tmp_path):
     assert sig.startswith("simulate(body: Body, model: str, omega0, *, t_end: float | None = None, "
                           "samples: int | None = None, t_eval=None, q0=None, euler_zxz0=None, method: str = 'auto',"), sig
     assert "kinematics: str = 'quaternion') → Trajectory" in sig, sig
-    # the docstring, with its "name : meaning" lines as a definition list
+    # the docstring, its numpydoc sections as field lists: name (type) – meaning
     assert "Integrate the Euler equation of model with orientation; return a Trajectory." in text
-    assert re.search(r"kinematics “quaternion” \(default\), “euler_zxz” \(the Poisson equations \(6\.4\)", text)
+    assert re.search(r"kinematics \(\{.quaternion., .euler_zxz., .none.\}\) – “quaternion” \(default\); "
+                     r"“euler_zxz”, the Poisson equations \(6\.4\)", text)
+    assert re.search(r"omega0 \(array_like, shape \(3,\)\) – Body-frame angular velocity at t = 0", text)
 
 
 def test_physics_equations_render_offline(site, tmp_path):

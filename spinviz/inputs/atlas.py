@@ -224,6 +224,7 @@ class AtlasFile:
 
     @property
     def model_names(self) -> tuple[str, ...]:
+        """The spec's models in order: ``models``, the one ``model``, or ("reduced",)."""
         return self.models or ((self.model,) if self.model else ("reduced",))
 
 

@@ -16,6 +16,7 @@ many and why, and the same call completes the store.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
 import time
@@ -45,6 +46,7 @@ class AtlasResult:
     plots : pictures written.  stats : the execution's measurements (``cluster.Stats``) or None.
     repaired : runs of damaged or unverified chunks found on resume, recomputed now.
     notices : what was said about the store on the way (one line each).
+    levels : refinement levels computed beyond the spec's grid (``[refine]``).
     """
 
     path: str
@@ -58,6 +60,7 @@ class AtlasResult:
     stats: object = None
     repaired: int = 0
     notices: list = field(default_factory=list)
+    levels: int = 0
 
     @property
     def dataset(self):
@@ -68,7 +71,8 @@ class AtlasResult:
         if self.computed == 0:
             return f"{self.path}: all {self.total} runs already there, nothing to compute"
         s = (f"{self.path}: {self.total} runs ({self.reused} already there, {self.computed} computed now"
-             f"{f', {self.failed} failed' if self.failed else ''}) in {self.seconds:.1f} s on {self.cluster}")
+             f"{f', {self.failed} failed' if self.failed else ''}"
+             f"{f', over {self.levels + 1} refinement levels' if self.levels else ''}) in {self.seconds:.1f} s on {self.cluster}")
         if self.stats is not None and self.stats.runs:
             st = self.stats
             s += (f"; {st.runs / st.wall_s:.1f} runs/s, {st.tasks} tasks, overhead {100 * st.overhead_share:.0f} % "
@@ -114,7 +118,7 @@ def plan(spec: AtlasSpec, chunks: tuple, done: np.ndarray, runs_per_task: int = 
                                 batches.append(RN.Batch(model, (float(spec.deltas[di]),),
                                                         tuple(float(x) for x in spec.chis[pa:pb]),
                                                         np.asarray(spec.omega0[pma:pmb]), spec.settings,
-                                                        (mi, (di, di + 1), (pa, pb), (pma, pmb))))
+                                                        (mi, (di, di + 1), (pa, pb), (pma, pmb)), spec.series))
                                 keys.append(key)
                                 expected[key] = expected.get(key, 0) + 1
     return batches, keys, expected
@@ -155,8 +159,9 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
     scheduler : address of an existing Dask cluster (``tcp://HOST:8786``); default: a
         LocalCluster with ``workers`` single-threaded processes (default and at most one per
         core) that starts and stops here.
-    plot : also draw the delta-chi diagram there (PNG) and the hodographs beside it
-        (``<stem>_hodographs.png``).
+    plot : also draw the delta-chi diagram there (PNG, every refinement level over the
+        coarser), the hodographs beside it (``<stem>_hodographs.png``) and the interactive
+        page (``<stem>.html``: hover a cell for its shares, click it for its hodograph).
     progress : the progress bar on stderr.
     runs_per_task : runs per Dask task (the store's chunking is fixed when it is created).
     processes : LocalCluster workers as processes (default) or threads of this process.
@@ -173,7 +178,6 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
     the same call computes what is missing.  ``StoreDamaged`` for a store whose metadata do
     not match their checksums.
     """
-    from .cluster import Cluster, Progress, execute
 
     # the one schema (spinviz.inputs.atlas): arguments named as here, then the spec, then
     # whether it can finish on this machine -- all before any work
@@ -193,57 +197,172 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
 
         plots = check_plot_paths(plot, out, spec)
     t0 = time.perf_counter()
-    exists = os.path.exists(out)
-    notices, repaired = [], 0
+    levels = [Level(spec, out, None)]
+    totals = {"todo": 0, "reused": 0, "repaired": 0, "failed": 0, "runs": 0}
+    notices: list = []
+    stats = None
+    where = "nothing to compute"
     # stop signals are recorded, and acted on where this code looks (check()), never raised
     # inside Dask or Zarr, whose callbacks could swallow them
-    with deferred():
-        if exists:
-            chunks, done, repaired, notices = _resume(spec, out, say)
-            if retry_failed:
-                done &= ST.regime_codes(out) != -1
-        else:
-            chunks = ST.chunk_shape(spec)
-            done = np.zeros((len(spec.models), len(spec.deltas), len(spec.chis), spec.members), dtype=bool)
-        check()
-        reused = int(done.sum())
-        batches, keys, expected = plan(spec, chunks, done, runs_per_task)
-        todo = int(sum(b.runs for b in batches))
-        stats = None
-        where = "nothing to compute"
-        if batches:
-            with Cluster(scheduler, workers, processes=processes) as cl:
-                where = cl.describe
-                if not exists:
-                    ST.create(spec, out, chunks)
-                writer = ST.Writer(out, expected, flush_s=flush_s)
-                bar = Progress(todo, f"atlas {printable(os.path.basename(out), 80)}", enabled=progress)
-                try:
-                    stats = execute(cl, batches, keys, writer, bar, on_result=on_result)
-                finally:
-                    writer.close()
-                    bar.finish()
-                    if stats is not None:
-                        stats.write_s, stats.checksum_s = writer.write_s, writer.checksum_s
-                        stats.chunk_writes = writer.chunk_writes
-                if stats.incomplete is not None and stats.incomplete.cluster_lost:
-                    cl.close(fast=True)            # no point waiting for a cluster that is gone
-        elif not exists:                           # an empty plan and no store: cannot happen
-            raise UsageError(f"{spec.path}: the spec holds no runs")
+    with deferred(), contextlib.ExitStack() as stack:
+        cluster = _LazyCluster(stack, scheduler, workers, processes)
+        for k in range(spec.refine_levels + 1):
+            if k:
+                levels.append(refined_level(spec, out, levels, k))
+                if not levels[-1].wanted.any():
+                    levels.pop()
+                    break
+            lv = levels[-1]
+            s = _run_level(lv, cluster, runs_per_task, flush_s, retry_failed, on_result, progress, say, notices, totals)
+            stats = s if stats is None else stats.merged(s)
+            if s is not None:
+                where = cluster.describe
+                if s.incomplete is not None:
+                    if s.incomplete.cluster_lost:
+                        cluster.close_fast()
+                    inc = s.incomplete
+                    done = ST.done_mask(lv.out)
+                    done = int((done if lv.wanted is None else done & lv.wanted[..., None]).sum())
+                    raise AtlasIncomplete(lv.out, inc.cause, lv.runs - done, lv.runs, done, inc.cluster_lost)
     seconds = time.perf_counter() - t0
-    if stats is not None and stats.incomplete is not None:
-        inc = stats.incomplete
-        raise AtlasIncomplete(out, inc.cause, int(spec.runs - ST.done_mask(out).sum()), spec.runs,
-                              int(ST.done_mask(out).sum()), inc.cluster_lost)
-    failed = 0
-    if batches:
-        failed = int(((ST.regime_codes(out) == -1) & ~done).sum())
-    res = AtlasResult(out, spec.runs, todo, reused, failed, seconds, where, [], stats, repaired, notices)
+    res = AtlasResult(out, totals["runs"], totals["todo"], totals["reused"], totals["failed"], seconds, where, [], stats,
+                      totals["repaired"], notices, levels=len(levels) - 1)
     if plot is not None:
         from .plot import draw
 
         res.plots = draw(out, plots)
     return res
+
+
+@dataclass
+class Level:
+    """One level of the quadtree (``refine``): its spec (level 0: the spec itself; level k: the
+    grid cut 2^k times finer), its store (level 0: ``out``; level k: ``out/levelK``, an atlas
+    store of its own), and the cells to compute (model, delta, chi) -- None: all."""
+
+    spec: AtlasSpec
+    out: str
+    wanted: np.ndarray | None
+
+    @property
+    def runs(self) -> int:
+        return self.spec.runs if self.wanted is None else int(self.wanted.sum()) * self.spec.members
+
+
+def level_spec(spec: AtlasSpec, k: int) -> AtlasSpec:
+    """The spec of refinement level ``k``: every axis cut 2^k times finer, the rest unchanged."""
+    from dataclasses import replace
+
+    from . import refine as RF
+
+    (d0, d1, nd), (c0, c1, nc) = spec.axes["delta"], spec.axes["chi"]
+    return replace(spec, title=f"{spec.title or os.path.basename(spec.path)}: refinement level {k}",
+                   deltas=RF.centres(d0, d1, nd, k), chis=RF.centres(c0, c1, nc, k), refine_levels=0,
+                   axes={"delta": (d0, d1, nd * 2**k), "chi": (c0, c1, nc * 2**k)})
+
+
+def refined_level(spec: AtlasSpec, out: str, levels: list, k: int) -> Level:
+    """Level ``k``: the children of the level-(k - 1) cells that ``refine.flags`` marks, from
+    the types the levels below computed (a cell counts as computed when all its members are)."""
+    from . import refine as RF
+
+    sub = level_spec(spec, k)
+    wanted = np.zeros((len(spec.models), len(sub.deltas), len(sub.chis)), dtype=bool)
+    for mi in range(len(spec.models)):
+        maj, share, comp = [], None, []
+        for lv in levels:
+            types, done = level_types(lv.out, mi)
+            m, share = RF.majority(types)
+            maj.append(m)
+            comp.append(done)
+        eff = RF.effective(maj, comp)
+        wanted[mi] = RF.children(RF.flags(maj[-1], share, comp[-1], eff, spec.refine_agree))
+    return Level(sub, ST.level_path(out, k), wanted)
+
+
+def level_types(path: str, model_index: int):
+    """(types (delta, chi, member) int, computed (delta, chi) bool) of one model of a level's
+    store: an approaching run counts for the type it approaches (``refine.type_of``)."""
+    import zarr
+
+    from . import refine as RF
+
+    g = zarr.open_group(path, mode="r", zarr_format=2)
+    codes = np.asarray(g["regime"][model_index])
+    types = RF.type_of(codes, np.asarray(g["candidate"][model_index]))
+    return types, (np.asarray(g["done"][model_index]) == 1).all(axis=-1)
+
+
+class _LazyCluster:
+    """The Dask cluster, started on the first level that has work (and then kept for the others)."""
+
+    def __init__(self, stack, scheduler, workers, processes):
+        self.stack, self.args, self.cl = stack, (scheduler, workers, processes), None
+
+    def get(self):
+        from .cluster import Cluster
+
+        if self.cl is None:
+            scheduler, workers, processes = self.args
+            self.cl = self.stack.enter_context(Cluster(scheduler, workers, processes=processes))
+        return self.cl
+
+    @property
+    def describe(self) -> str:
+        return self.cl.describe if self.cl is not None else "nothing to compute"
+
+    def close_fast(self) -> None:
+        if self.cl is not None:
+            self.cl.close(fast=True)           # no point waiting for a cluster that is gone
+
+
+def _run_level(lv: Level, cluster: _LazyCluster, runs_per_task, flush_s, retry_failed, on_result, progress, say,
+               notices: list, totals: dict):
+    """Compute what level ``lv`` lacks (its wanted cells): the store created or verified and
+    resumed, the batches planned, executed and written.  Returns the execution's stats or None."""
+    from .cluster import Progress, execute
+
+    spec, out = lv.spec, lv.out
+    exists = os.path.exists(os.path.join(out, ".zgroup")) if lv.wanted is not None else os.path.exists(out)
+    repaired = 0
+    if exists:
+        chunks, done, repaired, said = _resume(spec, out, say)
+        notices += said
+        if retry_failed:
+            done &= ST.regime_codes(out) != -1
+    else:
+        chunks = ST.chunk_shape(spec)
+        done = np.zeros((len(spec.models), len(spec.deltas), len(spec.chis), spec.members), dtype=bool)
+    check()
+    skip = done if lv.wanted is None else (done | ~lv.wanted[..., None])
+    totals["runs"] += lv.runs
+    totals["reused"] += int(done.sum() if lv.wanted is None else (done & lv.wanted[..., None]).sum())
+    totals["repaired"] += repaired
+    batches, keys, expected = plan(spec, chunks, skip, runs_per_task)
+    todo = int(sum(b.runs for b in batches))
+    totals["todo"] += todo
+    if not batches:
+        if not exists and lv.wanted is None:       # an empty plan and no store: cannot happen
+            raise UsageError(f"{spec.path}: the spec holds no runs")
+        return None
+    cl = cluster.get()
+    if not exists:
+        ST.create(spec, out, chunks)
+    writer = ST.Writer(out, expected, flush_s=flush_s)
+    label = os.path.basename(out) if lv.wanted is None else f"{os.path.basename(os.path.dirname(out))}/" \
+                                                             f"{os.path.basename(out)}"
+    bar = Progress(todo, f"atlas {printable(label, 80)}", enabled=progress)
+    stats = None
+    try:
+        stats = execute(cl, batches, keys, writer, bar, on_result=on_result)
+    finally:
+        writer.close()
+        bar.finish()
+        if stats is not None:
+            stats.write_s, stats.checksum_s = writer.write_s, writer.checksum_s
+            stats.chunk_writes = writer.chunk_writes
+    totals["failed"] += int(((ST.regime_codes(out) == -1) & ~skip).sum())
+    return stats
 
 
 def _say(line: str) -> None:
@@ -273,7 +392,7 @@ def _resume(spec: AtlasSpec, out: str, say) -> tuple:
     repaired = 0
     if bad:
         with deferred():
-            IN.discard(out, ST.RUN_VARIABLES, bad, rep.leftovers)
+            IN.discard(out, ST.run_variables(out), bad, rep.leftovers)
         n = sum(int(np.prod([r.stop - r.start for r in IN.chunk_region(k, shape, chunks)])) for k in bad)
         repaired = n
         what = "damaged" if rep.damaged else "unverified"
@@ -283,7 +402,7 @@ def _resume(spec: AtlasSpec, out: str, say) -> tuple:
                        f"{'their' if len(bad) != 1 else 'its'} {n} runs are recomputed")
     elif rep.leftovers:
         with deferred():
-            IN.discard(out, ST.RUN_VARIABLES, [], rep.leftovers)
+            IN.discard(out, ST.run_variables(out), [], rep.leftovers)
     if rep.leftovers and not bad:
         notices.append(f"{out}: removed {len(rep.leftovers)} temporary file{'s' if len(rep.leftovers) != 1 else ''} "
                        f"of an interrupted write ({IN.summary([IN.Problem(x, 'leftover') for x in rep.leftovers], 3)})")

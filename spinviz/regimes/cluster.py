@@ -175,6 +175,7 @@ class Cluster:
         self.cluster = None
         self._quiet = None
         self._monitor = None
+        self._describe = None
 
     def __enter__(self) -> Cluster:
         from distributed import Client
@@ -197,6 +198,7 @@ class Cluster:
                                       f"start some with 'dask worker {self.scheduler}'") from None
                 polled(self.client.register_plugin, WarmUp(quiet_terminal=False))
                 self._check_versions()
+            self.describe                            # noqa: B018 -- asked now, while the scheduler is surely there
             self._monitor = _Monitor(self.client)
         except BaseException:
             self.close(fast=True)
@@ -242,9 +244,15 @@ class Cluster:
 
     @property
     def describe(self) -> str:
-        n = len(polled(self.client.nthreads))
-        where = "embedded LocalCluster" if self.scheduler is None else f"cluster at {self.scheduler}"
-        return f"{where}, {n} worker{'s' if n != 1 else ''}, {self.nthreads} thread{'s' if self.nthreads != 1 else ''}"
+        """Where it runs, as found when the cluster was reached (asked once: the scheduler may
+        be gone when the caller wants to say where it ran)."""
+        if self._describe is None:
+            n = polled(self.client.nthreads)
+            threads = max(1, sum(n.values()))
+            where = "embedded LocalCluster" if self.scheduler is None else f"cluster at {self.scheduler}"
+            self._describe = (f"{where}, {len(n)} worker{'s' if len(n) != 1 else ''}, "
+                              f"{threads} thread{'s' if threads != 1 else ''}")
+        return self._describe
 
     @property
     def where(self) -> str:
@@ -417,6 +425,20 @@ class Stats:
     write_s: float = 0.0                                  # the client writing the store (data, done, checksums)
     checksum_s: float = 0.0                               # of which: hashing the chunk files, recording the sums
     chunk_writes: int = 0
+
+    def merged(self, other: Stats | None) -> Stats:
+        """The measurements of two executions one after the other (refinement levels on one
+        cluster): counts and times added, the later one's incomplete state kept."""
+        if other is None:
+            return self
+        out = Stats(threads=max(self.threads, other.threads), incomplete=other.incomplete)
+        for name in ("runs", "tasks", "failed_tasks", "wall_s", "compute_s", "cpu_s", "write_s", "checksum_s",
+                     "chunk_writes"):
+            setattr(out, name, getattr(self, name) + getattr(other, name))
+        out.task_compute_s = self.task_compute_s + other.task_compute_s
+        out.max_rss_mb = {pid: max(self.max_rss_mb.get(pid, 0), other.max_rss_mb.get(pid, 0))
+                          for pid in {*self.max_rss_mb, *other.max_rss_mb}}
+        return out
 
     @property
     def overhead_share(self) -> float:

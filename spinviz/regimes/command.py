@@ -39,7 +39,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     a.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing Dask cluster (tcp://HOST:8786) instead "
                                                           "of the embedded LocalCluster")
     a.add_argument("--workers", type=_count, help="worker processes of the embedded LocalCluster (default: one per core)")
-    a.add_argument("--plot", metavar="PATH", help="also draw the delta-chi diagram (PNG) and PATH_hodographs.png")
+    a.add_argument("--plot", metavar="PATH", help="also draw the delta-chi diagram (PNG, every refinement level), "
+                   "PATH_hodographs.png and the interactive page PATH.html")
     a.add_argument("--runs-per-task", type=_count, default=None, help="runs per Dask task (default 32)")
     a.add_argument("--retry-failed", action="store_true", help="also recompute the runs the store records as failed")
     a.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -125,13 +126,45 @@ def _run(args) -> int:
 
 def verify(path: str, as_json: bool = False) -> int:
     """``--verify STORE``: one line per variable (chunks intact, or the damaged ones named),
-    the metadata, and a verdict; 0 if everything matches its checksums, 1 if not."""
+    the metadata, and a verdict -- for the store and each refinement level kept inside it
+    (``levelK``); 0 if everything matches its checksums, 1 if not."""
     import os
 
-    from . import store as ST
+    from .store import stored_levels
 
     if not os.path.isdir(path) or not os.path.exists(os.path.join(path, ".zgroup")):
         raise UsageError(f"--verify {printable(path, 200)}: not an atlas store (no such directory, or no .zgroup in it)")
+    reports = []
+    for k, where in enumerate(stored_levels(path)):
+        lines, rep = _verify_lines(where)
+        reports.append({"path": where, "level": k, "ok": rep.clean, "lines": lines, "runs_verified": rep.runs_done,
+                        "damaged_chunks": len(rep.bad_keys), "skeleton_ok": rep.skeleton_ok})
+    clean = all(r["ok"] for r in reports)
+    verdict = "ok" if clean else "DAMAGED"
+    n_bad = sum(r["damaged_chunks"] for r in reports)
+    runs = sum(r["runs_verified"] for r in reports)
+    levels = f" over {len(reports)} refinement levels" if len(reports) > 1 else ""
+    tail = (f"{runs} runs verified{levels}" if clean else
+            f"{n_bad} chunk(s) to recompute; the same atlas command recomputes their runs"
+            if all(r["skeleton_ok"] for r in reports) else
+            "the metadata cannot be recomputed; compute the atlas again into a new store")
+    if as_json:
+        first = reports[0]
+        print(json.dumps({"path": path, "ok": clean, "lines": first["lines"], "runs_verified": runs,
+                          "damaged_chunks": n_bad, "levels": reports[1:]}, indent=2))
+    else:
+        for r in reports:
+            prefix = f"level {r['level']}: " if len(reports) > 1 else ""
+            for line in r["lines"]:
+                print(printable(prefix + line, 2000))
+        print(printable(f"{path}: {verdict}: {tail}", 2000))
+    return 0 if clean else 1
+
+
+def _verify_lines(path: str):
+    """The lines ``--verify`` says about one store (one level), and the integrity report."""
+    from . import store as ST
+
     rep = ST.verify(path)
     lines = []
     if rep.skeleton is None:
@@ -155,19 +188,7 @@ def verify(path: str, as_json: bool = False) -> int:
                          f"and no usable record ({_names(records)})")
     if rep.leftovers:
         lines.append(f"leftovers: {len(rep.leftovers)} temporary file(s) of an interrupted write (removed on resume)")
-    verdict = "ok" if rep.clean else "DAMAGED"
-    n_bad = len(rep.bad_keys)
-    tail = (f"{rep.runs_done} runs verified" if rep.clean else
-            f"{n_bad} chunk(s) to recompute; the same atlas command recomputes their runs" if rep.skeleton_ok else
-            "the metadata cannot be recomputed; compute the atlas again into a new store")
-    if as_json:
-        print(json.dumps({"path": path, "ok": rep.clean, "lines": lines, "runs_verified": rep.runs_done,
-                          "damaged_chunks": n_bad}, indent=2))
-    else:
-        for line in lines:
-            print(printable(line, 2000))
-        print(printable(f"{path}: {verdict}: {tail}", 2000))
-    return 0 if rep.clean else 1
+    return lines, rep
 
 
 def _names(problems, limit: int = 4) -> str:

@@ -3,7 +3,7 @@ SVG, a cell's type shares and evidence on hover, its hodograph on click.
 
 No library and no network: the page is one file with inline SVG, CSS and a few lines of
 JavaScript.  Each cell is a ``<g>`` whose ``<title>`` the browser shows on hover; clicking it
-(or opening the page with ``#open=MODEL:I:J``) draws the stored series of the cell's first
+(or opening the page with ``#open=MODEL:LEVEL:I:J``, level 0 the spec's grid) draws the stored series of the cell's first
 member -- omega1 sqrt(tau) against omega2 sqrt(tau) and omega_perp sqrt(tau) against omega3
 sqrt(tau), dots coloured by log tau -- in the side panel.  The series travel as base64 int16
 at 1e-3 resolution: every other sample of the last ``2 SERIES_POINTS`` (the late decades,
@@ -16,11 +16,12 @@ import base64
 import html
 import json
 import math
+import warnings
 
 import numpy as np
 
 from . import formulas as FM
-from .plot import COLORS, LINE_STYLE, WORDS, compose
+from .plot import COLORS, LINE_STYLE, WORDS, compose_levels
 
 W, H = 560, 470                # one panel's plot area, px
 PAD_L, PAD_B, PAD_T = 52, 40, 12
@@ -54,15 +55,15 @@ def _panel(model: str, cells: list[dict], evidence) -> str:
            f'aria-label="{model} model diagram">',
            f'<text x="{PAD_L + W / 2}" y="{PAD_T - 1}" class="ptitle">{model} model</text>']
     for c in cells:
-        cid = f"{model}:{c['i']}:{c['j']}"
+        cid = c["id"]
         out.append(f'<g class="cell" data-id="{cid}"><title>{html.escape(_tip(model, c, evidence(c)))}</title>')
         x = c["x0"]
         y0, y1 = _y(c["y1"]), _y(c["y0"])
         for name, frac, hatched in c["bars"]:
             w = (c["x1"] - c["x0"]) * frac
             fill = f"url(#hatch-{name.replace('.', '_')})" if hatched else COLORS[name]
-            out.append(f'<rect x="{_x(x):.2f}" y="{y0:.2f}" width="{_x(x + w) - _x(x) + 0.05:.2f}" '
-                       f'height="{y1 - y0 + 0.05:.2f}" fill="{fill}"/>')
+            out.append(f'<rect x="{_x(x):.2f}" y="{y0:.2f}" width="{_x(x + w) - _x(x) + 0.4:.2f}" '
+                       f'height="{y1 - y0 + 0.4:.2f}" fill="{fill}"/>')
             x += w
         if c["coexist"]:
             out.append(f'<circle cx="{_x(c["delta"]):.1f}" cy="{_y(c["chi_deg"]):.1f}" r="1.6" class="co"/>')
@@ -121,7 +122,8 @@ def _pack(series: dict) -> dict:
         if len(tau) < 2:
             continue
         x = np.clip(np.round(w * np.sqrt(tau)[:, None] * 1e3), -32000, 32000).astype("<i2")
-        out[cid] = {"label": s.get("label", ""), "lt0": float(np.log10(tau[0])), "lt1": float(np.log10(tau[-1])),
+        out[cid] = {"label": s.get("label", ""), "where": s.get("where", cid),
+                    "lt0": float(np.log10(tau[0])), "lt1": float(np.log10(tau[-1])),
                     "b64": base64.b64encode(x.tobytes()).decode()}
     return out
 
@@ -145,7 +147,7 @@ function hodo(id){
   const ax = `<line x1="10" x2="210" y1="110" y2="110" stroke="#bbb"/><line x1="110" x2="110" y1="10" y2="210" stroke="#bbb"/>`;
   const fig = (title, dots) => `<svg viewBox="0 0 220 240" class="h"><text x="110" y="232" class="tick">` +
     `${title}</text>${ax}${dots}</svg>`;
-  box.innerHTML = `<h3>${id.replaceAll(':', ' ')}: first start, label ${s.label}</h3>` +
+  box.innerHTML = `<h3>${s.where}: first start, label ${s.label}</h3>` +
     fig('\u03c9\u2081\u221a\u03c4 \u2192, \u03c9\u2082\u221a\u03c4 \u2191', a) +
     fig('\u03c9\u22a5\u221a\u03c4 \u2192, \u03c9\u2083\u221a\u03c4 \u2191', b) +
     `<p>log\u2081\u2080 \u03c4 from ${s.lt0.toFixed(1)} (violet) to ${s.lt1.toFixed(1)} (green); ` +
@@ -159,25 +161,37 @@ STYLE = """
 body{font-family:sans-serif;margin:12px;color:#222} h1{font-size:18px} .row{display:flex;flex-wrap:wrap;gap:8px}
 .panel{width:620px;height:auto} .ptitle{font-size:14px;text-anchor:middle} .tick{font-size:10px;text-anchor:middle}
 .axis{font-size:12px;text-anchor:middle} .lbl{font-size:10px;paint-order:stroke;stroke:#fff;stroke-width:3px}
+.cell rect{shape-rendering:crispEdges}
 .cell:hover rect{opacity:.75} .cell.sel rect{stroke:#000;stroke-width:1} .co{fill:#000;stroke:#fff;stroke-width:.5}
 #hodo{min-width:460px} .h{width:220px} .legend span{display:inline-block;margin:2px 10px 2px 0;font-size:12px}
 .legend i{display:inline-block;width:14px;height:10px;margin-right:4px;border:1px solid #888;vertical-align:middle}
 """
 
 
-def page(ds, series: dict | None = None, evidence=None, title: str | None = None) -> str:
-    """The page of one atlas (an ``open_atlas`` Dataset).  series : cell id ("model:i:j") ->
+def page(levels, series: dict | None = None, evidence=None, title: str | None = None) -> str:
+    """The page of one atlas: ``levels`` an ``open_atlas`` Dataset or the list of its
+    refinement levels (``plot.open_levels``).  series : cell id ("model:level:i:j") ->
     {"tau", "omega" (N, 3), "label"}; evidence(model, cell) -> a small dict shown on hover."""
+    levels = levels if isinstance(levels, (list, tuple)) else [levels]
+    ds = levels[0]
     models = [str(m) for m in ds["model"].values]
-    panels = [_panel(m, compose(ds, m), (lambda c, m=m: evidence(m, c)) if evidence else (lambda c: None)) for m in models]
+    cells = {m: compose_levels(levels, m) for m in models}
+    panels = [_panel(m, cells[m], (lambda c, m=m: evidence(m, c)) if evidence else (lambda c: None)) for m in models]
+    drawn = {c["id"] for m in models for c in cells[m]}          # a cell a finer level covers is not drawn
+    series = {cid: s for cid, s in (series or {}).items() if cid in drawn}
     hatches = "".join(
         f'<pattern id="hatch-{k.replace(".", "_")}" patternUnits="userSpaceOnUse" width="4" height="4" '
         f'patternTransform="rotate(45)"><rect width="4" height="4" fill="{c}"/><line x1="0" y1="0" x2="0" y2="4" '
         f'stroke="#fff" stroke-width="1.4"/></pattern>' for k, c in COLORS.items())
-    legend = "".join(f'<span><i style="background:{COLORS[k]}"></i>{html.escape(w)}</span>' for k, w in WORDS.items())
+    found = {name for m in models for c in cells[m] for name, _, _ in c["bars"]}
+    legend = "".join(f'<span><i style="background:{COLORS[k]}"></i>{html.escape(w)}</span>'
+                     for k, w in WORDS.items() if k in found)
     legend += ('<span><i style="background:repeating-linear-gradient(45deg,#888 0 2px,#fff 2px 4px)"></i>'
                'hatched: still approaching that type (a slow hand-over)</span><span>\u25cf two types coexist</span>'
                '<span>black lines: the paper\'s boundaries; blue/red: spinviz\'s (each labelled)</span>')
+    if len(levels) > 1:
+        legend += (f'<span>smaller cells: {len(levels) - 1} refinement level(s) where the types change, down to '
+                   f'{levels[-1].sizes["delta"]} \u00d7 {levels[-1].sizes["chi"]} cells</span>')
     head = html.escape(title or ds.attrs.get("title", "regime atlas"))
     data = json.dumps(_pack(series or {}), separators=(",", ":")).replace("</", "<\\/")
     return (f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>{head}</title><style>{STYLE}</style>'
@@ -185,3 +199,35 @@ def page(ds, series: dict | None = None, evidence=None, title: str | None = None
             f'<div class="row">{"".join(panels)}<div id="hodo"><p>Hover a cell for its types and evidence; click it for '
             f'the hodograph of its first start.</p></div></div><div class="legend">{legend}</div>'
             f'<script type="application/json" id="series">{data}</script><script>{SCRIPT}</script></body></html>')
+
+
+EVIDENCE = ("slope_perp", "slope_3")     # shown on hover: the exponents of |omega_perp| and |omega_3| in tau
+
+
+def page_of(levels: list) -> str:
+    """The page of an atlas read from its store: every level's cells, the stored series of
+    each cell's first start (``[output].series``), and on hover the median confidence and
+    fitted exponents of the cell's runs."""
+    series, medians = {}, {}
+    for k, ds in enumerate(levels):
+        has_series = "series" in ds and ds.sizes.get("start", 0) > 0
+        tau = ds["tau"].values if has_series else None
+        for model in [str(m) for m in ds["model"].values]:
+            sub = ds.sel(model=model)
+            lab = sub["label"].values
+            done = (lab != "missing").all(axis=-1)
+            conf = np.where(done[..., None], sub["confidence"].values, np.nan)
+            ev = sub["evidence"].sel(quantity=list(EVIDENCE)).values
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)        # all-NaN cells: no median
+                med_c, med_e = np.nanmedian(conf, axis=-1), np.nanmedian(ev, axis=-2)
+            w = sub["series"].isel(start=0).values.astype(float) if has_series else None
+            for i, j in zip(*np.nonzero(done)):
+                cid = f"{model}:{k}:{i}:{j}"
+                medians[cid] = {"confidence": med_c[i, j], **{q: med_e[i, j, n] for n, q in enumerate(EVIDENCE)}}
+                if w is not None and np.isfinite(w[i, j]).any():
+                    where = (f"{model} model, \u03b4 = {float(ds['delta'][i]):+.3f}, "
+                             f"\u03c7 = {math.degrees(float(ds['chi'][j])):.2f}\u00b0")
+                    series[cid] = {"tau": tau, "omega": w[i, j], "label": str(lab[i, j, 0]), "where": where}
+    return page(levels, series, lambda model, c: {q: v for q, v in medians.get(c["id"], {}).items()
+                                                   if np.isfinite(v)})

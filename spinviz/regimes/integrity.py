@@ -39,7 +39,7 @@ DIR = ".checksums"
 SKELETON = "skeleton.json"
 CHUNKS = "chunks"
 PARTIAL = ".partial"                  # what an interrupted atomic write leaves (Zarr's and spinviz's temporaries)
-TRAILING = {"evidence": 1, "omega_final": 1}   # per-run variables with one more (unchunked) dimension
+TRAILING = {"evidence": 1, "omega_final": 1, "series": 2}   # per-run variables' further (unchunked) dimensions
 
 
 def sha256_file(path: str) -> str | None:

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import os
+import textwrap
 
 import numpy as np
 
@@ -54,11 +55,17 @@ def hodograph_path(path: str) -> str:
     return f"{stem}_hodographs{ext}"
 
 
+def page_path(path: str) -> str:
+    """The interactive page drawn beside the diagram ``path``: ``<stem>.html``."""
+    return f"{os.path.splitext(path)[0]}.html"
+
+
 def check_plot_paths(path: str, out: str, spec=None) -> list[str]:
-    """The two picture paths of ``--plot PATH``, checked before any work."""
+    """The three output paths of ``--plot PATH`` -- the diagram, the hodographs and the
+    page -- checked before any work."""
     if os.path.splitext(path)[1].lower() != ".png":
         raise UsageError(f"--plot: {path}: the pictures are PNG; give a path ending in .png")
-    paths = [path, hodograph_path(path)]
+    paths = [path, hodograph_path(path), page_path(path)]
     for p in paths:
         if os.path.abspath(p).startswith(os.path.abspath(out) + os.sep) or os.path.abspath(p) == os.path.abspath(out):
             raise UsageError(f"--plot: {p}: inside the store {out}")
@@ -67,14 +74,26 @@ def check_plot_paths(path: str, out: str, spec=None) -> list[str]:
     return paths
 
 
-def draw(store_path: str, paths: list[str]) -> list[str]:
-    """Both pictures of the store, landed together (atomically)."""
-    from .store import open_atlas
+def open_levels(store_path: str) -> list:
+    """The atlas at ``store_path`` and its refinement levels (``store.stored_levels``), each
+    opened with ``store.open_atlas``: the coarse grid first."""
+    from .store import open_atlas, stored_levels
 
-    ds = open_atlas(store_path)
+    return [open_atlas(p) for p in stored_levels(store_path)]
+
+
+def draw(store_path: str, paths: list[str]) -> list[str]:
+    """The pictures of the store -- diagram (every refinement level), hodographs and, when a
+    third path is given, the interactive page -- landed together (atomically)."""
+    levels = open_levels(store_path)
     with Outputs(paths) as tmps:
-        diagram(ds, tmps[0])
-        hodographs(ds, tmps[1])
+        diagram(levels, tmps[0])
+        hodographs(levels[0], tmps[1])
+        if len(paths) > 2:
+            from .html import page_of
+
+            with open(tmps[2], "w", encoding="utf-8") as f:
+                f.write(page_of(levels))
     return list(paths)
 
 
@@ -126,18 +145,22 @@ def _edges(v: np.ndarray, lo: float, hi: float) -> np.ndarray:
     return np.concatenate([[max(lo, 2 * v[0] - mid[0])], mid, [min(hi, 2 * v[-1] - mid[-1])]])
 
 
-def diagram(ds, path: str, title: str | None = None):
+def diagram(levels, path: str, title: str | None = None):
     """The delta-chi diagram, one panel per model, like the paper's figures 2, 3.D and 5: each
     cell split into bars, one per type, as wide as that type's share of the cell's members
     (hatched: the share still approaching it at tau_end, a slow hand-over), a dot where two
     types coexist among the starts; the analytic boundaries labelled with their equations; the
-    DAST families of figure 5; a legend in words."""
+    DAST families of figure 5; a legend in words.  ``levels``: one atlas Dataset or the list of
+    its refinement levels (``open_levels``), each finer level drawn over the coarser."""
+    levels = levels if isinstance(levels, (list, tuple)) else [levels]
+    ds = levels[0]
     plt = pyplot()
     models = [str(m) for m in ds["model"].values]
-    fig, axes = plt.subplots(1, len(models), figsize=(7.2 * len(models), 7.6), squeeze=False)
+    one = len(models) == 1                  # one panel: the legend in 2 columns below, taller
+    fig, axes = plt.subplots(1, len(models), figsize=(9.0, 8.8) if one else (7.2 * len(models), 7.6), squeeze=False)
     seen = set()
     for ax, model in zip(axes[0], models):
-        seen |= _cells(ax, ds, model)
+        seen |= _cells(ax, compose_levels(levels, model))
         _lines(ax, model)
         n = ds.sizes["member"]
         ax.set_xlim(-1, 1)
@@ -145,21 +168,26 @@ def diagram(ds, path: str, title: str | None = None):
         ax.set_xlabel("\u03b4 = 1 \u2212 I\u2083/I\u2081   (prolate \u2190 0 \u2192 oblate)")
         ax.set_ylabel("\u03c7 = angle of the dipole from the symmetry axis (deg)")
         ax.set_title(f"{model} model: type of each of {n} starts per cell", fontsize=11)
-    _legend(fig, seen)
+    _legend(fig, seen, ncol=2 if one else 3)
     s = _spec(ds)
     w0 = s["members"]["omega"]
     starts = f"|\u03c9\u2080| = {w0}" if w0 else "explicit starts"
-    fig.suptitle(title or f"{ds.attrs.get('title', 'atlas')}   (\u03c4_end = {s['run']['tau_end']:.0e}, {starts})",
-                 y=0.985, fontsize=11)
-    fig.tight_layout(rect=(0, 0.13, 1, 0.96))
+    grid = f"{ds.sizes['delta']} \u00d7 {ds.sizes['chi']} cells"
+    if len(levels) > 1:
+        fine = levels[-1]
+        grid += f", refined {len(levels) - 1}\u00d7 near the boundaries to {fine.sizes['delta']} \u00d7 {fine.sizes['chi']}"
+    head = title or f"{ds.attrs.get('title', 'atlas')}   ({grid}; \u03c4_end = {s['run']['tau_end']:.0e}, {starts})"
+    fig.suptitle("\n".join(textwrap.wrap(head, 95 if one else 150)), y=0.985, fontsize=11)
+    fig.tight_layout(rect=(0, 0.2 if one else 0.13, 1, 0.95))
     _save_small(fig, path, dpi=110)
 
 
-def compose(ds, model: str) -> list[dict]:
+def compose(ds, model: str, level: int = 0) -> list[dict]:
     """The diagram's cells of one model, as plain data for the PNG and the HTML page: each a
-    dict with ``i``, ``j``, the rectangle ``x0, x1`` (delta) and ``y0, y1`` (chi, deg), the
-    ``bars`` -- (type, width fraction, hatched) left to right in ``ORDER`` -- ``coexist`` and
-    ``counts`` (type or "->type" -> members)."""
+    dict with ``i``, ``j``, ``level``, ``id`` ("model:level:i:j"), the rectangle ``x0, x1``
+    (delta) and ``y0, y1`` (chi, deg), the ``bars`` -- (type, width fraction, hatched) left to
+    right in ``ORDER`` -- ``coexist`` and ``counts`` (type or "->type" -> members).  On a
+    refinement level (``level`` > 0) only the cells it computed."""
     deltas, chis = ds["delta"].values, np.degrees(ds["chi"].values)
     de, ce = _edges(deltas, -1.0, 1.0), _edges(chis, 0.0, 90.0)
     lab, appr = cell_types(ds, model)
@@ -168,6 +196,8 @@ def compose(ds, model: str) -> list[dict]:
     cells = []
     for i in range(len(deltas)):
         for j in range(len(chis)):
+            if level and (lab[i, j] == "missing").all():
+                continue
             bars, counts = [], {}
             for name in ORDER:
                 m = lab[i, j] == name
@@ -181,34 +211,47 @@ def compose(ds, model: str) -> list[dict]:
                 if ka:
                     bars.append((name, ka / n, True))
                     counts["->" + name] = ka
-            cells.append({"i": i, "j": j, "delta": float(deltas[i]), "chi_deg": float(chis[j]), "x0": float(de[i]),
-                          "x1": float(de[i + 1]), "y0": float(ce[j]), "y1": float(ce[j + 1]), "bars": bars,
-                          "coexist": bool(co[i, j]), "counts": counts})
+            cells.append({"i": i, "j": j, "level": level, "id": f"{model}:{level}:{i}:{j}", "delta": float(deltas[i]),
+                          "chi_deg": float(chis[j]), "x0": float(de[i]), "x1": float(de[i + 1]), "y0": float(ce[j]),
+                          "y1": float(ce[j + 1]), "bars": bars, "coexist": bool(co[i, j]), "counts": counts})
     return cells
 
 
-def _cells(ax, ds, model: str) -> set:
-    """The bars of every cell (one PatchCollection per type and hatching) and the coexistence dots."""
+def compose_levels(levels: list, model: str) -> list[dict]:
+    """``compose`` of every refinement level, coarse first, without the cells a finer level
+    computed again (its four children cover each of them whole)."""
+    per = [compose(ds, model, level=k) for k, ds in enumerate(levels)]
+    out = []
+    for k, cells in enumerate(per):
+        finer = {(c["i"], c["j"]) for c in per[k + 1]} if k + 1 < len(per) else set()
+        out += [c for c in cells if (2 * c["i"], 2 * c["j"]) not in finer]
+    return out
+
+
+def _cells(ax, cells: list[dict]) -> set:
+    """The bars of every cell (one PatchCollection per level, type and hatching, finer levels
+    on top) and the coexistence dots."""
     from matplotlib.collections import PatchCollection
     from matplotlib.patches import Rectangle
 
     rects: dict = {}
     seen = set()
     dots = []
-    for c in compose(ds, model):
+    for c in cells:
         x, w, h = c["x0"], c["x1"] - c["x0"], c["y1"] - c["y0"]
         for name, frac, hatched in c["bars"]:
-            rects.setdefault((name, hatched), []).append(Rectangle((x, c["y0"]), w * frac, h))
+            rects.setdefault((c["level"], name, hatched), []).append(Rectangle((x, c["y0"]), w * frac, h))
             x += w * frac
             seen.add("approaching" if hatched else name)
             seen.add(name)
         if c["coexist"]:
-            dots.append((c["delta"], c["chi_deg"]))
-    for (name, hatched), rs in rects.items():
+            dots.append((c["delta"], c["chi_deg"], c["level"]))
+    for (level, name, hatched), rs in sorted(rects.items(), key=lambda kv: kv[0][0]):
         ax.add_collection(PatchCollection(rs, facecolor=COLORS[name], edgecolor="white" if hatched else "none",
-                                          hatch="////" if hatched else None, linewidth=0.0))
+                                          hatch="////" if hatched else None, linewidth=0.0, zorder=1 + 0.01 * level))
     if dots:
-        ax.scatter(*zip(*dots), s=7, color="black", edgecolors="white", linewidths=0.4, zorder=5)
+        d, c, lv = zip(*dots)
+        ax.scatter(d, c, s=7.0 / 2.0 ** np.asarray(lv), color="black", edgecolors="white", linewidths=0.4, zorder=5)
         seen.add("coexisting")
     return seen
 
@@ -238,7 +281,7 @@ def _lines(ax, model: str) -> None:
         ax.text(-0.98, np.degrees(fam["chi"][0]) + 0.8, fam["short"], fontsize=7, color="0.2")
 
 
-def _legend(fig, seen: set) -> None:
+def _legend(fig, seen: set, ncol: int = 3) -> None:
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -257,7 +300,7 @@ def _legend(fig, seen: set) -> None:
     extra += [Line2D([], [], color="k", lw=1.6, label="black: the paper's domain boundaries"),
               Line2D([], [], color="#0b3d91", lw=1.6, label="blue, red: lines spinviz derived (labelled)"),
               Line2D([], [], color="0.25", lw=1.2, label="grey: the DAST crystal families of figure 5")]
-    fig.legend(handles=handles + extra, loc="lower center", ncol=3, fontsize=8, frameon=False, bbox_to_anchor=(0.5, 0.0))
+    fig.legend(handles=handles + extra, loc="lower center", ncol=ncol, fontsize=8, frameon=False, bbox_to_anchor=(0.5, 0.0))
 
 
 def _save_small(fig, path: str, dpi: int) -> None:
@@ -285,16 +328,20 @@ def _spec(ds) -> dict:
 def representatives(ds) -> list[tuple]:
     """(model, label, delta, chi, member index, confidence) for each type found, per model:
     the cell where the type has its largest share (ties: the one nearest the centre of that
-    type's cells), and there the member labelled so with the highest confidence."""
+    type's cells), and there the member labelled so with the highest confidence -- preferring
+    the members whose series the store keeps (``[output].series``), so that drawing needs no
+    integration unless a type was met only among the others."""
     out = []
     d_all, c_all = ds["delta"].values, ds["chi"].values
+    kept = ds.sizes["start"] if "series" in ds else 0
     for model in [str(m) for m in ds["model"].values]:
-        lab = ds["label"].sel(model=model).values
-        conf = ds["confidence"].sel(model=model).values
+        lab_all = ds["label"].sel(model=model).values
+        conf_all = ds["confidence"].sel(model=model).values
         for name in ORDER:
             if name in ("other", "failed", "missing", "approaching"):
                 continue
-            m = lab == name
+            width = kept if (lab_all[..., :kept] == name).any() else lab_all.shape[-1]
+            m, conf = lab_all[..., :width] == name, conf_all[..., :width]
             if not m.any():
                 continue
             share = m.mean(axis=-1)
@@ -307,33 +354,45 @@ def representatives(ds) -> list[tuple]:
     return out
 
 
-def hodographs(ds, path: str):
-    """One panel per type found (per model), the most confident run of that type."""
-    from .runs import Settings, integrate
+def series_of(ds, model: str, i: int, j: int, k: int):
+    """(tau, omega (N, 3)) of member ``k`` of cell (i, j): read from the store when it kept
+    that series, else integrated again (the runs are deterministic)."""
+    if "series" in ds and k < ds.sizes["start"]:
+        w = ds["series"].sel(model=model).isel(delta=i, chi=j, start=k).values.astype(float)
+        if np.isfinite(w).any():
+            return ds["tau"].values, w
+    from .runs import integrate
+    from .spec import settings_from_canonical
 
+    st = settings_from_canonical(_spec(ds))
+    r = integrate(model, float(ds["delta"].values[i]), float(ds["chi"].values[j]), ds["omega0"].values[k], st)
+    return r.tau, r.omega
+
+
+def hodographs(ds, path: str):
+    """One panel per type found (per model), the most confident run of that type, its series
+    read from the store."""
     plt = pyplot()
     reps = representatives(ds)
-    s = _spec(ds)
-    rs = s["run"]
-    st = Settings(tau_end=rs["tau_end"], tau_start=rs["tau_start"], per_decade=max(60, rs["samples_per_decade"]),
-                  rtol=rs["rtol"], max_steps=rs["max_steps"], window=s["classify"]["window_decades"])
     n = max(1, len(reps))
     cols = min(n, 3)
     rows = math.ceil(n / cols)
     fig = plt.figure(figsize=(3.7 * cols, 3.5 * rows))
     omega0 = ds["omega0"].values
+    d_all, c_all = list(ds["delta"].values), list(ds["chi"].values)
+    tau_start = float(_spec(ds)["run"].get("tau_start", 1e-2))
     for idx, (model, name, d, c, k, conf) in enumerate(reps):
-        r = integrate(model, d, c, omega0[k], st)
+        tau, omega = series_of(ds, model, d_all.index(d), c_all.index(c), k)
         w0 = float(np.linalg.norm(omega0[k]))
         # omega sqrt(tau) has a limit for every braking type; a residual rotation does not brake
-        scale = np.full_like(r.tau, 1.0 / w0) if name == "R" else np.sqrt(r.tau + 1.0 / w0**2)
-        x = r.omega * scale[:, None]
+        scale = np.full_like(tau, 1.0 / w0) if name == "R" else np.sqrt(tau + 1.0 / w0**2)
+        x = omega * scale[:, None]
         ax = fig.add_subplot(rows, cols, idx + 1, projection="3d")
-        lt = np.log10(np.maximum(r.tau, st.tau_start))
+        lt = np.log10(np.maximum(tau, tau_start))
         # points, not a line: log-spaced samples alias the precession, and chords between
         # them would draw a motion that never happened
         ax.scatter(x[:, 0], x[:, 1], x[:, 2], c=lt, cmap="viridis", s=2.5, linewidths=0, depthshade=False)
-        lim = float(np.max(np.abs(x))) * 1.05 or 1.0
+        lim = float(np.nanmax(np.abs(x))) * 1.05 or 1.0
         ax.set_xlim(-lim, lim)
         ax.set_ylim(-lim, lim)
         ax.set_zlim(-lim, lim)

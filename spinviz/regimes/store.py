@@ -74,6 +74,12 @@ FORMULAS = (
     "truncated T4 A2", "truncated T4 beta", "truncated T2 B2", "truncated T2 alpha",
 )
 RUN_VARIABLES = tuple(PER_RUN) + ("evidence", "omega_final")   # what a run writes (``done`` among them)
+SERIES = "series"          # omega(tau) of a cell's first members (``[output].series``), when the spec keeps any
+
+
+def run_variables(path: str) -> tuple:
+    """The per-run variables of the store at ``path``: ``RUN_VARIABLES``, and ``series`` where kept."""
+    return RUN_VARIABLES + ((SERIES,) if os.path.isdir(os.path.join(path, SERIES)) else ())
 MAX_CHUNK_RUNS = 4096
 MAX_CHUNK_MEMBERS = 256
 
@@ -125,6 +131,13 @@ def template(spec, chunks: tuple):
                         {"description": "the classifier's measurements (see the quantity coordinate and classify.EVIDENCE)"})
     data["omega_final"] = (DIMS + ("axis",), da.full(shape + (3,), np.nan, chunks=chunks + (-1,)),
                            {"description": "body-frame omega at tau_reached (dimensionless)"})
+    if spec.series:
+        n = len(spec.settings.times())
+        data[SERIES] = (("model", "delta", "chi", "start", "sample", "axis"),
+                        da.full(shape[:3] + (spec.series, n, 3), np.nan, dtype=np.float32,
+                                chunks=chunks[:3] + (spec.series, n, 3)),
+                        {"description": "omega(tau) of the first members of every cell, body frame, dimensionless "
+                                        "(float32; samples at the coordinate tau); the hodographs read these"})
     data["omega0"] = (("member", "axis"), np.asarray(spec.omega0, dtype=float),
                       {"description": "body-frame omega(0), the same at every cell and model (dimensionless)"})
     pred = np.array([[predictions(float(d), float(c)) for c in spec.chis] for d in spec.deltas], dtype=float)
@@ -141,6 +154,9 @@ def template(spec, chunks: tuple):
         "quantity": list(C.EVIDENCE),
         "formula": list(FORMULAS),
     }
+    if spec.series:
+        coords["start"] = np.arange(spec.series)
+        coords["tau"] = ("sample", spec.settings.times(), {"long_name": "tau = t/tau0 of the series' samples"})
     s = spec.settings
     attrs = {
         "title": spec.title or os.path.basename(spec.path),
@@ -197,6 +213,20 @@ def _same_spec(attrs: dict, spec) -> bool:
         return False
 
 
+def level_path(out: str, k: int) -> str:
+    """Where level ``k`` of the atlas at ``out`` is kept (inside it: a Zarr subgroup)."""
+    return out if k == 0 else os.path.join(out, f"level{k}")
+
+
+def stored_levels(out: str) -> list[str]:
+    """The stores of an atlas's levels that exist: ``out`` itself, then ``levelK`` for
+    K = 1, 2, ... up to the first one missing."""
+    paths = [out]
+    while os.path.exists(os.path.join(level_path(out, len(paths)), ".zgroup")):
+        paths.append(level_path(out, len(paths)))
+    return paths
+
+
 def done_mask(path: str) -> np.ndarray:
     """Which runs are on disk, shape (model, delta, chi, member), bool."""
     import zarr
@@ -240,7 +270,8 @@ class Writer:
 
         self.path = path
         self.group = zarr.open_group(path, mode="r+", zarr_format=2)
-        self.arrays = {k: self.group[k] for k in RUN_VARIABLES}
+        self.variables = run_variables(path)
+        self.arrays = {k: self.group[k] for k in self.variables}
         self.shape = tuple(self.arrays["done"].shape)
         self.chunks = tuple(self.arrays["done"].chunks)
         self.expected = expected
@@ -280,20 +311,38 @@ class Writer:
         with deferred():                      # a stop signal waits for these few milliseconds
             IN.forget(self.path, key)         # from here until the record below, the chunk is unverified
             for name, arr in self.arrays.items():
-                if name == "done":
+                if name in ("done", SERIES):
                     continue
                 buf = np.empty(shape + tuple(arr.shape[4:]), dtype=arr.dtype) if whole else np.asarray(arr[region])
                 for res in p.parts:
                     buf[_relative(res["region"], lo)] = res["data"][name][None]
                 arr[region] = buf
+            if SERIES in self.arrays and key[3] == 0:
+                self._write_series(region, lo, p.parts, whole)
             done = new if whole else (np.asarray(self.arrays["done"][region]) == 1) | new
             self.arrays["done"][region] = done.astype(np.int8)
             t1 = time.perf_counter()
-            IN.record(self.path, RUN_VARIABLES, key, int(done.sum()))
+            IN.record(self.path, self.variables, key, int(done.sum()))
             self.checksum_s += time.perf_counter() - t1
         self.written_runs += int(new.sum())
         self.chunk_writes += 1
         self.write_s += time.perf_counter() - t0
+
+
+    def _write_series(self, region, lo, parts, whole: bool) -> None:
+        """The series of the chunk's first members (their own array: (model, delta, chi,
+        start, sample, axis), one chunk file per run chunk whose member block is the first)."""
+        arr = self.arrays[SERIES]
+        sreg = region[:3] + (slice(0, arr.shape[3]),)
+        shape = tuple(r.stop - r.start for r in sreg) + tuple(arr.shape[4:])
+        buf = np.full(shape, np.nan, dtype=arr.dtype) if whole else np.asarray(arr[sreg])
+        for res in parts:
+            if "series" not in res["data"]:
+                continue
+            m, ds, cs, ms = res["region"]
+            ks = res["data"]["series"].shape[2]
+            buf[m - lo[0], ds[0] - lo[1]:ds[1] - lo[1], cs[0] - lo[2]:cs[1] - lo[2], ms[0]:ms[0] + ks] = res["data"]["series"]
+        arr[sreg] = buf
 
 
 def _relative(r, lo) -> tuple:
@@ -305,7 +354,7 @@ def _relative(r, lo) -> tuple:
 
 def verify(path: str) -> IN.Report:
     """The store's files against their checksums (``integrity.verify``)."""
-    return IN.verify(path, RUN_VARIABLES)
+    return IN.verify(path, run_variables(path))
 
 
 def open_atlas(path: str):

@@ -1,0 +1,48 @@
+"""Headless Chromium for the tests of web pages (the docs site, the atlas page): Debian's
+``chromium`` package, no network, no display."""
+
+from __future__ import annotations
+
+import html
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+
+# Flags for a root user on a machine whose network is closed: without the background
+# networking ones Chromium keeps trying (and failing) to reach Google's hosts.
+CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                  "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                  "--hide-scrollbars", "--virtual-time-budget=10000"]
+
+
+def chromium(page: Path, tmp_path: Path, *args: str, fragment: str = "") -> subprocess.CompletedProcess:
+    """Run Chromium on ``page`` (a file; ``fragment``: what follows '#' in its address)."""
+    profile = tmp_path / f"profile-{page.stem}-{len(list(tmp_path.iterdir()))}"
+    uri = page.as_uri() + (f"#{fragment}" if fragment else "")
+    r = subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, f"--user-data-dir={profile}", *args, uri],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr[-2000:]
+    return r
+
+
+def screenshot(page: Path, tmp_path: Path, size=(1280, 900), fragment: str = "") -> np.ndarray:
+    """The page as Chromium draws it, RGB (height, width, 3)."""
+    from PIL import Image
+
+    png = tmp_path / f"{page.stem}-{len(list(tmp_path.iterdir()))}.png"
+    chromium(page, tmp_path, f"--screenshot={png}", f"--window-size={size[0]},{size[1]}", fragment=fragment)
+    return np.asarray(Image.open(png).convert("RGB"))
+
+
+def page_text(page: Path, tmp_path: Path, fragment: str = "") -> tuple[str, str]:
+    """The DOM after the page's scripts ran (MathJax included), and its visible text."""
+    dom = chromium(page, tmp_path, "--dump-dom", fragment=fragment).stdout
+    text = re.sub(r"<(script|style)\b.*?</\1>", " ", dom, flags=re.S)
+    text = re.sub(r"</?(?:p|div|dt|dd|li|h[1-6]|br|td|th|pre|section|nav|header|footer)\b[^>]*>", " ", text)
+    text = html.unescape(re.sub(r"<[^>]+>", "", text))          # inline markup: no space added
+    return dom, re.sub(r"\s+", " ", text)

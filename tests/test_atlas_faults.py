@@ -326,21 +326,21 @@ class External:
     """``dask scheduler`` and ``dask worker`` processes (each in its own session, as on other
     machines), stopped at the end whatever happened."""
 
-    def __init__(self, workers: int = 2):
+    def __init__(self, workers: int = 2, worker_args=(), env=None):
         self.port = _free_port()
         self.addr = f"tcp://127.0.0.1:{self.port}"
+        self.env = {**ENV, **(env or {})}
         self.scheduler = self._start([DASK, "scheduler", "--host", "127.0.0.1", "--port", str(self.port),
                                       "--no-dashboard"])
-        self.workers = [self._start([DASK, "worker", self.addr, "--nthreads", "1", "--no-dashboard"])
+        self.workers = [self._start([DASK, "worker", self.addr, "--nthreads", "1", "--no-dashboard", *worker_args])
                         for _ in range(workers)]
         from distributed import Client
 
         with Client(self.addr, timeout=30) as c:
             c.wait_for_workers(workers, timeout=60)
 
-    @staticmethod
-    def _start(cmd):
-        return subprocess.Popen(cmd, env=ENV, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    def _start(self, cmd):
+        return subprocess.Popen(cmd, env=self.env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                 start_new_session=True)
 
     def kill_group(self, p, sig=signal.SIGKILL):
@@ -359,8 +359,8 @@ class External:
 def external():
     made = []
 
-    def make(workers=2):
-        made.append(External(workers))
+    def make(workers=2, **kw):
+        made.append(External(workers, **kw))
         return made[-1]
 
     yield make
@@ -434,6 +434,94 @@ def test_workers_killed_at_random_points_same_numbers(spec_path, reference, tmp_
 
     res = api.atlas(spec_path, out, scheduler=ext.addr, progress=False, runs_per_task=1, on_result=kill)
     assert len(killed) == 3 and res.computed == 36 and res.failed == 0
+    same_numbers(out, reference)
+
+
+CRASHER = """
+import os
+from spinviz.regimes import runs
+
+_real = getattr(runs, "_unpatched_run_batch", runs.run_batch)     # Dask may load a preload twice
+runs._unpatched_run_batch = _real
+
+
+def run_batch(batch):
+    if batch.region == (0, (1, 2), (2, 3), (0, 3)):
+        os._exit(9)                                     # as a segfault in a compiled kernel would
+    return _real(batch)
+
+
+runs.run_batch = run_batch
+"""
+
+
+@pytest.mark.slow
+def test_task_that_kills_its_worker_is_not_written(spec_path, reference, tmp_path, external):
+    """A batch that kills the worker running it (a crash in compiled code), on a cluster that
+    gives a task one attempt and a worker one task at a time: Dask gives up on it
+    (KilledWorker); its 3 runs are not written, the 33 others are, exit status 1 with the
+    reason; the same call (here on a sound cluster) completes the store with the reference's
+    numbers."""
+    crasher = tmp_path / "crasher.py"
+    crasher.write_text(CRASHER)
+    ext = external(worker_args=["--preload", str(crasher)],
+                   env={"DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "0",
+                        "DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION": "1.0"})
+    out = tmp_path / "c.zarr"
+    with pytest.raises(AtlasIncomplete) as e:
+        api.atlas(spec_path, out, scheduler=ext.addr, progress=False, runs_per_task=3)
+    assert str(e.value).startswith("a task killed the worker that ran it (1 time): 3 of 36 runs not computed; ")
+    assert e.value.exit_status == 1 and not e.value.cluster_lost
+    done = done_runs_match(out, reference)
+    assert done.sum() == 33 and not done[0, 1, 2].any()
+    res = api.atlas(spec_path, out, workers=1, processes=False, progress=False)
+    assert (res.reused, res.computed) == (33, 3)
+    same_numbers(out, reference)
+
+
+DEEP = """
+from spinviz.regimes import runs
+
+_real = getattr(runs, "_unpatched_run_batch", runs.run_batch)
+runs._unpatched_run_batch = _real
+
+
+def _deeper(n):
+    return _deeper(n + 1)
+
+
+def run_batch(batch):
+    if batch.region == (1, (0, 1), (0, 1), (0, 3)):
+        _deeper(0)                                      # RecursionError, a traceback ~1000 frames deep
+    return _real(batch)
+
+
+runs.run_batch = run_batch
+"""
+
+
+@pytest.mark.slow
+def test_task_error_that_never_reaches_the_client(spec_path, reference, tmp_path, external, monkeypatch):
+    """A task whose error report distributed cannot read on the client (a RecursionError: its
+    deep traceback fails distributed's check, and the future would stay pending forever):
+    after ``STALL_S`` without a result (here 1 s) the scheduler's log is asked, the task
+    counted as failed, the others computed; exit status 1; the same call completes the store."""
+    monkeypatch.setattr(cluster, "STALL_S", 1.0)
+    deep = tmp_path / "deep.py"
+    deep.write_text(DEEP)
+    ext = external(worker_args=["--preload", str(deep)])
+    out = tmp_path / "d.zarr"
+    t0 = time.monotonic()
+    with pytest.raises(AtlasIncomplete) as e:
+        api.atlas(spec_path, out, scheduler=ext.addr, progress=False, runs_per_task=3)
+    assert time.monotonic() - t0 < 30
+    assert e.value.exit_status == 1 and not e.value.cluster_lost
+    assert str(e.value).startswith("a task failed on the cluster and its error never reached this client: 3 of 36 "
+                                   "runs not computed; ")
+    done = done_runs_match(out, reference)
+    assert done.sum() == 33 and not done[1, 0, 0].any()
+    res = api.atlas(spec_path, out, workers=1, processes=False, progress=False)
+    assert (res.reused, res.computed) == (33, 3)
     same_numbers(out, reference)
 
 

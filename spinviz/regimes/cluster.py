@@ -52,6 +52,7 @@ START_TIMEOUT_S = 120.0          # LocalCluster workers (spawned Python, imports
 NO_WORKER_S = 60.0               # an existing cluster without any worker this long: the atlas gives up
 POLL_S = 0.05                    # how often the client looks at a stop signal while it waits
 HEALTH_S = 0.5                   # how often the monitor asks the scheduler how many workers it has
+STALL_S = 10.0                   # nothing arrived this long: ask the scheduler whether a task erred unreported
 
 
 def worker_info() -> dict:
@@ -174,6 +175,7 @@ class Cluster:
         self.cluster = None
         self._quiet = None
         self._monitor = None
+        self._describe = None
 
     def __enter__(self) -> Cluster:
         from distributed import Client
@@ -196,6 +198,7 @@ class Cluster:
                                       f"start some with 'dask worker {self.scheduler}'") from None
                 polled(self.client.register_plugin, WarmUp(quiet_terminal=False))
                 self._check_versions()
+            self.describe                            # noqa: B018 -- asked now, while the scheduler is surely there
             self._monitor = _Monitor(self.client)
         except BaseException:
             self.close(fast=True)
@@ -241,9 +244,15 @@ class Cluster:
 
     @property
     def describe(self) -> str:
-        n = len(polled(self.client.nthreads))
-        where = "embedded LocalCluster" if self.scheduler is None else f"cluster at {self.scheduler}"
-        return f"{where}, {n} worker{'s' if n != 1 else ''}, {self.nthreads} thread{'s' if self.nthreads != 1 else ''}"
+        """Where it runs, as found when the cluster was reached (asked once: the scheduler may
+        be gone when the caller wants to say where it ran)."""
+        if self._describe is None:
+            n = polled(self.client.nthreads)
+            threads = max(1, sum(n.values()))
+            where = "embedded LocalCluster" if self.scheduler is None else f"cluster at {self.scheduler}"
+            self._describe = (f"{where}, {len(n)} worker{'s' if len(n) != 1 else ''}, "
+                              f"{threads} thread{'s' if threads != 1 else ''}")
+        return self._describe
 
     @property
     def where(self) -> str:
@@ -253,6 +262,24 @@ class Cluster:
     def problem(self) -> str | None:
         """Why the cluster cannot go on (the scheduler gone, no worker for ``NO_WORKER_S``), or None."""
         return self._monitor.problem(self.where) if self._monitor is not None else None
+
+    def erred_unreported(self, keys) -> list:
+        """Of ``keys`` (tasks this client still sees pending), those the scheduler has marked
+        erred: the report of their error did not arrive (distributed can fail to read it --
+        seen with a deep RecursionError's traceback -- and the future then waits forever).
+        From the scheduler's transition log, an RPC that runs no code of ours there."""
+        if not keys:
+            return []
+        try:
+            story = polled(self.client.sync, self.client.scheduler.get_story, keys_or_stimuli=list(keys))
+        except Exception:
+            return []
+        last = {}
+        for entry in story:
+            key, finish, stamp = entry[0], entry[2], entry[-1]
+            if key not in last or stamp >= last[key][1]:
+                last[key] = (finish, stamp)
+        return [k for k in keys if last.get(k, ("", 0))[0] == "erred"]
 
     def close(self, fast: bool = False) -> None:
         """Close the client and stop the LocalCluster.  ``fast`` (an exception, a stop signal, a
@@ -438,7 +465,8 @@ def _why_not_finished(f) -> str:
         except Exception as e:                     # the error could not even be fetched
             return f"a task's error could not be fetched ({type(e).__name__})"
         if isinstance(err, KilledWorker):
-            return f"a task killed the workers that ran it ({err.allowed_failures + 1} times)"
+            n = err.allowed_failures + 1
+            return f"a task killed the worker{'s' if n != 1 else ''} that ran it ({n} time{'s' if n != 1 else ''})"
         return f"a task raised {type(err).__name__}: {printable(str(err), 160)}"
     return f"a task was {f.status}"
 
@@ -464,6 +492,7 @@ def execute(cluster: Cluster, batches: list, keys: list, writer, progress: Progr
     not_done = 0                                  # runs of tasks that did not finish
     cause = None
     cluster_lost = False
+    last_seen = time.monotonic()                  # when a task last came back
 
     def submit_one():
         i = todo.pop()
@@ -486,7 +515,19 @@ def execute(cluster: Cluster, batches: list, keys: list, writer, progress: Progr
                     if problem:
                         cause, cluster_lost = problem, True
                         break
+                    if time.monotonic() - last_seen > STALL_S:
+                        last_seen = time.monotonic()
+                        pending = [k for k, (g, _) in in_flight.items() if g.status == "pending"]
+                        for key in cluster.erred_unreported(pending):
+                            i = in_flight.pop(key)[1]
+                            cause = cause or "a task failed on the cluster and its error never reached this client"
+                            not_done += batches[i].runs
+                            stats.failed_tasks += 1
+                            stats.tasks += 1
+                            if todo:
+                                submit_one()
                     continue
+            last_seen = time.monotonic()
             if f.key not in in_flight:
                 continue
             relost.pop(f.key, None)

@@ -1,6 +1,6 @@
 """Regime atlas: which asymptotic type of section 4 a top ends in, over the (delta, chi) plane.
 
-Ensembles of Euler-only runs (compiled kernel) classified one by one, computed on Dask and
+Ensembles of Euler-only runs (heyoka's batch mode) classified one by one, computed on Dask and
 written to a resumable Zarr store (issue 12).  Modules, in the order data flows:
 
 * ``formulas`` -- the paper's asymptotic solutions and domains, spinviz's derived lines,

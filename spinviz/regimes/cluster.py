@@ -8,9 +8,10 @@
   processes are killed (their work is not needed: only results the client holds are ever
   written), so the command exits within a fraction of a second instead of waiting for
   the running tasks.
-* ``WarmUp``: a ``WorkerPlugin`` that loads the compiled kernel once per worker process
-  (from the on-disk cache; the client compiles it first when the cluster is local), so
-  no task pays for it, and that checks the worker runs the client's spinviz version.
+* ``WarmUp``: a ``WorkerPlugin`` that loads the Taylor integrators (heyoka, from spinviz's
+  on-disk cache; the client builds them first when the cluster is local) once per worker
+  process, so no task pays for them, and that checks the worker runs the client's spinviz
+  version.
 * ``execute``: submits the batches in store order, keeps a bounded number in flight (so a
   stop cancels little and a big atlas does not flood the scheduler), hands each result to
   the store's writer as it arrives, and draws the progress bar.  A task that did not finish
@@ -63,7 +64,7 @@ def worker_info() -> dict:
 
 
 class WarmUp(WorkerPlugin):
-    """Dask ``WorkerPlugin``: load the kernel when a worker starts (also a restarted one).
+    """Dask ``WorkerPlugin``: load the Taylor integrators when a worker starts (also a restarted one).
 
     ``quiet_terminal``: for the LocalCluster's own worker processes, ignore SIGINT and SIGHUP
     (the terminal sends them to the whole process group; they are blocked from the start,

@@ -97,6 +97,7 @@ def test_stop_signal_mid_render(tmp_path, sig, to_group, ext):
     assert gone(proc.pid) == []                                           # no worker, tracker or ffmpeg left
 
 
+@pytest.mark.slow
 def test_sigterm_stops_a_compiled_run_promptly(tmp_path):
     """An asymmetric body over ~5e6 turns (allowed; about a minute of compiled loop, ~3 s per
     1e5 turns measured): SIGTERM ends it within a second with nothing written."""

@@ -119,6 +119,21 @@ def test_truncated_solves_2_5_exactly_for_asymmetric_bodies(rng):
     assert np.max(np.abs(lhs - rhs)) < 1e-14
 
 
+@pytest.mark.parametrize("symmetric, general", [(E.symmetric_reduced_rate, E.reduced_rate),
+                                                 (E.symmetric_truncated_rate, E.truncated_rate)], ids=["reduced", "truncated"])
+def test_symmetric_top_rates_equal_the_general_ones(symmetric, general, rng):
+    """The written-out symmetric-top rates the atlas integrates ((4.2)-(4.4), and spinviz's own
+    truncated analogue) equal the general rates with J = (1, 1, 1 - delta), g = (sin chi, 0,
+    cos chi), at random bodies and states (measured 2.2e-15 and 3.7e-15 of the largest
+    component, round-off; bound 5e-14)."""
+    delta = rng.uniform(-1.0, 0.95, N)
+    chi = rng.uniform(0.0, 0.5 * math.pi, N)
+    w = rng.normal(size=(3, N)) * rng.uniform(0.01, 1.0, N)
+    got = np.array(symmetric(*w, delta, np.sin(chi), np.cos(chi)))
+    want = np.array(general(*w, (1.0, 1.0, 1.0 - delta), (np.sin(chi), 0.0, np.cos(chi))))
+    assert np.max(np.abs(got - want) / np.abs(want).max(axis=0)) < 5e-14
+
+
 def test_2_3b_both_printed_forms_are_the_free_flow_derivative():
     """Both lines of (2.3b) equal d/dt of (2.3a) along the free flow (the reduction's input)."""
     J = (1.0, 0.7, 0.4)

@@ -36,6 +36,9 @@ extensions = [
     "myst_parser",
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
+    # numpydoc sections (Parameters / Returns / Raises, with a line of dashes) become field
+    # lists; docstrings without sections keep the "name : meaning" lines handled below.
+    "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
     "sphinx.ext.viewcode",
     "sphinx_copybutton",
@@ -71,12 +74,18 @@ autodoc_default_options = {"members": True, "show-inheritance": True, "member-or
 autodoc_typehints = "signature"
 autodoc_preserve_defaults = True      # the signature shows ``method='auto'``, not a repr
 add_module_names = False
+napoleon_google_docstring = False     # only numpydoc sections: a line ending in ":" stays prose
+napoleon_numpy_docstring = True
+napoleon_use_rtype = False            # "Returns: (type) -- meaning" on one line, as the docstrings read
+napoleon_use_ivar = True              # "Attributes" as a field list: no second target beside autodoc's members
 # Heavy optional stacks are installed for the docs build (the "docs" extra pulls the render
 # and ensemble extras), so nothing is mocked: what the reference shows is what imports.
 
-# The project's docstrings (see STYLE.md) list parameters as lines ``name : meaning`` (shape,
-# units and frame on the line), not in numpydoc sections; shown as reST they would run
-# together into one paragraph.  This turns such a paragraph into a definition list.
+# Many of the project's docstrings (see STYLE.md) list parameters as lines ``name : meaning``
+# (shape, units and frame on the line) outside any numpydoc section; shown as reST they would
+# run together into one paragraph.  This turns such a paragraph into a definition list.  (The
+# public entry points use numpydoc sections, which napoleon renders; once every docstring
+# does, this hook can go.  Napoleon runs first and its output never matches ``_PARAM``.)
 _PARAM = re.compile(r"^(?P<names>[A-Za-z_*][\w*]*(?:\s*,\s*[A-Za-z_*][\w*]*)*)\s+:\s+(?P<text>\S.*)$")
 
 

@@ -51,10 +51,13 @@ class AtomicPath:
             raise
 
     def commit(self):
+        """Rename the finished temporary file over ``path`` (one atomic ``os.replace``), with the
+        permissions a new file would get."""
         os.chmod(self.tmp, 0o666 & ~_umask())
         os.replace(self.tmp, self.path)
 
     def discard(self):
+        """Delete the temporary file, if any, and the directories made for it while they are empty."""
         if self.tmp is not None and os.path.exists(self.tmp):
             os.unlink(self.tmp)
         for d in self._created:                # leave no new, empty directories behind
@@ -239,5 +242,6 @@ class Outputs:
                         os.unlink(b)
 
     def discard(self) -> None:
+        """Discard every temporary file of the group (``AtomicPath.discard``), the last first."""
         for t in reversed(self.targets):
             t.discard()

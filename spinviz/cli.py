@@ -36,26 +36,49 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _parser() -> argparse.ArgumentParser:
+    """The ``spinviz`` command line: one subcommand per task, each added by its ``_add_*``."""
     p = _Parser(prog="spinviz", description="Rotation of a dipolar nanocrystal braked by radiation reaction "
                                             "(reduced (2.2)+(2.3) vs truncated (2.5) Euler equations).")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
+    for add in (_add_check, _add_info, _add_simulate, _add_render, _add_compare, _add_observe, _add_listen,
+                _add_bench, _add_stress, _add_report):
+        add(sub)
+    sub.add_parser("methods", help="list the integrators")
 
+    from .regimes import command as atlas_command  # argparse and spinviz.errors only: light
+
+    atlas_command.add_parser(sub)
+    return p
+
+
+def _add_check(sub) -> None:
     c = sub.add_parser("check", help="validate the integrators against the paper's closed forms, and secular against "
                                      "full integration at real scales (~2.5 min)")
     c.add_argument("--json", action="store_true", help="print a JSON list of records instead of a table")
     c.add_argument("--quick", action="store_true", help="secular comparisons at tau0 |Omega0| = 1e-4, 1e-5 only (~16 s)")
+    c.add_argument("--sweep", action="store_true",
+                   help="instead: secular against taylor on random symmetric tops, are its stated errors bounds? "
+                        "(~8 s per seed of 40 runs)")
+    c.add_argument("--seeds", type=_seed_list, help="with --sweep: the seeds, e.g. 1-9 or 1,4,7 (default 1-3)")
+    c.add_argument("--runs", type=_positive, help="with --sweep: runs per seed (default 40)")
 
+
+def _add_info(sub) -> None:
     i = sub.add_parser("info", help="derived quantities of a preset or scene, beside the paper's figures")
     i.add_argument("target", help="a preset name (cellulose_rod, dast_cube, dast_family1) or a scene file")
     i.add_argument("--json", action="store_true")
 
+
+def _add_simulate(sub) -> None:
     s = sub.add_parser("simulate", help="integrate a scene and write the trajectory and its radiation observables (.npz)")
     s.add_argument("scene")
     s.add_argument("--out", required=True, help="output .npz path")
     s.add_argument("--model", help="which of the scene's models (default: the first)")
     s.add_argument("--method", help="override the scene's integrator")
 
+
+def _add_render(sub) -> None:
     r = sub.add_parser("render", help="render a scene off-screen to MP4 or GIF, with a PNG poster")
     r.add_argument("scene")
     r.add_argument("--out", help="output .mp4 or .gif (default renders/<scene>.mp4)")
@@ -71,13 +94,18 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--plot", metavar="PATH", help="with --bench: also draw frames per second against the targets (PNG)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
 
-    c2 = sub.add_parser("compare", help="reduced vs truncated for a two-model scene: angles, crossing times, final states, plots")
-    c2.add_argument("scene")
-    c2.add_argument("--out", help="prefix of the PNG plots (default renders/<scene>): "
-                                  "<prefix>_compare.png, <prefix>_hodograph.png")
-    c2.add_argument("--samples", type=_positive, default=800, help="evenly spaced plus as many log-spaced output times")
-    c2.add_argument("--json", action="store_true", help="print the results as JSON")
 
+def _add_compare(sub) -> None:
+    c = sub.add_parser("compare", help="reduced vs truncated for a two-model scene: angles, crossing times, final states, "
+                                       "plots")
+    c.add_argument("scene")
+    c.add_argument("--out", help="prefix of the PNG plots (default renders/<scene>): "
+                                 "<prefix>_compare.png, <prefix>_hodograph.png")
+    c.add_argument("--samples", type=_positive, default=800, help="evenly spaced plus as many log-spaced output times")
+    c.add_argument("--json", action="store_true", help="print the results as JSON")
+
+
+def _add_observe(sub) -> None:
     o = sub.add_parser("observe", help="what a detector records from both models of a scene, and when the two part "
                                        "(power, frequency, polarization); plots")
     o.add_argument("scene")
@@ -92,6 +120,8 @@ def _parser() -> argparse.ArgumentParser:
     o.add_argument("--samples", type=_positive, default=800, help="evenly spaced plus as many log-spaced instants")
     o.add_argument("--json", action="store_true", help="print the results as JSON")
 
+
+def _add_listen(sub) -> None:
     li = sub.add_parser("listen", help="hear the crystal spin down: the detector's signal of both models as a stereo "
                                        "WAV (left one model, right the other), with its spectrogram")
     li.add_argument("scene")
@@ -109,6 +139,8 @@ def _parser() -> argparse.ArgumentParser:
     li.add_argument("--distance-cm", type=_real, help=argparse.SUPPRESS)
     li.add_argument("--samples", type=_positive, default=800, help="evenly spaced plus as many log-spaced instants")
 
+
+def _add_bench(sub) -> None:
     b = sub.add_parser("bench", help="work-precision benchmark: error against run time, per method and horizon")
     b.add_argument("--quick", action="store_true", help="two problems, 1e2 and 1e4 turns, fewer settings (~2 min)")
     b.add_argument("--json", metavar="PATH", help="also write rows and summary as JSON")
@@ -116,21 +148,21 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--process", action="store_true",
                    help="time whole processes (spinviz simulate, and the standalone heyoka and scipy scripts of "
                         "benchmarks/) instead of in-process runs, at ~400 turns (~5 min; --quick ~1 min)")
+    b.add_argument("--problems", type=_names, help="only these problems, e.g. 6.10,askew (default: the plan's; "
+                                                 "with --process also asym)")
+    b.add_argument("--repeats", type=_positive, help="runs per point, the minimum time kept (default 3)")
 
+
+def _add_stress(sub) -> None:
     st = sub.add_parser("stress", help="stiff and extreme cases: pass/fail, error, time, and the method the driver picked")
     st.add_argument("--json", action="store_true", help="print a JSON list of records instead of a table")
 
+
+def _add_report(sub) -> None:
     rp = sub.add_parser("report", help="regenerate docs/accuracy.md: bench plot and tables, stress table")
     rp.add_argument("--quick", action="store_true", help="the quick benchmark plan")
     rp.add_argument("--out", default="docs/accuracy.md", help="the Markdown file to write")
     rp.add_argument("--out-dir", default="renders", help="where the plot and JSON go")
-
-    sub.add_parser("methods", help="list the integrators")
-
-    from .regimes import command as atlas_command  # argparse and spinviz.errors only: light
-
-    atlas_command.add_parser(sub)
-    return p
 
 
 # --- argument types: parsing only; ranges are checked by the library -----------------------
@@ -152,6 +184,27 @@ def _positive(text: str) -> int:
     if v < 1:
         raise argparse.ArgumentTypeError(f"must be at least 1, got {v}")
     return v
+
+
+def _seed_list(text: str) -> list[int]:
+    try:
+        if "-" in text:
+            lo, hi = (int(x) for x in text.split("-"))
+            seeds = list(range(lo, hi + 1))
+        else:
+            seeds = [int(x) for x in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seeds A-B or A,B,C, got {text!r}") from None
+    if not seeds:
+        raise argparse.ArgumentTypeError(f"no seeds in {text!r}")
+    return seeds
+
+
+def _names(text: str) -> tuple[str, ...]:
+    names = tuple(x.strip() for x in text.split(",") if x.strip())
+    if not names:
+        raise argparse.ArgumentTypeError(f"expected NAME[,NAME...], got {text!r}")
+    return names
 
 
 def _vector(text: str):
@@ -225,6 +278,14 @@ class _Stream:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one ``spinviz`` command in-process and return its exit status.
+
+    argv : the arguments after ``spinviz`` (default ``sys.argv[1:]``), e.g. ``["check", "--quick"]``.
+    Returns 0 on success, 1 when a check or run failed or an output could not be written, 2 for
+    bad input (one line on stderr), 128 + the signal number when stopped by SIGINT, SIGTERM or
+    SIGHUP.  Standard output and error are guarded for the call (a closed or full stream never
+    raises into the command); ``entry`` is the console script around it.
+    """
     args = _parser().parse_args(argv)
     out, err = sys.stdout, sys.stderr
     sys.stdout, sys.stderr = _Stream(out, pipe_ends=True), _Stream(err, pipe_ends=False)
@@ -306,12 +367,33 @@ def _progress(msg: str) -> None:
 def _cmd_check(args) -> int:
     from .validation import checks
 
+    if args.sweep:
+        return _secular_sweep(args)
+    for given, option in ((args.seeds, "--seeds"), (args.runs, "--runs")):
+        if given is not None:
+            raise UsageError(f"{option}: only with --sweep")
     results = checks.run_all(quick=args.quick)
     if args.json:
         print(json.dumps([r.record() for r in results], indent=2, default=float))
     else:
         _out(checks.format_table(results))
     return EXIT_OK if all(r.passed for r in results) else EXIT_FAIL
+
+
+def _secular_sweep(args) -> int:
+    import time
+
+    from .validation import secular_sweep as SW
+
+    if args.quick:
+        raise UsageError("--quick: not with --sweep (give fewer --seeds or --runs)")
+    start = time.perf_counter()
+    rows = SW.run(args.seeds or [1, 2, 3], args.runs or 40, progress=lambda r: _progress(SW.row_line(r)))
+    if args.json:
+        print(json.dumps(rows, indent=2, default=float))
+    else:
+        _out(SW.format_table(rows, time.perf_counter() - start))
+    return EXIT_OK if SW.passed(rows) else EXIT_FAIL
 
 
 def _cmd_info(args) -> int:
@@ -608,7 +690,8 @@ def _cmd_bench(args) -> int:
     if args.process:
         from .validation import process_bench as PB
 
-        pts = PB.run(quick=args.quick, progress=_progress)
+        _known_problems(args.problems, PB.PROBLEMS)
+        pts = PB.run(args.problems or PB.PROBLEMS, repeats=args.repeats or 3, quick=args.quick, progress=_progress)
         print(PB.format_table(pts))
         if args.json:
             write_json(args.json, {"points": [p.record() for p in pts], "headline": PB.headline(pts)})
@@ -616,6 +699,9 @@ def _cmd_bench(args) -> int:
             PB.plot(pts, args.plot)
         return EXIT_OK
     plan = bench.quick_plan() if args.quick else bench.Plan()
+    _known_problems(args.problems, bench.PROBLEMS)
+    plan = dataclasses.replace(plan, **{k: v for k, v in (("problems", args.problems), ("repeats", args.repeats))
+                                        if v is not None})
     rows = bench.run(plan, progress=_progress)
     summ = bench.summary(rows)
     print(bench.format_table(rows, summ, plan.notes))
@@ -624,6 +710,12 @@ def _cmd_bench(args) -> int:
     if args.plot:
         bench.plot(rows, args.plot)
     return EXIT_OK
+
+
+def _known_problems(names, valid) -> None:
+    unknown = [n for n in names or () if n not in valid]
+    if unknown:
+        raise UsageError(f"--problems: unknown {', '.join(map(_p, unknown))}; valid: {', '.join(valid)}")
 
 
 def _cmd_stress(args) -> int:

@@ -56,22 +56,54 @@ def simulate(
 ) -> Trajectory:
     """Integrate the Euler equation of ``model`` with orientation; return a ``Trajectory``.
 
-    body : Body -- its ``units`` decide the units of everything below.
-    model : "reduced" (2.2)+(2.3), "truncated" (2.5) or "free".
-    omega0 : shape (3,), body-frame angular velocity at t = 0 (rad/s or dimensionless).
-    t_end, samples : output at ``samples`` instants evenly spaced over [0, t_end]; or
-    t_eval : shape (N,), increasing output times from 0 (s or tau).
-    q0 : shape (4,), (w, x, y, z), initial orientation; or euler_zxz0 : (phi, theta, psi) rad.
-    method : a registered integrator name, or "auto".
-    rtol, atol : tolerances for adaptive methods, in spin units (|omega(0)| = 1, |q| = 1, so
-        both are relative to the initial spin); atol defaults to rtol / 100.
-    step : step size for fixed-step methods, in units of t (s or tau).
-    kinematics : "quaternion" (default), "euler_zxz" (the Poisson equations (6.4), for
-    comparison; singular at theta = 0) or "none" (no orientation: Euler equation only).
+    Parameters
+    ----------
+    body : Body
+        Its ``units`` ("cgs" or "dimensionless") decide the units of everything below.
+    model : {"reduced", "truncated", "free"}
+        The reduced equation (2.2)+(2.3), the truncated one (2.5), or the torque-free top.
+    omega0 : array_like, shape (3,)
+        Body-frame angular velocity at t = 0, rad/s (CGS) or 1/tau0 (4.1).
+    t_end : float, optional
+        The horizon, s (CGS) or tau0: output at ``samples`` instants evenly spaced over
+        [0, t_end].  Give either ``t_end`` and ``samples`` or ``t_eval``.
+    samples : int, optional
+        How many output instants (with ``t_end``).
+    t_eval : array_like, shape (N,), optional
+        Increasing output times from 0, s or tau0.
+    q0 : array_like, shape (4,), optional
+        Initial orientation as a quaternion (w, x, y, z), scalar first (normalized here), of
+        O = R_world_from_body.  Give ``q0`` or ``euler_zxz0``; default the identity.
+    euler_zxz0 : array_like, shape (3,), optional
+        Initial orientation as ZXZ Euler angles (phi, theta, psi), rad.
+    method : str
+        A registered integrator name (``spinviz methods``), or "auto".
+    rtol : float
+        Relative tolerance of adaptive methods, in spin units (|omega(0)| = 1, |q| = 1: relative
+        to the initial spin).
+    atol : float, optional
+        Absolute tolerance in the same units; default rtol / 100.
+    step : float, optional
+        Step of fixed-step methods, in units of t (s or tau0).
+    kinematics : {"quaternion", "euler_zxz", "none"}
+        "quaternion" (default); "euler_zxz", the Poisson equations (6.4), for comparison
+        (singular at theta = 0); "none", no orientation (the Euler equation only).
 
-    The arguments are checked once, by ``spinviz.inputs.simulation.SimulationRequest``
-    (shared with scenes and the command line): a bad one raises ``SpecError`` naming it
-    (``SpecTypeError``, also a TypeError, for a value of the wrong kind).
+    Returns
+    -------
+    Trajectory
+        t (N,), omega_body (N, 3) body frame and q (N, 4) (w, x, y, z) at the output
+        instants, in the body's units, with ``stats`` (method, cost, run time, and the
+        accuracy notes of a run that could not meet its tolerance).
+
+    Raises
+    ------
+    SpecError
+        A bad argument, named (``SpecTypeError``, also a TypeError, for a value of the wrong
+        kind); the arguments are checked once, by ``spinviz.inputs.simulation.SimulationRequest``,
+        shared with scenes and the command line.
+    SimulationError
+        The integration could not be done (an integrator gave up, a runaway, a singular start).
     """
     return simulate_request(SimulationRequest(
         body=body, model=model, omega0=omega0, t_end=t_end, samples=samples, t_eval=t_eval, q0=q0,
@@ -79,7 +111,8 @@ def simulate(
 
 
 def simulate_request(request: SimulationRequest) -> Trajectory:
-    """Run a validated ``SimulationRequest`` (``Scene.request(model)`` makes one for a scene)."""
+    """Run a validated ``SimulationRequest`` (``Scene.request(model)`` makes one for a scene):
+    ``simulate`` with its arguments already checked; returns the ``Trajectory``."""
     if not isinstance(request, SimulationRequest):
         raise SpecTypeError("request", f"must be a SimulationRequest, got {type(request).__name__}")
     body, model, kinematics = request.body, request.model, request.kinematics
@@ -174,19 +207,20 @@ def initial_orientation(q0=None, euler_zxz0=None):
     return R.quat_from_euler_zxz(euler), euler
 
 
-def truncated_margin(system: System, omega) -> float:
-    """1 + (g x omega).J^-1 g for the dimensionless (tau0 = 1) or spin-unit system: (2.5) is
+def truncated_margin(system: System, omega_body) -> float:
+    """1 + (g x omega).J^-1 g at the body-frame state ``omega_body`` (3,) of the dimensionless
+    (tau0 = 1) or spin-unit system: (2.5) is
     linear in Omega_dot with the factor J + g (g x Omega)^T, whose determinant is det J times
     this.  1 at rest and 1 + O(tau0 |Omega|) for any real particle."""
-    w = np.asarray(omega, dtype=float)
+    w = np.asarray(omega_body, dtype=float)
     return float(truncated_singularity(w[0], w[1], w[2], system.inertia, system.coupling))
 
 
-def check_truncated_solvable(system: System, omega, margin: float = 1e-12) -> None:
+def check_truncated_solvable(system: System, omega_body, margin: float = 1e-12) -> None:
     """Refuse a truncated start where ``truncated_margin`` <= ``margin``: such a state is cut
     off from rest by the singular surface, and runs started there fall into it (the stress
     case shows one)."""
-    den = truncated_margin(system, omega)
+    den = truncated_margin(system, omega_body)
     if not den > margin:
         raise SimulationError(
             f"the truncated equation (2.5) is singular at the initial state: 1 + (g x Omega).J^-1 g = {den:.3g} "
@@ -271,7 +305,7 @@ def _check_finite(sol: Solution) -> None:
 class Run:
     """One run of ``solve_many``, in the dimensionless units (4.1) of its request.
 
-    tau : (N,) the output grid; omega : (N, 3) body frame, NaN after ``reached`` samples;
+    tau : (N,) the output grid; omega (``omega_body``) : (N, 3) body frame, NaN after ``reached`` samples;
     status : how it ended (``integrators.status``; OK = 0); reason : one line when not OK;
     t_stop : where it stopped (tau); nsteps : integrator steps (a batch's, for batched runs);
     seconds : wall time of its share of the work.
@@ -285,6 +319,11 @@ class Run:
     nsteps: int
     seconds: float
     reason: str = ""
+
+    @property
+    def omega_body(self) -> np.ndarray:
+        """Body-frame omega, shape (N, 3), 1/tau0: the documented name of the field ``omega``."""
+        return self.omega
 
 
 SINGULAR_START = ST.SINGULAR_START

@@ -38,6 +38,7 @@ class Interrupted(KeyboardInterrupt):
 
     @property
     def exit_status(self) -> int:
+        """128 + the signal number: the exit status of a command stopped by it (130 for SIGINT)."""
         return 128 + self.signum
 
 

@@ -100,10 +100,13 @@ class Scene:
 
     @property
     def units(self) -> str:
+        """The unit system of the scene's body: "cgs" (t in s, Omega in rad/s) or "dimensionless"
+        (tau, omega of (4.1))."""
         return self.body.units
 
     @property
     def model(self) -> str:
+        """The first of the scene's models (the one ``spinviz simulate`` runs by default)."""
         return self.models[0]
 
     def request(self, model: str | None = None, *, kinematics: str = "quaternion", t_eval=None) -> SimulationRequest:

@@ -35,16 +35,35 @@ def _frozen(a):
 
 @dataclass(frozen=True)
 class Trajectory:
-    """t (N,); omega_body (N, 3), the body-frame angular velocity (stored, and accepted by the
-    constructor, as ``omega``: the name of the field and of the array in saved files); q (N,
-    4) (w, x, y, z) or None when no orientation was integrated; euler (N, 3) only when the
-    Euler-angle kinematics (6.4) was integrated instead of quaternions; all in ``units`` of
-    ``body``.  stats: method, nfev, runtime_s, ...
+    """The result of one run: states at the output instants, in the units of ``body``.
 
-    slow: for ``secular`` runs, the slow geometry -- q_L (4,) taking world z to the fixed
-    L_world, and (N,) arrays theta_L (nutation of e3 from L), phi_L (precession phase) and
-    psi_L (spin phase).  When ``phase_resolved`` is False the phases (and so q) are beyond
-    float64 resolution: only theta_L, L and omega's magnitude are physical.
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        Output instants, s (CGS) or tau0 (dimensionless).
+    omega : ndarray, shape (N, 3)
+        The body-frame angular velocity Omega, rad/s or 1/tau0; documented as ``omega_body``
+        (``omega`` stays the field's name, the constructor's keyword and the saved array's).
+    q : ndarray, shape (N, 4), or None
+        Orientation as unit quaternions (w, x, y, z), scalar first, of O = R_world_from_body;
+        None when no orientation was integrated.
+    body : Body
+    model : {"reduced", "truncated", "free"}
+    euler : ndarray, shape (N, 3), or None
+        ZXZ Euler angles (phi, theta, psi), rad, only when the Poisson equations (6.4) were
+        integrated instead of quaternions.
+    stats : dict
+        method, nfev or nsteps, runtime_s, rtol, atol, ... and the error statements of
+        ``secular``.
+    slow : dict or None
+        For ``secular`` runs, the slow geometry: q_L (4,) taking world z to the fixed
+        L_world, and (N,) arrays theta_L (nutation of e3 from L), phi_L (precession phase) and
+        psi_L (spin phase), rad.
+
+    Notes
+    -----
+    When ``phase_resolved`` is False the phases (and so q) are beyond float64 resolution:
+    only theta_L, L and |Omega| are physical.
     """
 
     t: np.ndarray
@@ -75,6 +94,8 @@ class Trajectory:
     # -- units ---------------------------------------------------------------------------
     @property
     def units(self) -> str:
+        """The body's unit system: "cgs" (t in s, Omega in rad/s) or "dimensionless" (tau, omega of
+        (4.1))."""
         return self.body.units
 
     @property
@@ -103,6 +124,7 @@ class Trajectory:
 
     @property
     def omega_magnitude(self) -> np.ndarray:
+        """|Omega|, shape (N,), rad/s (CGS) or 1/tau0: the same in every frame."""
         return np.linalg.norm(self.omega, axis=-1)
 
     def dipole_world(self) -> np.ndarray:
@@ -177,13 +199,28 @@ class Trajectory:
 
     # -- resampling ----------------------------------------------------------------------
     def sample(self, times) -> Trajectory:
-        """The trajectory at ``times`` (within [t0, t_end]): Omega by cubic Hermite with the
-        model's Omega_dot, q by slerp between stored orientations.  No integration.
+        """The trajectory at other instants, without integrating: Omega by cubic Hermite
+        interpolation with the model's own Omega_dot at the nodes, q by slerp between stored
+        orientations.
 
+        Parameters
+        ----------
+        times : array_like, shape (M,)
+            Instants within [t[0], t[-1]], in the run's time unit (s or tau0).
+
+        Returns
+        -------
+        Trajectory
+            omega_body (M, 3) body frame, q (M, 4) (w, x, y, z); ``self`` when ``times`` are
+            the stored instants.
+
+        Notes
+        -----
         Between stored instants this is only as good as the storage: slerp needs neighbours
         less than half a turn apart (the renderer stores every frame for that reason), and
         for a run whose spin phase is unresolved (``phase_resolved`` False) only the nodes
-        and the slow geometry are meaningful."""
+        and the slow geometry are meaningful.
+        """
         times = np.atleast_1d(np.asarray(times, dtype=float))
         t = self.t
         if times.shape == t.shape and np.array_equal(times, t):
@@ -291,6 +328,8 @@ class Trajectory:
         return out
 
     def metadata(self) -> dict:
+        """The JSON record saved beside the arrays (``save``): format, units, conventions
+        (quaternion order, Euler convention), model, body and its full description, and stats."""
         b = self.body
         return {
             "format": FORMAT,

@@ -115,11 +115,6 @@ def format_time(t: float, units: str) -> str:
     return human_time(t) if units == "cgs" else f"{t:.4g} \u03c40"
 
 
-def format_omega(w: float, units: str) -> str:
-    """|Omega| in rad/s (CGS), or |omega| in 1/tau0 (dimensionless)."""
-    return f"|\u03a9| = {w:.3g} rad/s" if units == "cgs" else f"|\u03c9| = {w:.3g} /\u03c40"
-
-
 # --- radiation (the observables of ``physics.radiation``) ----------------------------------
 # Each quantity is computed in the variables (4.1) with the coupling g = sqrt(2/3c^3) d of unit
 # size, so (2/3c^3) d^2 = I1 tau0 = 1; back in CGS it carries I1^a tau0^b (and |d| for the dipole).
@@ -146,11 +141,6 @@ def radiation_unit(kind: str, units: str) -> str:
     """The unit label of a radiation quantity in a unit system ("cgs" or "dimensionless")."""
     cgs_unit, dimless_unit = RADIATION_UNITS[kind][2:]
     return cgs_unit if units == "cgs" else dimless_unit
-
-
-def frequency_hz(angular_rate):
-    """An angular rate (rad/s) as a frequency, Hz: f = Omega / 2 pi."""
-    return np.asarray(angular_rate, dtype=float) / (2.0 * math.pi)
 
 
 def field_rms_from_power_per_sr(power_per_sr_cgs, distance_cm: float):

@@ -119,9 +119,11 @@ def test_api_page_of_simulate(site, tmp_path):
     assert sig.startswith("simulate(body: Body, model: str, omega0, *, t_end: float | None = None, "
                           "samples: int | None = None, t_eval=None, q0=None, euler_zxz0=None, method: str = 'auto',"), sig
     assert "kinematics: str = 'quaternion') → Trajectory" in sig, sig
-    # the docstring, with its "name : meaning" lines as a definition list
+    # the docstring, its numpydoc sections as field lists: name (type) – meaning
     assert "Integrate the Euler equation of model with orientation; return a Trajectory." in text
-    assert re.search(r"kinematics “quaternion” \(default\), “euler_zxz” \(the Poisson equations \(6\.4\)", text)
+    assert re.search(r"kinematics \(\{.quaternion., .euler_zxz., .none.\}\) – “quaternion” \(default\); "
+                     r"“euler_zxz”, the Poisson equations \(6\.4\)", text)
+    assert re.search(r"omega0 \(array_like, shape \(3,\)\) – Body-frame angular velocity at t = 0", text)
 
 
 def test_physics_equations_render_offline(site, tmp_path):

@@ -15,9 +15,11 @@ instants (8 nodes on every quarter turn: exact to round-off for the smooth integ
 remains is the model's departure from the balance plus the integrator's error.
 
 What each model should show (dimensionless eps_rad = tau0 |Omega|):
+
 * truncated (2.5) is (2.4a) solved for Omega_dot: r_a at the integrator's error; r_1 = -(K(t) - K(0)),
-  a bounded oscillation; r_E does not close: dE/dt + P - dE_S/dt = (2/3c^3) d_ddot . (Omega_dot x d)
-  - (2/3c^3) d_dot . d_dddot is O(1) relative to P for a top that precesses (delta != 0), e.g.
+  a bounded oscillation; r_E does not close:
+  dE/dt + P - dE_S/dt = (2/3c^3) d_ddot . (Omega_dot x d) - (2/3c^3) d_dot . d_dddot
+  is O(1) relative to P for a top that precesses (delta != 0), e.g.
   -(2/3c^3) d^2 delta (1 - delta) Omega3^2 Omega_perp^2 on average for chi = 0;
 * reduced (2.2)+(2.3) is (2.1) with the free-motion Omega_dot, Omega_ddot in d_dddot: r_1 and r_E
   are O(eps_rad) relative (the order of its reduction), and r_a equals the Schott integral to
@@ -80,6 +82,7 @@ class BalanceRun:
     details: dict = field(default_factory=dict)
 
     def record(self) -> dict:
+        """The fields as a JSON-ready dict (``spinviz check --json``)."""
         return {k: v for k, v in vars(self).items()}
 
 
@@ -96,16 +99,16 @@ def balance_run(body: Body, model: str, eps: float, direction=(0.3, 0.5, 0.8), e
     tr = simulate(body, model, w0, t_eval=t, euler_zxz0=euler0, method="taylor", rtol=rtol, atol=atol)
     runtime = time.perf_counter() - start
     s = body.system(model)
-    b = RA.balance(model, tr.omega, s.inertia, s.coupling)
-    g = np.broadcast_to(np.asarray(s.coupling), tr.omega.shape)
+    b = RA.balance(model, tr.omega_body, s.inertia, s.coupling)
+    g = np.broadcast_to(np.asarray(s.coupling), tr.omega_body.shape)
     world = lambda v: R.world_from_body(tr.q, v)      # noqa: E731
-    L = world(b.L)
-    F = world(b.flux)
-    K = world(np.cross(g, b.b2))
+    L_world = world(b.L_body)
+    F_world = world(b.flux_body)
+    K_world = world(np.cross(g, b.b2))
     cum = lambda f: np.cumsum(wt[:, None] * f if f.ndim == 2 else wt * f, axis=0)[ends]   # noqa: E731
-    dL = L[ends] - L[0]
-    r_a = dL - cum(F)
-    r_1 = r_a - (K[ends] - K[0])
+    dL = L_world[ends] - L_world[0]
+    r_a = dL - cum(F_world)
+    r_1 = r_a - (K_world[ends] - K_world[0])
     int_P = cum(b.power)
     r_E = (b.energy[ends] - b.energy[0]) + int_P - (b.schott_energy[ends] - b.schott_energy[0])
     # the energy residual predicted from the state alone: int (Omega . N - b1 . b3) dt
@@ -117,7 +120,7 @@ def balance_run(body: Body, model: str, eps: float, direction=(0.3, 0.5, 0.8), e
         rel_2_4a=float(np.max(np.linalg.norm(r_a, axis=1))) / scale_L,
         rel_2_1=float(np.max(np.linalg.norm(r_1, axis=1))) / scale_L,
         rel_energy=float(np.max(np.abs(r_E))) / scale_E,
-        rel_schott_over_dL=float(np.max(np.linalg.norm(K[ends] - K[0], axis=1))) / scale_L,
+        rel_schott_over_dL=float(np.max(np.linalg.norm(K_world[ends] - K_world[0], axis=1))) / scale_L,
         rel_energy_defect_predicted=float(np.max(np.abs(r_E - predicted))) / scale_E,
         runtime_s=runtime,
         details={"method": tr.stats["method"], "samples": int(t.size), "energy_radiated_over_lost":
@@ -125,8 +128,8 @@ def balance_run(body: Body, model: str, eps: float, direction=(0.3, 0.5, 0.8), e
     )
 
 
-def pointwise(model: str, omega, J, g) -> dict:
-    """The balance identities at states ``omega`` (..., 3) (body frame, dimensionless), as the
+def pointwise(model: str, omega_body, J, g) -> dict:
+    """The balance identities at states ``omega_body`` (..., 3) (body frame, dimensionless), as the
     largest residual relative to the largest |flux (2.4a)|:
 
     * ``2_4a``: |N - F|, the model's torque against (2.4a);
@@ -135,13 +138,13 @@ def pointwise(model: str, omega, J, g) -> dict:
       reduced equation's definition; round-off for it);
     * ``energy``: |Omega . N - b1 . b3| / max P, dE/dt against -P + dE_S/dt.
     """
-    b = RA.balance(model, omega, J, g)
-    scale = float(np.max(np.linalg.norm(b.flux, axis=-1)))
-    free = RA.free_dipole_torque(omega, J, g)
+    b = RA.balance(model, omega_body, J, g)
+    scale = float(np.max(np.linalg.norm(b.flux_body, axis=-1)))
+    free = RA.free_dipole_torque(omega_body, J, g)
     return {
-        "2_4a": float(np.max(np.linalg.norm(b.torque - b.flux, axis=-1))) / scale,
-        "2_1": float(np.max(np.linalg.norm(b.torque - b.dipole_torque(g), axis=-1))) / scale,
-        "2_1_free": float(np.max(np.linalg.norm(b.torque - free, axis=-1))) / scale,
+        "2_4a": float(np.max(np.linalg.norm(b.torque_body - b.flux_body, axis=-1))) / scale,
+        "2_1": float(np.max(np.linalg.norm(b.torque_body - b.dipole_torque(g), axis=-1))) / scale,
+        "2_1_free": float(np.max(np.linalg.norm(b.torque_body - free, axis=-1))) / scale,
         "energy": float(np.max(np.abs(b.work - b.dipole_work))) / float(np.max(b.power)),
     }
 

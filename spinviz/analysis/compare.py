@@ -29,6 +29,11 @@ MAX_SAMPLES = 100_000          # per kind of output time: 2 x 1e5 instants x 7 f
 
 @dataclass
 class ModelSummary:
+    """How one model's run ends (``summarize``): |Omega| at the end (rad/s or 1/tau0) and
+    relative to the start, the late spin-down exponent d ln|Omega| / d ln t, the angle between
+    Omega and d (degrees, frame-free), angle(d, L) along the run, shape (N,), degrees, and the
+    end state in words."""
+
     model: str
     omega_final: float               # |Omega| at t_end, scene units
     omega_ratio: float               # |Omega(t_end)| / |Omega(0)|
@@ -40,6 +45,15 @@ class ModelSummary:
 
 @dataclass
 class Comparison:
+    """Reduced against truncated from the same start (``compare``), stored at the same times.
+
+    t : (N,) s or tau0; misorientation_deg, dipole_angle_deg : (N,) degrees between the two
+    orientations and the two world-frame dipoles, None where the phases are not resolved;
+    cone_difference_deg : (N,) difference of angle(d, L), degrees (needs no phase);
+    first_exceed : metric -> {threshold: first time above it, or None}; models : the two
+    ``ModelSummary``; omega_body : model -> (N, 3) body-frame Omega, rad/s or 1/tau0.
+    """
+
     t: np.ndarray
     units: str
     phase_resolved: bool
@@ -48,9 +62,10 @@ class Comparison:
     cone_difference_deg: np.ndarray
     first_exceed: dict = field(default_factory=dict)      # metric -> {threshold: time or None}
     models: list = field(default_factory=list)
-    omega: dict = field(default_factory=dict)             # model -> (N, 3) body-frame Omega
+    omega_body: dict = field(default_factory=dict)
 
     def record(self) -> dict:
+        """The end states and first crossings as a JSON-ready dict (``spinviz compare --json``)."""
         return {
             "phase_resolved": self.phase_resolved,
             "units": self.units,
@@ -87,7 +102,10 @@ def _angle(a, b):
 
 
 def summarize(tr: Trajectory) -> ModelSummary:
-    w = tr.omega
+    """The end state of one run (``ModelSummary``): residual rotation about d (5.2), (6.8),
+    spin-down to rest (5.4), (6.10), or still evolving, from |Omega| over the last third of the
+    run and the angle between Omega and d at its end."""
+    w = tr.omega_body
     mag = np.linalg.norm(w, axis=1)
     d = tr.body.dipole_direction
     L_body = np.asarray(tr.body.inertia) * w
@@ -125,10 +143,12 @@ def compare(trajs: list[Trajectory]) -> Comparison:
     first["angle(d, L)"] = {f"{x:g} deg": first_crossing(a.t, cone_diff, x) for x in THRESHOLDS_DEG}
     return Comparison(t=np.asarray(a.t), units=a.units, phase_resolved=resolved, misorientation_deg=mis,
                       dipole_angle_deg=dip, cone_difference_deg=cone_diff, first_exceed=first, models=[sa, sb],
-                      omega={sa.model: a.omega, sb.model: b.omega})
+                      omega_body={sa.model: a.omega_body, sb.model: b.omega_body})
 
 
 def format_table(c: Comparison, title: str) -> str:
+    """The comparison as the text ``spinviz compare`` prints: first crossings of 1 and 10 deg,
+    then each model's end state, times in the scene's units."""
     units = c.units
     lines = [title, ""]
     if not c.phase_resolved:
@@ -205,7 +225,7 @@ def plot(c: Comparison, path: str, title: str) -> None:
                     textcoords="offset points", fontsize=8, color="tab:red", va="bottom")
     _time_axis(ax, tl, "angle between the predictions (°)", "reduced vs truncated: how far apart")
     ax = axes[1]
-    for m, w in c.omega.items():
+    for m, w in c.omega_body.items():
         ax.plot(t, np.linalg.norm(w[pos], axis=1), color=model_color(m), lw=1.6, label=m)
     ax.set_yscale("log")
     _time_axis(ax, tl, "|Ω| (rad/s)" if c.units == "cgs" else "|ω| (1/τ₀)", "spin rate")
@@ -237,12 +257,12 @@ def plot_hodograph(c: Comparison, path: str, title: str) -> None:
     plt = pyplot()
 
     fig = plt.figure(figsize=(11, 5))
-    scale = max(float(np.linalg.norm(w[0])) for w in c.omega.values()) or 1.0
-    allw = np.vstack([w for w in c.omega.values()]) / scale
+    scale = max(float(np.linalg.norm(w[0])) for w in c.omega_body.values()) or 1.0
+    allw = np.vstack([w for w in c.omega_body.values()]) / scale
     lo, hi = np.minimum(allw.min(axis=0), 0.0), np.maximum(allw.max(axis=0), 0.0)
     pad = 0.05 * float(np.max(hi - lo) or 1.0)
     sym = "Ω" if c.units == "cgs" else "ω"
-    for k, (m, w) in enumerate(c.omega.items()):
+    for k, (m, w) in enumerate(c.omega_body.items()):
         ax = fig.add_subplot(1, 2, k + 1, projection="3d")
         x = w / scale
         ax.plot(x[:, 0], x[:, 1], x[:, 2], lw=1.2, color=model_color(m))

@@ -33,8 +33,6 @@ from .. import units as U
 from ..physics import radiation as RA
 from ..trajectory import Trajectory
 
-MIN_LINE_SHARE = 1e-12        # lines weaker than this share of a sample's strongest carry nothing shown
-
 
 @dataclass
 class Detection:
@@ -71,18 +69,22 @@ class Detection:
 
     @property
     def freq_unit(self) -> str:
+        """Unit of ``freq``: Hz (CGS) or cycles per tau0 (dimensionless)."""
         return "Hz" if self.units == "cgs" else "1/tau0"
 
     @property
     def power_unit(self) -> str:
+        """Unit of the powers: erg/s (CGS) or I1/tau0^3 (``units.RADIATION_UNITS``)."""
         return U.radiation_unit("power", self.units)
 
     @property
     def power_sr_unit(self) -> str:
+        """Unit of the powers per solid angle: erg/s/sr (CGS) or I1/tau0^3/sr."""
         return U.radiation_unit("power_per_sr", self.units)
 
     @property
     def field_unit(self) -> str:
+        """Unit of the field amplitudes: V/m at ``distance_cm`` (CGS) or (I1/tau0^3)^1/2."""
         return "V/m" if self.units == "cgs" else "(I1/tau0^3)^1/2"
 
     def record(self, i: int) -> dict:
@@ -123,8 +125,8 @@ def detect(traj: Trajectory, line_of_sight=None, distance_cm: float = 1.0, M: in
     e, psr = lines.toward(n)
     stokes = lines.stokes(n)
     to_hz = 1.0 / (2.0 * math.pi * tau0)                 # rad per tau0 -> Hz (cycles per tau0 if dimensionless)
-    freq = np.abs(lines.omega) * to_hz
-    e = np.where((lines.omega < 0)[..., None], np.conj(e), e)
+    freq = np.abs(lines.angular_frequency) * to_hz
+    e = np.where((lines.angular_frequency < 0)[..., None], np.conj(e), e)
     line_power_sr = U.radiation_from_dimensionless(psr, "power_per_sr", I1, tau0)
     sig = math.sqrt(I1 / tau0**3) if cgs else 1.0        # g-unit signal -> (erg/s)^1/2
     to_field = (math.sqrt(1.5 / U.C_LIGHT) / distance_cm * U.STATV_PER_CM_IN_V_PER_M) if cgs else 1.0

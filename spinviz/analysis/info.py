@@ -23,10 +23,10 @@ _LABELS = {
 }
 
 
-def rows(body: Body, omega=None) -> list[dict]:
+def rows(body: Body, omega_body=None) -> list[dict]:
     """One dict per quantity: key, label, value, unit, human, printed, where, rel_diff, flagged.
 
-    omega : optional shape (3,) initial Omega (rad/s or dimensionless) of a scene; T and
+    omega_body : optional shape (3,) initial body-frame Omega (rad/s or 1/tau0) of a scene; T and
     Theta are then also given for it.  For presets the paper's reference spin
     Omega0 = Omega3 = pi 1e10 rad/s is used for the printed comparison.
     """
@@ -42,8 +42,8 @@ def rows(body: Body, omega=None) -> list[dict]:
             r.update(printed=p.value, printed_human=_human(p.value, unit, short=True), where=p.where, approx=p.approx,
                      rel_diff=diff, flagged=abs(diff) > FLAG_THRESHOLD)
         out.append(r)
-    if omega is not None:
-        w = np.asarray(omega, dtype=float)
+    if omega_body is not None:
+        w = np.asarray(omega_body, dtype=float)
         w0, w_perp, w3 = float(np.linalg.norm(w)), math.hypot(w[0], w[1]), abs(float(w[2]))
         tu = "s" if body.units == "cgs" else "tau0"
         if w_perp > 0:   # the unit of a scene's t_end_T
@@ -70,12 +70,12 @@ def _human(value: float, unit: str, short: bool = False) -> str:
     return f"{value:.4g} {unit}"
 
 
-def format_info(body: Body, title: str, omega=None) -> str:
+def format_info(body: Body, title: str, omega_body=None) -> str:
     """The human-readable report."""
     lines = [title, f"  source: {body.source}" if body.source else "", f"  units: {body.units}", ""]
     lines.append(f"  {'quantity':<34} {'spinviz':<30} {'paper prints':<16} diff")
     flagged = 0
-    for r in rows(body, omega):
+    for r in rows(body, omega_body):
         line = f"  {r['label']:<34} {r['human']:<30}"
         if "printed" in r:
             p = ("~" if r["approx"] else "") + r["printed_human"]

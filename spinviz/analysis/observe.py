@@ -42,6 +42,7 @@ class Resolution:
     polarization_deg: float = 5.0
 
     def label(self, key: str) -> str:
+        """The resolution of observable ``key`` ("power", "frequency" or "polarization") in words."""
         return {"power": f"factor {self.power_factor:g} in power toward the detector",
                 "frequency": f"{100 * self.frequency:g} % in dominant frequency",
                 "polarization": f"{self.polarization_deg:g}° in polarization angle"}[key]
@@ -85,6 +86,8 @@ class Observation:
     horizon: float = 0.0
 
     def record(self) -> dict:
+        """The observation as a JSON-ready dict (``spinviz observe --json``): scales, parting
+        times, and per model the scalar observables at the first and last samples."""
         a, b = self.detections
         return {
             "title": self.title, "units": self.units, "horizon": self.horizon,
@@ -218,46 +221,27 @@ def _horizon_text(obs: Observation) -> str:
     return f"watched for {U.format_time(obs.horizon, obs.units)}"
 
 
-def plot(obs: Observation, path: str) -> None:
-    """Four panels against log time: power toward the detector, dominant frequency, polarization
-    angle (both models in their video colours), and each difference in units of its resolution
-    (the models part where a curve crosses 1); parting times marked (PNG, atomic)."""
-    plt = pyplot()
-    a, b = obs.detections
-    scale, tl = time_unit(obs.horizon, obs.units)
-    pos = a.t > 0
-    t = a.t[pos] / scale
-    cgs = obs.units == "cgs"
-    fig, axes = plt.subplots(2, 2, figsize=(14, 8.6))
-    fs = 1e9 if cgs else 1.0
-    f_all = np.concatenate([d.f_dom[pos] for d in obs.detections])
-    f_log = float(np.max(f_all)) > 5.0 * max(float(np.min(f_all)), 1e-300)
-    panels = (("power", lambda d: d.power_sr * (U.ERG_PER_S_IN_W if cgs else 1.0),
-               "power toward the detector (W/sr)" if cgs else f"dP/dΩ ({a.power_sr_unit})", "log", "power received"),
-              ("frequency", lambda d: d.f_dom / fs, "dominant frequency (GHz)" if cgs else f"dominant frequency "
-               f"({a.freq_unit})", "log" if f_log else "linear", "strongest spectral line"),
-              ("polarization", lambda d: np.degrees(d.pol_angle), "polarization angle from u1 (°)", "linear",
-               "linear polarization"))
-    for ax, (key, fn, ylabel, yscale, title) in zip(axes.flat, panels):
-        for d in obs.detections:
-            ax.plot(t, fn(d)[pos], **_style(d.model))
-        ax.set_yscale(yscale)
-        tp = obs.parting[key]
-        word = obs.resolution.label(key).split(" in ")[0]
-        if tp is not None and tp > 0:
-            ax.axvline(tp / scale, color="tab:red", lw=1.0, ls="--")
-            ax.annotate(f"{word} apart\nat {U.format_time(tp, obs.units)}", (tp / scale, 0.96),
-                        xycoords=("data", "axes fraction"), xytext=(4, 0), textcoords="offset points", fontsize=8,
-                        color="tab:red", va="top")
-        elif tp is None:
-            ax.annotate(f"never {word} apart within the run", (0.98, 0.96), xycoords="axes fraction", fontsize=8,
-                        color="0.35", va="top", ha="right")
-        ax.set_title(title)
-        ax.set_ylabel(ylabel)
-    axes[1, 0].set_ylim(-95, 95)
-    axes[1, 0].set_yticks([-90, -45, 0, 45, 90])
-    ax = axes[1, 1]
-    diff = differences(a, b)
+def _observable_panel(ax, obs: Observation, key: str, series, t, scale: float) -> None:
+    """One observable of both models (``series``, one array per detection, at times ``t`` in
+    the plot's unit), with the time the models part in it, or that they never do."""
+    for d, y in zip(obs.detections, series):
+        ax.plot(t, y, **_style(d.model))
+    tp = obs.parting[key]
+    word = obs.resolution.label(key).split(" in ")[0]
+    if tp is not None and tp > 0:
+        ax.axvline(tp / scale, color="tab:red", lw=1.0, ls="--")
+        ax.annotate(f"{word} apart\nat {U.format_time(tp, obs.units)}", (tp / scale, 0.96),
+                    xycoords=("data", "axes fraction"), xytext=(4, 0), textcoords="offset points", fontsize=8,
+                    color="tab:red", va="top")
+    elif tp is None:
+        ax.annotate(f"never {word} apart within the run", (0.98, 0.96), xycoords="axes fraction", fontsize=8,
+                    color="0.35", va="top", ha="right")
+
+
+def _difference_panel(ax, obs: Observation, t, pos) -> None:
+    """Each observable's difference between the models in units of its resolution: the models
+    part where a curve crosses 1."""
+    diff = differences(*obs.detections)
     res = obs.resolution
     with np.errstate(divide="ignore", invalid="ignore"):
         norm = {"power": np.log(diff["power"]) / math.log(res.power_factor), "frequency": diff["frequency"] / res.frequency,
@@ -273,6 +257,36 @@ def plot(obs: Observation, path: str) -> None:
     ax.set_ylim(1e-6, 1e4)
     ax.set_ylabel("difference / resolution")
     ax.set_title("reduced vs truncated, in units of the resolution")
+
+
+def plot(obs: Observation, path: str) -> None:
+    """Four panels against log time: power toward the detector, dominant frequency, polarization
+    angle (both models in their video colours), and each difference in units of its resolution
+    (the models part where a curve crosses 1); parting times marked (PNG, atomic)."""
+    plt = pyplot()
+    a = obs.detections[0]
+    scale, tl = time_unit(obs.horizon, obs.units)
+    pos = a.t > 0
+    t = a.t[pos] / scale
+    cgs = obs.units == "cgs"
+    fig, axes = plt.subplots(2, 2, figsize=(14, 8.6))
+    fs = 1e9 if cgs else 1.0
+    f_all = np.concatenate([d.f_dom[pos] for d in obs.detections])
+    f_log = float(np.max(f_all)) > 5.0 * max(float(np.min(f_all)), 1e-300)
+    panels = (("power", lambda d: d.power_sr * (U.ERG_PER_S_IN_W if cgs else 1.0),
+               "power toward the detector (W/sr)" if cgs else f"dP/dΩ ({a.power_sr_unit})", "log", "power received"),
+              ("frequency", lambda d: d.f_dom / fs, "dominant frequency (GHz)" if cgs else f"dominant frequency "
+               f"({a.freq_unit})", "log" if f_log else "linear", "strongest spectral line"),
+              ("polarization", lambda d: np.degrees(d.pol_angle), "polarization angle from u1 (°)", "linear",
+               "linear polarization"))
+    for ax, (key, fn, ylabel, yscale, title) in zip(axes.flat, panels):
+        _observable_panel(ax, obs, key, [fn(d)[pos] for d in obs.detections], t, scale)
+        ax.set_yscale(yscale)
+        ax.set_title(title)
+        ax.set_ylabel(ylabel)
+    axes[1, 0].set_ylim(-95, 95)
+    axes[1, 0].set_yticks([-90, -45, 0, 45, 90])
+    _difference_panel(axes[1, 1], obs, t, pos)
     for ax in axes.flat:
         ax.set_xscale("log")
         ax.set_xlabel(tl + ", log scale")
@@ -292,8 +306,6 @@ def plot_detector(obs: Observation, path: str, epochs: int = 4) -> None:
     frequencies drawn and labelled), the RMS field over the run, and the field's waveform over
     three rotation periods at a few instants (PNG, atomic)."""
     plt = pyplot()
-    from .detector import waveform
-
     a = obs.detections[0]
     scale, tl = time_unit(obs.horizon, obs.units)
     cgs = obs.units == "cgs"
@@ -317,33 +329,14 @@ def plot_detector(obs: Observation, path: str, epochs: int = 4) -> None:
     picks = np.unique(np.geomspace(max(t[0], obs.horizon * 1e-4), obs.horizon, epochs))
     for col, d in enumerate(obs.detections):
         ax = fig.add_subplot(grid[0, col])
-        img = np.full((nf, t.size), floor)
-        fb = np.clip(np.searchsorted(edges, d.freq[pos]), 0, nf - 1)
-        db = 10.0 * np.log10(np.maximum(d.line_power_sr[pos], 1e-300) / ref[pos, None])
-        cols = np.arange(t.size)
-        for k in range(d.freq.shape[1]):
-            for dr in (-1, 0, 1):                       # three bins: a line stays visible at any size
-                r = np.clip(fb[:, k] + dr, 0, nf - 1)
-                img[r, cols] = np.maximum(img[r, cols], db[:, k])
+        img = _spectrogram_image(d, pos, edges, ref, floor)
         mesh = ax.pcolormesh(x, edges / fscale, img, vmin=floor, vmax=0.0, cmap="magma", shading="nearest",
                              rasterized=True)
         if log_f:
             ax.set_yscale("log")
             ax.yaxis.set_major_formatter(lambda v, _: f"{v:g}")
             ax.yaxis.set_minor_formatter(lambda v, _: "")
-        at = lambda frac: int(np.argmin(np.abs(x - (x[0] + frac * (x[-1] - x[0])))))   # noqa: E731
-        j = at(0.03)
-        ax.plot(x, d.f_rot[pos] / fscale * 1.04, color="white", lw=0.8, ls=(0, (2, 3)), alpha=0.8)
-        ax.annotate("rotation |L|/2πI₁ (dashed, just above its line)", (x[j], d.f_rot[pos][j] / fscale * 1.04),
-                    xytext=(0, 5), textcoords="offset points", color="white", fontsize=8)
-        if np.any(d.f_prec[pos] > 0):
-            ax.plot(x, d.f_prec[pos] / fscale, color="cyan", lw=0.8, ls=(0, (1, 2)), alpha=0.8)
-            j = at(0.45)
-            ax.annotate("body precession |δΩ₃|/2π (dotted)", (x[j], d.f_prec[pos][j] / fscale), xytext=(0, -11),
-                        textcoords="offset points", color="cyan", fontsize=8)
-        else:
-            ax.annotate("no body precession (δΩ₃ = 0): one line", (0.02, 0.03), xycoords="axes fraction",
-                        color="0.85", fontsize=8)
+        _frequency_guides(ax, d, x, pos, fscale)
         ax.set_ylim(edges[0] / fscale, fmax / fscale)
         _log_ticks(ax, x)
         ax.set_xlabel(tl + ", log scale")
@@ -353,37 +346,8 @@ def plot_detector(obs: Observation, path: str, epochs: int = 4) -> None:
         cb.set_label("dP/dΩ per line, dB re the stronger model at that instant")
         for tp in picks:
             ax.axvline(math.log10(tp / scale), color="0.6", lw=0.6, ls=":")
-        ax2 = fig.add_subplot(grid[2, col])
-        for j, tp in enumerate(picks[::-1]):
-            i = int(np.argmin(np.abs(d.t - tp)))
-            tw, E = waveform(d, i)
-            amp = float(np.max(np.abs(E))) or 1.0
-            span = float(tw[-1]) or 1.0
-            ax2.plot(tw / span * 3.0, E[:, 0] / amp * 0.42 + j, color=model_color(d.model), lw=1.2)
-            ax2.plot(tw / span * 3.0, E[:, 1] / amp * 0.42 + j, color=model_color(d.model), lw=0.8, ls="--", alpha=0.6)
-            unit = "µV/m" if cgs else d.field_unit
-            peak = amp * (1e6 if cgs else 1.0)
-            per = (f"{1e9 / d.f_rot[i]:.3g} ns" if cgs else f"{1.0 / d.f_rot[i]:.3g} τ₀") if d.f_rot[i] > 0 else "-"
-            ax2.annotate(f"t = {U.format_time(d.t[i], obs.units)}: peak {peak:.3g} {unit}, period {per}",
-                         (3.05, j), xycoords="data", fontsize=8, va="center")
-        ax2.set_xlim(0, 5.5)
-        ax2.set_ylim(-0.6, len(picks) - 0.4)
-        ax2.set_yticks([])
-        ax2.set_xlabel("time within the snapshot (rotation periods at that instant)")
-        ax2.set_title("field at the dotted instants (later lower, rows normalized; solid u1, dashed u2)", fontsize=9)
-        for side in ("left", "right", "top"):
-            ax2.spines[side].set_visible(False)
-    ax = fig.add_subplot(grid[1, :])
-    for d in obs.detections:
-        ax.plot(t / scale, d.field_rms[pos] * (1e6 if cgs else 1.0), **_style(d.model))
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel(tl + ", log scale")
-    ax.set_ylabel(f"RMS field at {a.distance_cm:g} cm (µV/m)" if cgs else f"RMS field ({a.field_unit})")
-    ax.set_title("the detected signal's strength over the run (its time series, averaged over each turn)")
-    ax.grid(True, which="major", color="0.9", lw=0.6)
-    ax.legend(fontsize=8, loc="lower left")
-    _scale_marks(ax, obs, scale, t / scale)
+        _waveforms(fig.add_subplot(grid[2, col]), obs, d, picks)
+    _field_strength(fig.add_subplot(grid[1, :]), obs, pos, scale, tl)
     dist = f", field at {a.distance_cm:g} cm" if cgs else ""
     n = ", ".join(f"{v:.2g}" for v in a.line_of_sight)
     fig.suptitle(f"{obs.title}\ndetector along n = ({n}){dist}, {_horizon_text(obs)}: the spectral lines of the free "
@@ -391,6 +355,83 @@ def plot_detector(obs: Observation, path: str, epochs: int = 4) -> None:
                                                   "phase is not resolved)" if a.notes else ""), fontsize=11)
     fig.tight_layout()
     save(fig, path)
+
+
+def _spectrogram_image(d, pos, edges, ref, floor: float) -> np.ndarray:
+    """(frequency bin, instant) image of one detection's lines, dB re ``ref`` (per instant),
+    ``floor`` where no line falls; each line drawn three bins tall."""
+    nf = edges.size
+    img = np.full((nf, int(np.count_nonzero(pos))), floor)
+    fb = np.clip(np.searchsorted(edges, d.freq[pos]), 0, nf - 1)
+    db = 10.0 * np.log10(np.maximum(d.line_power_sr[pos], 1e-300) / ref[pos, None])
+    cols = np.arange(img.shape[1])
+    for k in range(d.freq.shape[1]):
+        for dr in (-1, 0, 1):                       # three bins: a line stays visible at any size
+            r = np.clip(fb[:, k] + dr, 0, nf - 1)
+            img[r, cols] = np.maximum(img[r, cols], db[:, k])
+    return img
+
+
+def _frequency_guides(ax, d, x, pos, fscale: float) -> None:
+    """The rotation |L|/2 pi I1 and body precession |delta Omega3|/2 pi frequencies over the
+    spectrogram (``x``: log10 time), labelled."""
+    at = lambda frac: int(np.argmin(np.abs(x - (x[0] + frac * (x[-1] - x[0])))))   # noqa: E731
+    j = at(0.03)
+    ax.plot(x, d.f_rot[pos] / fscale * 1.04, color="white", lw=0.8, ls=(0, (2, 3)), alpha=0.8)
+    ax.annotate("rotation |L|/2πI₁ (dashed, just above its line)", (x[j], d.f_rot[pos][j] / fscale * 1.04),
+                xytext=(0, 5), textcoords="offset points", color="white", fontsize=8)
+    if np.any(d.f_prec[pos] > 0):
+        ax.plot(x, d.f_prec[pos] / fscale, color="cyan", lw=0.8, ls=(0, (1, 2)), alpha=0.8)
+        j = at(0.45)
+        ax.annotate("body precession |δΩ₃|/2π (dotted)", (x[j], d.f_prec[pos][j] / fscale), xytext=(0, -11),
+                    textcoords="offset points", color="cyan", fontsize=8)
+    else:
+        ax.annotate("no body precession (δΩ₃ = 0): one line", (0.02, 0.03), xycoords="axes fraction",
+                    color="0.85", fontsize=8)
+
+
+def _waveforms(ax, obs: Observation, d, picks) -> None:
+    """The field's two polarizations over three rotation periods at the instants ``picks``
+    (later lower, each row normalized), with its peak and period."""
+    from .detector import waveform
+
+    cgs = obs.units == "cgs"
+    for j, tp in enumerate(picks[::-1]):
+        i = int(np.argmin(np.abs(d.t - tp)))
+        tw, E = waveform(d, i)
+        amp = float(np.max(np.abs(E))) or 1.0
+        span = float(tw[-1]) or 1.0
+        ax.plot(tw / span * 3.0, E[:, 0] / amp * 0.42 + j, color=model_color(d.model), lw=1.2)
+        ax.plot(tw / span * 3.0, E[:, 1] / amp * 0.42 + j, color=model_color(d.model), lw=0.8, ls="--", alpha=0.6)
+        unit = "µV/m" if cgs else d.field_unit
+        peak = amp * (1e6 if cgs else 1.0)
+        per = (f"{1e9 / d.f_rot[i]:.3g} ns" if cgs else f"{1.0 / d.f_rot[i]:.3g} τ₀") if d.f_rot[i] > 0 else "-"
+        ax.annotate(f"t = {U.format_time(d.t[i], obs.units)}: peak {peak:.3g} {unit}, period {per}",
+                    (3.05, j), xycoords="data", fontsize=8, va="center")
+    ax.set_xlim(0, 5.5)
+    ax.set_ylim(-0.6, len(picks) - 0.4)
+    ax.set_yticks([])
+    ax.set_xlabel("time within the snapshot (rotation periods at that instant)")
+    ax.set_title("field at the dotted instants (later lower, rows normalized; solid u1, dashed u2)", fontsize=9)
+    for side in ("left", "right", "top"):
+        ax.spines[side].set_visible(False)
+
+
+def _field_strength(ax, obs: Observation, pos, scale: float, tl: str) -> None:
+    """Both models' RMS field at the detector over the run, log-log."""
+    a = obs.detections[0]
+    cgs = obs.units == "cgs"
+    t = a.t[pos] / scale
+    for d in obs.detections:
+        ax.plot(t, d.field_rms[pos] * (1e6 if cgs else 1.0), **_style(d.model))
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(tl + ", log scale")
+    ax.set_ylabel(f"RMS field at {a.distance_cm:g} cm (µV/m)" if cgs else f"RMS field ({a.field_unit})")
+    ax.set_title("the detected signal's strength over the run (its time series, averaged over each turn)")
+    ax.grid(True, which="major", color="0.9", lw=0.6)
+    ax.legend(fontsize=8, loc="lower left")
+    _scale_marks(ax, obs, scale, t)
 
 
 def _log_ticks(ax, x) -> None:

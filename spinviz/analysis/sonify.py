@@ -30,7 +30,6 @@ import numpy as np
 
 from .. import __version__
 from .. import units as U
-from ..atomic import atomic_path
 from .detector import Detection
 
 RATE = 44_100
@@ -121,12 +120,7 @@ def synthesize(dets: list[Detection], duration: float = 20.0, f0: float = 440.0,
     knee : the log time map's k (default t_end/1000); pitch : "linear" (every frequency times
     one factor) or "auto" (that, unless the dominant frequency falls by more than 16x over the
     run: then f0 (f/f_start)^gamma with gamma putting the whole fall into 16x)."""
-    if len(dets) != 2:
-        raise ValueError("listen needs two models, one for each ear")
-    if not 0.5 <= duration <= MAX_SECONDS:
-        raise ValueError(f"duration must lie in [0.5, {MAX_SECONDS:g}] s, got {duration:g}")
-    if time_map not in ("log", "linear"):
-        raise ValueError(f"time map must be 'log' or 'linear', got {time_map!r}")
+    _check_synthesis(dets, duration, time_map, pitch)
     a, b = dets
     t = np.asarray(a.t, dtype=float)
     t_end = float(t[-1])
@@ -134,8 +128,6 @@ def synthesize(dets: list[Detection], duration: float = 20.0, f0: float = 440.0,
     f_src = float(a.f_rot[0]) or float(a.f_dom[0])
     if not f_src > 0:
         raise ValueError("the run does not rotate at the start: nothing to hear")
-    if pitch not in ("auto", "linear"):
-        raise ValueError(f"pitch must be 'auto' or 'linear', got {pitch!r}")
     f_low = min(float(np.min(np.where(d.f_dom > 0, d.f_dom, np.inf))) for d in dets)
     fall = f_src / f_low if math.isfinite(f_low) else 1.0
     gamma = math.log(PITCH_RANGE) / math.log(fall) if pitch == "auto" and fall > PITCH_RANGE else 1.0
@@ -158,20 +150,8 @@ def synthesize(dets: list[Detection], duration: float = 20.0, f0: float = 440.0,
     out = np.zeros((n, 2))
     below = np.zeros(n, dtype=bool)
     for ch, (d, amp, fr) in enumerate(zip(dets, amps, freqs)):
-        strongest = np.zeros(n)
-        for k in range(fr.shape[1]):
-            ak = np.interp(ts, t, amp[:, k]) / peak
-            if not np.any(ak > 1e-9):
-                continue
-            fk = np.interp(ts, t, fr[:, k])
-            if np.any(fk > NYQUIST_SHARE * rate):
-                dropped += 1
-                continue
-            # compress in dB: a -> a^comp keeps the loudest at its level and lifts the quiet ones
-            ak = np.power(np.maximum(ak, 0.0), comp)
-            phase = 2.0 * math.pi * np.cumsum(fk) / rate + float(np.angle(d.line_field[0, k] @ ant))
-            out[:, ch] += ak * np.cos(phase)
-            strongest = np.where(ak > strongest, fk, strongest)
+        out[:, ch], strongest, lost = _channel(d, amp / peak, fr, t, ts, ant, comp, rate)
+        dropped += lost
         below |= (strongest > 0) & (strongest < AUDIBLE_HZ)
     top = float(np.max(np.abs(out))) or 1.0
     out *= 0.8 / top
@@ -184,6 +164,46 @@ def synthesize(dets: list[Detection], duration: float = 20.0, f0: float = 440.0,
                       phase_resolved=bool(a.phase_resolved and b.phase_resolved), dropped_above_nyquist=dropped,
                       below_audible_s=float(below.sum() / rate))
     return out, mapping
+
+
+def _check_synthesis(dets, duration: float, time_map: str, pitch: str) -> None:
+    """``synthesize``'s arguments, checked before any work (ValueError saying which)."""
+    if len(dets) != 2:
+        raise ValueError("listen needs two models, one for each ear")
+    if not 0.5 <= duration <= MAX_SECONDS:
+        raise ValueError(f"duration must lie in [0.5, {MAX_SECONDS:g}] s, got {duration:g}")
+    if time_map not in ("log", "linear"):
+        raise ValueError(f"time map must be 'log' or 'linear', got {time_map!r}")
+    if pitch not in ("auto", "linear"):
+        raise ValueError(f"pitch must be 'auto' or 'linear', got {pitch!r}")
+
+
+def _channel(d: Detection, amp, fr, t, ts, ant, comp: float, rate: int):
+    """One ear: the sum of the detection's lines as tones at the sound's instants.
+
+    amp, fr : (N, K) line amplitudes on the antenna (relative to the loudest of both ears) and
+    audio frequencies (Hz) at the run's samples t (N,); ts : (n,) the run's time of each sound
+    sample.
+    Returns (samples (n,), the frequency of the strongest line per sample (n,), Hz, the number
+    of lines left out above ``NYQUIST_SHARE`` of the rate)."""
+    n = ts.size
+    out = np.zeros(n)
+    strongest = np.zeros(n)
+    dropped = 0
+    for k in range(fr.shape[1]):
+        ak = np.interp(ts, t, amp[:, k])
+        if not np.any(ak > 1e-9):
+            continue
+        fk = np.interp(ts, t, fr[:, k])
+        if np.any(fk > NYQUIST_SHARE * rate):
+            dropped += 1
+            continue
+        # compress in dB: a -> a^comp keeps the loudest at its level and lifts the quiet ones
+        ak = np.power(np.maximum(ak, 0.0), comp)
+        phase = 2.0 * math.pi * np.cumsum(fk) / rate + float(np.angle(d.line_field[0, k] @ ant))
+        out += ak * np.cos(phase)
+        strongest = np.where(ak > strongest, fk, strongest)
+    return out, strongest, dropped
 
 
 # --- the WAV file ---------------------------------------------------------------------------
@@ -208,12 +228,6 @@ def wav_bytes(samples: np.ndarray, rate: int, title: str, mapping: Mapping) -> b
     data = pcm.tobytes()
     chunks = b"fmt " + struct.pack("<I", len(fmt)) + fmt + info + b"data" + struct.pack("<I", len(data)) + data
     return b"RIFF" + struct.pack("<I", 4 + len(chunks)) + b"WAVE" + chunks
-
-
-def write_wav(path, samples, rate: int, title: str, mapping: Mapping) -> None:
-    """The WAV of ``wav_bytes``, written atomically."""
-    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
-        fh.write(wav_bytes(samples, rate, title, mapping))
 
 
 def read_info(path) -> dict:
@@ -243,7 +257,6 @@ def plot_wav(path_wav, path_png, title: str = "") -> None:
     right ear, sound time and pitch on the axes, the run's time and frequency on the opposite
     axes from the file's own mapping; the mapping stated under the title (PNG, atomic)."""
     from scipy.io import wavfile
-    from scipy.signal import spectrogram
 
     from ..plotting import pyplot, save
     from .compare import model_color
@@ -252,23 +265,8 @@ def plot_wav(path_wav, path_png, title: str = "") -> None:
     rate, data = wavfile.read(path_wav)
     info = read_info(path_wav)
     m = info.get("mapping", {})
-    x = data.astype(float) / 32768.0
+    specs, top, fmax = _spectrograms(data.astype(float) / 32768.0, rate)
     fig, axes = plt.subplots(1, 2, figsize=(15, 7.4), sharey=True)
-    nper = 4096
-    top = 0.0
-    specs = []
-    for ch in range(2):
-        # no detrending: removing each segment's mean from a tone puts a broadband step in it (-45 dB
-        # fringes); Blackman-Harris sidelobes sit at -92 dB
-        f, tt, S = spectrogram(x[:, ch], fs=rate, nperseg=nper, noverlap=nper * 3 // 4, window="blackmanharris",
-                               detrend=False)
-        specs.append((f, tt, S))
-        top = max(top, float(S.max()))
-    fmax = 0.0
-    for f, _, S in specs:
-        strong = S.max(axis=1) > top * 1e-6
-        fmax = max(fmax, float(f[strong].max()) if strong.any() else 0.0)
-    fmax = min(rate / 2, 1.25 * fmax or rate / 4)
     for ch, (ax, (f, tt, S)) in enumerate(zip(axes, specs)):
         keep = f <= fmax                                   # draw only the rows on screen
         f, S = f[keep], S[keep]
@@ -299,6 +297,28 @@ def plot_wav(path_wav, path_png, title: str = "") -> None:
     fig.suptitle(title or info.get("INAM", ""), fontsize=12)
     fig.text(0.06, 0.02, "the mapping, as written in the file:\n" + mapping, fontsize=9, va="bottom", family="monospace")
     save(fig, path_png)
+
+
+def _spectrograms(x, rate: int):
+    """Both channels' spectrograms of samples ``x`` (n, 2) in [-1, 1]: ([(f, t, S)] per channel,
+    the largest S of both, the highest frequency worth drawing, Hz)."""
+    from scipy.signal import spectrogram
+
+    nper = 4096
+    top = 0.0
+    specs = []
+    for ch in range(2):
+        # no detrending: removing each segment's mean from a tone puts a broadband step in it (-45 dB
+        # fringes); Blackman-Harris sidelobes sit at -92 dB
+        f, tt, S = spectrogram(x[:, ch], fs=rate, nperseg=nper, noverlap=nper * 3 // 4, window="blackmanharris",
+                               detrend=False)
+        specs.append((f, tt, S))
+        top = max(top, float(S.max()))
+    fmax = 0.0
+    for f, _, S in specs:
+        strong = S.max(axis=1) > top * 1e-6
+        fmax = max(fmax, float(f[strong].max()) if strong.any() else 0.0)
+    return specs, top, min(rate / 2, 1.25 * fmax or rate / 4)
 
 
 def audio_frequency(f, mapping: dict):

@@ -182,6 +182,26 @@ class ClassifyTable:
 
 
 @request
+class RefineTable:
+    """``[refine]``: adaptive refinement where the types change (``regimes.refine``): each of
+    ``levels`` passes computes the four children of every cell whose members disagree (the
+    most common type below ``agree``) or whose neighbours' type differs.  Needs both grid axes
+    as {min, max, cells}."""
+
+    levels: Annotated[Int, Field(ge=0, le=6)] = 0
+    agree: Annotated[Real, between(0.5, 1.0, "a share of the members")] = 0.9
+
+
+@request
+class OutputTable:
+    """``[output]``: what the store keeps beyond each run's label and evidence: the full
+    omega(tau) series of the first ``series`` members of every cell (the hodographs and the
+    web page read them; 0 keeps none)."""
+
+    series: Annotated[Int, Field(ge=0, le=16)] = 1
+
+
+@request
 class AtlasFile:
     """The top level of an atlas spec."""
 
@@ -193,6 +213,8 @@ class AtlasFile:
     models: Annotated[tuple, PlainValidator(_models)] | None = None
     run: Table | None = None
     classify: Table | None = None
+    refine: Table | None = None
+    output: Table | None = None
 
     @model_validator(mode="after")
     def _one_model_key(self):
@@ -202,10 +224,11 @@ class AtlasFile:
 
     @property
     def model_names(self) -> tuple[str, ...]:
+        """The spec's models in order: ``models``, the one ``model``, or ("reduced",)."""
         return self.models or ((self.model,) if self.model else ("reduced",))
 
 
-SUBTABLES = ("grid", "members", "run", "classify")
+SUBTABLES = ("grid", "members", "run", "classify", "refine", "output")
 SETTINGS_NAMES = {"samples_per_decade": "per_decade", "window_decades": "window"}    # TOML key -> Settings field
 
 

@@ -38,7 +38,6 @@ MAX_GIF_BYTES = 1_000_000_000   # a GIF's frames are kept in memory (RGB, 3 byte
 ZOOM_RANGE = (0.05, 20.0)       # outside it the body is a dot or fills the frame far beyond its edges
 MAX_KNEE_RATIO = 1e15           # t_end / log_knee: float64 must still tell neighbouring frame times apart
 MAX_TITLE = 160
-CAPTIONS = ("outreach", "physics")
 
 
 def _size(v):
@@ -132,18 +131,6 @@ class RenderSpec:
             raise SpecError("spin_turns_per_second", f"must be at most fps / 4 = {self.fps / 4.0:g} (a quarter turn per "
                                                      f"frame; faster spins alias), got {self.spin_turns_per_second:g}")
         return self
-
-    # -- construction ---------------------------------------------------------------------
-    @classmethod
-    def from_mapping(cls, data, title: str = "") -> RenderSpec:
-        """A spec from a parsed ``[render]`` table (``title`` unless it sets one); unknown keys
-        are refused.  ``SpecError`` names the key."""
-        from .base import terms
-
-        if not isinstance(data, dict):
-            raise SpecError("[render]", f"must be a table, got {type(data).__name__}")
-        with terms("key"):
-            return cls(**{"title": title, **data})
 
     def with_(self, **overrides) -> RenderSpec:
         """A copy with some fields replaced (validated like the original); None keeps a field."""

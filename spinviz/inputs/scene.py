@@ -34,7 +34,6 @@ DENSITY = (1e-3, 1e3, "g/cm^3")
 DIPOLE_DEBYE = (1e-6, 1e30, "D")
 ASPECT = (1e-3, 1e3, "L/D")
 DISTANCE_CM = (1e-4, 1e30, "from a micron to a megaparsec")
-PRESET_NAMES = tuple(P.PRESETS) + ("dast_box",)
 
 Length = Annotated[Real, between(*LENGTH_NM)]
 Density = Annotated[Real, between(*DENSITY)]
@@ -130,6 +129,8 @@ class BodyTable:
 
     @property
     def form(self) -> str:
+        """Which way the table gives the body: the first of ``BODY_FORMS`` it sets ("preset",
+        "shape", "delta" or "inertia")."""
         return next(k for k in BODY_FORMS if getattr(self, k) is not None)
 
     def _need(self, *keys: str):
@@ -225,6 +226,8 @@ class InitialTable:
 
     @property
     def orientation_key(self) -> str:
+        """The key the initial orientation was given by ("euler_zxz", "euler_zxz_deg" or
+        "quaternion", the default)."""
         return one_of(self, "euler_zxz", "euler_zxz_deg", "quaternion") or "quaternion"
 
     def q0(self) -> np.ndarray:
@@ -269,10 +272,13 @@ class SimulationTable:
 
     @property
     def model_names(self) -> tuple[str, ...]:
+        """The scene's models in order: ``models``, or the one ``model``."""
         return self.models if self.models is not None else (self.model,)
 
     @property
     def horizon_key(self) -> str:
+        """The key the horizon was given by ("t_end", "t_end_T" or "t_end_Theta"), to name it in
+        messages."""
         return one_of(self, *HORIZON_KEYS)
 
 
@@ -300,6 +306,7 @@ class ObserveTable:
 
     @property
     def horizon_key(self) -> str | None:
+        """The key the detector's horizon was given by, or None (the scene's horizon)."""
         return one_of(self, *HORIZON_KEYS)
 
 

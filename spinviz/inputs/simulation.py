@@ -158,10 +158,12 @@ class SimulationRequest:
 
     @property
     def time_unit(self) -> str:
+        """Unit of every time of the request: "s" (CGS body) or "tau0" (dimensionless)."""
         return "s" if self.units == "cgs" else "tau0"
 
     @property
     def omega_unit(self) -> str:
+        """Unit of ``omega0`` and of the run's Omega: "rad/s" (CGS body) or "1/tau0"."""
         return "rad/s" if self.units == "cgs" else "1/tau0"
 
     @property
@@ -171,6 +173,7 @@ class SimulationRequest:
 
     @property
     def horizon(self) -> float:
+        """The end of the run, in ``time_unit``: the last of ``t_eval``, or ``t_end``."""
         return float(self.t_eval[-1]) if self.t_eval is not None else float(self.t_end)
 
     def times(self) -> np.ndarray:

@@ -247,6 +247,7 @@ def radiation_flow(model, st, tau, J, g, A, b, rh_max, ec):
 
     The increment dOmega is accumulated on its own (it is small) and then turned into
     increments of rho, phi and Omega3 without cancellation, each added with compensation."""
+    # Long on purpose: a numba kernel on scalars; helpers returning the increments would cost a tuple per stage.
     c, s_ = math.cos(st[1]), math.sin(st[1])
     w1, w2, w3 = st[0] * c, st[0] * s_, st[2]
     r = radiation(model, w1, w2, w3, J, g)

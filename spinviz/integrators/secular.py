@@ -57,6 +57,12 @@ class NotApplicable(ValueError):
 
 @dataclass
 class Setup:
+    """A secular run made ready by ``prepare``: the system in the symmetric top's own frame
+    (body' = body turned so that e3 is the symmetry axis; d's direction for a sphere), the
+    quaternion q_frame (w, x, y, z) taking body' to body, the start w0 (3,) body' frame in spin
+    units, q_L (4,) taking world z to L_world, the ZXZ angles (rad) of the start about L,
+    eps = tau0 |Omega0|, and whether the torque is equivariant about e3 (d on the axis)."""
+
     system: System          # in the frame where e3 is the symmetry axis (along d for a sphere)
     q_frame: np.ndarray     # body' from body: identity except for spheres
     w0: np.ndarray          # spin units, in that frame
@@ -136,6 +142,26 @@ def resonance_kicks(setup: Setup, crossings) -> list[dict]:
 
 
 def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, step: float | None = None) -> Solution:
+    """The ``secular`` method: the averaged slow flow (4.12) of a symmetric top, with the fast
+    phases carried analytically, and its error statements in ``stats``.
+
+    Parameters
+    ----------
+    problem : Problem
+        In spin units (|omega(0)| = 1); omega0 body frame, q0 (w, x, y, z).
+    rtol, atol : float
+        Tolerances of the slow flow's DOP853 steps.
+    step : float, optional
+        Ignored (the method is adaptive); accepted for the common interface.
+
+    Returns
+    -------
+    Solution
+        omega (N, 3) body frame and q (N, 4) at ``problem.t_eval``; ``slow`` holds q_L and the
+        (N,) angles phi_L, theta_L, psi_L about L; not successful (with the reason) where the
+        flow does not apply, meets the oscillating regime "5", or crosses a resonance whose
+        kick on L exceeds ``L_TOL``.
+    """
     from . import kernels as KN
     from . import slowflow as SF
 
@@ -162,28 +188,9 @@ def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, st
                           f"equation, whose cost grows as eps^-1/2, needs more than {MAX_STEPS:g} steps; shorten t_end",
                           stats)
         return failed(f"the slow flow: {ST.MESSAGES.get(status, status)}", stats)
-    crossings = resonance_kicks(setup, recorded)
-    kicks = np.array([c["kick_rad"] for c in crossings])
-    kick_rss = float(np.sqrt(np.sum(kicks**2)))
-    # the O(eps) wobble of L under the torque: 2 eps, measured up to 1.1 eps (delta = 0.5, chi = 1.36,
-    # eps = 1e-4, 3 T in full as omega3 -> 0); none if free, nor for the truncated model with the dipole
-    # on the axis, whose torque lies along L ((6.10); measured 1.5e-8 rad at eps = 1e-4)
-    fixed_L = s.model == "free" or (s.model == "truncated" and setup.equivariant)
-    wobble = 0.0 if fixed_L else 2.0 * setup.eps
-    L_unc = kick_rss + wobble
-    stats.update(resonances=[[c["m"], c["t"], c["kick_rad"]] for c in crossings], L_direction_uncertainty_rad=L_unc,
-                 L_direction_bound_rad=float(np.sum(kicks)) + wobble)
-    # a resonant kick also moves L relative to the body, i.e. the split of |L| between omega_perp and
-    # omega3 (measured with L_TOL lifted: delta = 0.8, chi = 1.16, eps = 3e-5: slow error 2.8e-4 against
-    # a kick of 2.6e-4), and that error in omega3 drifts the phases for the rest of the run
-    # (1.5: measured turns of L are 0.57-1.13 x the predicted kick in spinviz check)
-    stats["slow_error_estimate"] += 1.5 * kick_rss
-    stats["phase_error_rad"] += 1.5 * abs(setup.delta) * kick_rss * float(t[-1] - t[0])
-    if kick_rss > L_TOL:
-        first = crossings[0]
-        return failed(f"the run crosses the resonance |L|/I1 = {first['m']} delta omega3 at {first['t'] / t[-1]:.3g} of the "
-                      f"horizon, where the torque across L no longer averages out: L's direction becomes uncertain "
-                      f"by ~{L_unc:.2g} rad (~sqrt(tau0 Omega)), more than {L_TOL:g}; integrate in full instead", stats)
+    L_unc, refusal = _resonance_budget(setup, recorded, stats, t)
+    if refusal:
+        return failed(refusal, stats)
     o = out
     phi, p = o[:, 3], o[:, 4]
     wp, w3 = np.hypot(o[:, 0], o[:, 1]), o[:, 2]
@@ -203,6 +210,36 @@ def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, st
     return Solution(t=t, omega=omega, q=q, stats=stats, slow=slow)
 
 
+def _resonance_budget(setup: Setup, recorded, stats: dict, t: np.ndarray) -> tuple[float, str | None]:
+    """The resonances the slow flow crossed, charged to the error statements in ``stats``
+    (updated in place): (the uncertainty of L's direction, rad; the reason to refuse the run
+    when a kick exceeds ``L_TOL``, else None)."""
+    s = setup.system
+    crossings = resonance_kicks(setup, recorded)
+    kicks = np.array([c["kick_rad"] for c in crossings])
+    kick_rss = float(np.sqrt(np.sum(kicks**2)))
+    # the O(eps) wobble of L under the torque: 2 eps, measured up to 1.1 eps (delta = 0.5, chi = 1.36,
+    # eps = 1e-4, 3 T in full as omega3 -> 0); none if free, nor for the truncated model with the dipole
+    # on the axis, whose torque lies along L ((6.10); measured 1.5e-8 rad at eps = 1e-4)
+    fixed_L = s.model == "free" or (s.model == "truncated" and setup.equivariant)
+    wobble = 0.0 if fixed_L else 2.0 * setup.eps
+    L_unc = kick_rss + wobble
+    stats.update(resonances=[[c["m"], c["t"], c["kick_rad"]] for c in crossings], L_direction_uncertainty_rad=L_unc,
+                 L_direction_bound_rad=float(np.sum(kicks)) + wobble)
+    # a resonant kick also moves L relative to the body, i.e. the split of |L| between omega_perp and
+    # omega3 (measured with L_TOL lifted: delta = 0.8, chi = 1.16, eps = 3e-5: slow error 2.8e-4 against
+    # a kick of 2.6e-4), and that error in omega3 drifts the phases for the rest of the run
+    # (1.5: measured turns of L are 0.57-1.13 x the predicted kick in spinviz check)
+    stats["slow_error_estimate"] += 1.5 * kick_rss
+    stats["phase_error_rad"] += 1.5 * abs(setup.delta) * kick_rss * float(t[-1] - t[0])
+    if not kick_rss > L_TOL:
+        return L_unc, None
+    first = crossings[0]
+    return L_unc, (f"the run crosses the resonance |L|/I1 = {first['m']} delta omega3 at {first['t'] / t[-1]:.3g} of the "
+                   f"horizon, where the torque across L no longer averages out: L's direction becomes uncertain "
+                   f"by ~{L_unc:.2g} rad (~sqrt(tau0 Omega)), more than {L_TOL:g}; integrate in full instead")
+
+
 def _phi0(setup: Setup) -> float:
     """The starting precession angle in the kernel's split of the ZXZ angles about L.
 
@@ -220,7 +257,7 @@ def _stats(setup: Setup, cnt, switches, rtol: float, t) -> dict:
     """What the run did and how sure it is, before the resonance scan.
 
     The error statements are bounds fitted to measurements against full integration on random
-    bodies (README; ``python -m spinviz.validation.secular_sweep``, and a seed of it in
+    bodies (README; ``spinviz check --sweep``, and a seed of it in
     tests/test_secular_real_scale.py): where averaged, the phases drift by ~ integral of
     mu^2 dt and at least 2 eps max(1, t/T), the slow variables are off by ~ max(15 eps^2,
     mu^2), with mu = eps |w|^2 / |delta w3| the radiation rate over the precession rate (small

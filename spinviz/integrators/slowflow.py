@@ -119,6 +119,10 @@ def sigma_rate(wp2, w3, J3, sgn, N):
 
 @_jit
 def rhs(mode, sgn, model, J, g, cM, sM, equiv, y, out):
+    """The slow flow's right-hand side into ``out`` (4,): in FULL mode y = (w1, w2, w3, Sigma),
+    the body-frame Euler equation of the symmetric top J = (1, 1, J3); in AVG mode
+    y = (w_perp, w3, p, Sigma), its average over the precession phase p on the M nodes
+    (cM, sM) ((4.12) for the reduced model).  Spin units; ``sgn`` the sign of w3 in Sigma."""
     J3 = J[2]
     if mode == FULL:
         w1, w2, w3 = y[0], y[1], y[2]
@@ -276,6 +280,7 @@ def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_steps
     changes of w3, 13 the time of the first (9, 14, 15 unused), 10 the integral of mu^2 dt over
     AVG (mu = eps |w|^2 / |delta w3|), 11 the phase Sigma covered in FULL, 12 the largest
     forced-response error met in AVG."""
+    # Long on purpose: one compiled loop whose step, hand-over and dense output share ~20 local arrays and counters.
     N = t_eval.shape[0]
     n = 4
     out = np.empty((N, 6))

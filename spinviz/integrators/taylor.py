@@ -19,8 +19,10 @@ Scaled variables.  heyoka's error control is absolute where the state is below 1
 relative above, on the state's largest component.  Radiation brakes |omega| like
 1/sqrt(1 + c t) (section 3, (3.7); c = |g|^2 = eps_rad in spin units), so late in a long run
 an absolute tolerance on omega would no longer mean anything.  The integrated variable is
-therefore u = omega sqrt(1 + c t), O(1) for the whole run, with
+therefore u = omega sqrt(1 + c t), O(1) for the whole run, with::
+
     du/dt = sigma f(u / sigma) + u c / (2 sigma^2),   sigma = sqrt(1 + c t),
+
 and the kinematics driven by omega = u / sigma.  (For real particles c ~ 1e-16 and sigma = 1
 to round-off; for the atlas it keeps the tolerance meaningful to tau = 1e16.)
 

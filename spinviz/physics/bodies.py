@@ -68,9 +68,25 @@ class PrintedFigure:
 class Body:
     """A rigid body with a permanent dipole (principal axes e1, e2, e3).
 
-    inertia : (I1, I2, I3) -- g cm^2 ("cgs") or relative ("dimensionless").
-    dipole : (d1, d2, d3) body frame -- statC cm ("cgs") or a direction ("dimensionless").
-    reference_omega : rad/s, the spin the paper uses for T and Theta (pi 1e10 s^-1), or None.
+    Attributes
+    ----------
+    name : str
+    units : {"cgs", "dimensionless"}
+        The unit system of everything derived from the body and of its runs.
+    inertia : tuple of 3 float
+        (I1, I2, I3), g cm^2 ("cgs") or relative ("dimensionless").
+    dipole : tuple of 3 float
+        (d1, d2, d3) in the body frame, statC cm ("cgs") or a direction ("dimensionless").
+    shape : Shape or None
+        What is drawn.
+    source : str
+        Where the numbers come from.
+    printed : tuple of PrintedFigure
+        The figures the paper prints for this body, to set beside the computed ones.
+    reference_omega : float or None
+        rad/s, the spin the paper uses for T and Theta (pi 1e10 s^-1).
+    extra : dict
+        Further derived numbers of a preset (density, mass, ...).
     """
 
     name: str
@@ -107,6 +123,8 @@ class Body:
 
     @classmethod
     def from_dict(cls, d: dict) -> Body:
+        """The body ``to_dict`` described (as saved in a trajectory file's metadata), rebuilt
+        exactly."""
         sh = d.get("shape")
         shape = None if sh is None else Shape(sh["kind"], tuple(sh["dims"]), tuple(sh["q_body_from_shape"]), sh["label"])
         return cls(name=d["name"], units=d["units"], inertia=tuple(d["inertia"]), dipole=tuple(d["dipole"]),
@@ -117,14 +135,18 @@ class Body:
     # -- derived quantities --------------------------------------------------------------
     @property
     def I1(self) -> float:
+        """I1, the first principal moment: g cm^2 (CGS) or 1 (dimensionless, the unit of inertia)."""
         return float(self.inertia[0])
 
     @property
     def I2(self) -> float:
+        """I2, the second principal moment, in the units of ``I1``."""
         return float(self.inertia[1])
 
     @property
     def I3(self) -> float:
+        """I3, the third principal moment (about e3, the symmetry axis of a symmetric top), in the
+        units of ``I1``."""
         return float(self.inertia[2])
 
     @property
@@ -310,7 +332,24 @@ def box(a, b, c, density, dipole, name="box", q_body_from_shape=(1.0, 0.0, 0.0, 
 
 
 def custom(inertia, dipole, units="cgs", name="custom", **kw) -> Body:
-    """Any principal moments and dipole vector (asymmetric bodies included)."""
+    """Any principal moments and dipole vector (asymmetric bodies included).
+
+    Parameters
+    ----------
+    inertia : sequence of 3 float
+        (I1, I2, I3), g cm^2 ("cgs") or relative to I1 ("dimensionless").
+    dipole : sequence of 3 float
+        d in the body frame (principal axes), statC cm ("cgs") or a direction ("dimensionless").
+    units : {"cgs", "dimensionless"}
+    name : str
+    **kw
+        Further ``Body`` fields (source, printed, reference_omega, ...).
+
+    Returns
+    -------
+    Body
+        Drawn as the uniform box with the same principal moments.
+    """
     inertia = tuple(float(x) for x in inertia)
     validate_inertia(inertia)
     shape = Shape("box", box_from_inertia(inertia), label="inertia-equivalent box")
@@ -318,7 +357,23 @@ def custom(inertia, dipole, units="cgs", name="custom", **kw) -> Body:
 
 
 def symmetric_top(delta: float, chi: float, name="symmetric top", **kw) -> Body:
-    """Dimensionless symmetric top of section 3: I = (1, 1, 1 - delta), d = (sin chi, 0, cos chi)."""
+    """Dimensionless symmetric top of section 3: I = (1, 1, 1 - delta), d = (sin chi, 0, cos chi).
+
+    Parameters
+    ----------
+    delta : float
+        1 - I3/I1 (3.6), in [-1, 1) (a prolate top above 0, an oblate one below).
+    chi : float
+        Angle of d from the symmetry axis e3, rad, d in the e1-e3 plane.
+    name : str
+    **kw
+        Further ``Body`` fields.
+
+    Returns
+    -------
+    Body
+        units "dimensionless": tau0 = 1 (3.8), so times are in tau0 and rates in 1/tau0 (4.1).
+    """
     delta = float(delta)
     if not math.isfinite(delta) or not (-1.0 <= delta < 1.0):
         raise BodyError("delta", f"must satisfy -1 <= delta < 1 (3.6), got {brief(delta)}")

@@ -181,15 +181,33 @@ def radiation_function(model: str):
     return lambda w1, w2, w3, J, g: terms(w1, w2, w3, J, g, 0.0)
 
 
-def omega_dot(model: str, omega, J, g) -> np.ndarray:
-    """Vectorized Omega_dot for omega of shape (..., 3); returns the same shape."""
-    omega = np.asarray(omega, dtype=float)
-    out = rate_function(model)(omega[..., 0], omega[..., 1], omega[..., 2], tuple(J), tuple(g))
+def omega_dot(model: str, omega_body, J, g) -> np.ndarray:
+    """The model's angular acceleration at many states at once.
+
+    Parameters
+    ----------
+    model : {"reduced", "truncated", "free"}
+        (2.2)+(2.3), (2.5) or the torque-free top (2.3a).
+    omega_body : array_like, shape (..., 3)
+        Body-frame angular velocity, rad/s (CGS) or 1/tau0 (4.1), matching ``J`` and ``g``.
+    J : sequence of 3 float
+        Principal moments (g cm^2, or relative to I1).
+    g : sequence of 3 float
+        Body-frame radiation coupling sqrt(2/3c^3) d (the unit dipole direction in (4.1)).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Body-frame Omega_dot, rad/s^2 or 1/tau0^2.
+    """
+    omega_body = np.asarray(omega_body, dtype=float)
+    out = rate_function(model)(omega_body[..., 0], omega_body[..., 1], omega_body[..., 2], tuple(J), tuple(g))
     return np.stack(np.broadcast_arrays(*out), axis=-1)
 
 
-def jacobian(model: str, omega, J, g) -> np.ndarray:
-    """d Omega_dot / d Omega at one state, shape (3, 3), exact to round-off.
+def jacobian(model: str, omega_body, J, g) -> np.ndarray:
+    """d Omega_dot / d Omega at one body-frame state ``omega_body`` (3,), shape (3, 3), in
+    the units of ``J`` and ``g`` (see ``omega_dot``); exact to round-off.
 
     Complex-step differentiation of the model's own formula: for a real-analytic f,
     f(x + i h e_k) = f(x) + i h df/dx_k + O(h^2), with no subtraction, so with h = 1e-30
@@ -198,7 +216,7 @@ def jacobian(model: str, omega, J, g) -> np.ndarray:
     a hand-expanded (and error-prone) copy of (2.2).
     """
     f = rate_function(model)
-    w = np.asarray(omega, dtype=float)
+    w = np.asarray(omega_body, dtype=float)
     h = 1e-30 * max(float(np.max(np.abs(w))), 1e-300)
     Jt, gt = tuple(J), tuple(g)
     out = np.empty((3, 3))
@@ -258,6 +276,7 @@ class System:
 
     @property
     def is_symmetric(self) -> bool:
+        """J1 = J2 to 1e-12 relative: the paper's symmetric top (``is_symmetric``)."""
         return is_symmetric(self.inertia)
 
     def rate(self):
@@ -272,13 +291,14 @@ class System:
         J, g = tuple(map(float, self.inertia)), tuple(map(float, self.coupling))
         return lambda w1, w2, w3: f(w1, w2, w3, J, g)
 
-    def omega_dot(self, omega) -> np.ndarray:
-        """Vectorized Omega_dot, omega shape (..., 3)."""
-        return omega_dot(self.model, omega, self.inertia, self.coupling)
+    def omega_dot(self, omega_body) -> np.ndarray:
+        """Body-frame Omega_dot (..., 3) at body-frame states ``omega_body`` (..., 3), 1/tau0^2
+        and 1/tau0 (4.1): the module function ``omega_dot`` with this system's J and g."""
+        return omega_dot(self.model, omega_body, self.inertia, self.coupling)
 
-    def jacobian(self, omega) -> np.ndarray:
-        """Exact d Omega_dot / d Omega, shape (3, 3)."""
-        return jacobian(self.model, omega, self.inertia, self.coupling)
+    def jacobian(self, omega_body) -> np.ndarray:
+        """Exact d Omega_dot / d Omega, shape (3, 3), at one body-frame state (3,), (4.1) units."""
+        return jacobian(self.model, omega_body, self.inertia, self.coupling)
 
     def rhs(self):
         """f(t, y) for y = (w1, w2, w3, q0, q1, q2, q3): Euler equation + quaternion kinematics."""
@@ -315,12 +335,40 @@ class System:
         return jac
 
 
-def kinetic_energy(omega, J) -> np.ndarray:
-    """E = 1/2 Omega . J Omega for omega shape (..., 3)."""
-    omega = np.asarray(omega, dtype=float)
-    return 0.5 * np.sum(np.asarray(J) * omega * omega, axis=-1)
+def kinetic_energy(omega_body, J) -> np.ndarray:
+    """Rotational kinetic energy E = 1/2 Omega . J Omega.
+
+    Parameters
+    ----------
+    omega_body : array_like, shape (..., 3)
+        Body-frame angular velocity, rad/s (CGS) or 1/tau0 (4.1).
+    J : sequence of 3 float
+        Principal moments, g cm^2 (or relative to I1).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        E, erg (or I1/tau0^2).
+    """
+    omega_body = np.asarray(omega_body, dtype=float)
+    return 0.5 * np.sum(np.asarray(J) * omega_body * omega_body, axis=-1)
 
 
-def angular_momentum_world(q, omega, J) -> np.ndarray:
-    """L_world = O J Omega_body; q shape (..., 4) (w, x, y, z), omega shape (..., 3)."""
-    return world_from_body(q, np.asarray(J) * np.asarray(omega, dtype=float))
+def angular_momentum_world(q, omega_body, J) -> np.ndarray:
+    """Angular momentum in the world frame, L_world = O J Omega_body.
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Unit quaternions (w, x, y, z), scalar first, of O = R_world_from_body.
+    omega_body : array_like, shape (..., 3)
+        Body-frame angular velocity, rad/s (CGS) or 1/tau0 (4.1).
+    J : sequence of 3 float
+        Principal moments, g cm^2 (or relative to I1).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        L_world, g cm^2/s (or I1/tau0).
+    """
+    return world_from_body(q, np.asarray(J) * np.asarray(omega_body, dtype=float))

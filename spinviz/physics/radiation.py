@@ -52,16 +52,18 @@ def _components(fn, w, J, g):
     return np.stack(np.broadcast_arrays(*out), axis=-1)
 
 
-def model_rates(model: str, omega, J, g, second: bool = True):
-    """The model's Omega_dot, its radiation part, and Omega_ddot at states ``omega`` (..., 3).
+def model_rates(model: str, omega_body, J, g, second: bool = True):
+    """The model's Omega_dot, its radiation part, and Omega_ddot at body-frame states
+    ``omega_body`` (..., 3).
 
-    Dimensionless (4.1): J = (1, J2, J3), g the unit coupling.  Returns (omega_dot,
-    omega_dot_radiation, omega_ddot), each (..., 3); omega_ddot is None unless ``second``.
-    Omega_ddot = D Omega_dot(Omega) . Omega_dot, the derivative along the model's own flow, by a
-    complex step along Omega_dot: f(w + i h u) = f(w) + i h Df u + O(h^2) with no subtraction,
-    so with h = 1e-30 |w| the imaginary part is the directional derivative to round-off.
+    Dimensionless (4.1): J = (1, J2, J3), g the unit coupling.  Returns (omega_dot_body,
+    omega_dot_radiation_body, omega_ddot_body), each (..., 3), body frame, 1/tau0^2 and
+    1/tau0^3; omega_ddot_body is None unless ``second``.  Omega_ddot = D Omega_dot(Omega) . Omega_dot,
+    the derivative along the model's own flow, by a complex step along Omega_dot:
+    f(w + i h u) = f(w) + i h Df u + O(h^2) with no subtraction, so with h = 1e-30 |w| the
+    imaginary part is the directional derivative to round-off.
     """
-    w = np.asarray(omega, dtype=float)
+    w = np.asarray(omega_body, dtype=float)
     Jt, gt = tuple(float(x) for x in J), tuple(float(x) for x in g)
     wd = _components(rate_function(model), w, Jt, gt)
     wr = _components(radiation_function(model), w, Jt, gt)
@@ -76,44 +78,46 @@ def model_rates(model: str, omega, J, g, second: bool = True):
     return wd, wr, wdd
 
 
-def dipole_derivatives(omega, omega_dot, g, omega_ddot=None):
+def dipole_derivatives(omega_body, omega_dot_body, g, omega_ddot_body=None):
     """Body-frame (b1, b2, b3) of the space dipole's first three derivatives (module docstring),
-    for g (3,) and states (..., 3); b3 is None without ``omega_ddot``."""
-    w = np.asarray(omega, dtype=float)
-    wd = np.asarray(omega_dot, dtype=float)
+    for g (3,) and body-frame states, rates and second rates (..., 3) in (4.1) units; b3 is None
+    without ``omega_ddot_body``.  O b_k is the k-th time derivative of the world-frame dipole g."""
+    w = np.asarray(omega_body, dtype=float)
+    wd = np.asarray(omega_dot_body, dtype=float)
     g = np.broadcast_to(np.asarray(g, dtype=float), w.shape)
     b1 = np.cross(w, g)
     wdg = np.cross(wd, g)
     b2 = wdg + np.cross(w, b1)
-    if omega_ddot is None:
+    if omega_ddot_body is None:
         return b1, b2, None
-    b3 = (np.cross(np.asarray(omega_ddot, dtype=float), g) + np.cross(wd, b1) + 2.0 * np.cross(w, wdg)
+    b3 = (np.cross(np.asarray(omega_ddot_body, dtype=float), g) + np.cross(wd, b1) + 2.0 * np.cross(w, wdg)
           + np.cross(w, np.cross(w, b1)))
     return b1, b2, b3
 
 
 @dataclass(frozen=True)
 class Balance:
-    """The radiation observables at states Omega, body frame, dimensionless (module docstring).
+    """The radiation observables at body-frame states Omega, dimensionless (4.1) (module docstring).
 
-    Arrays (..., 3) unless noted: b1, b2, b3 (the dipole's derivatives), power P (...),
-    flux F (2.4a), schott S (2.4b), torque N = dL/dt of the model, energy E (...),
-    schott_energy E_S (...), L = J Omega, and the states' omega, omega_dot, omega_ddot.
+    Vectors are (..., 3) in the body frame (``world_from_body(q, ...)`` takes them to the world):
+    b1, b2, b3 (the dipole's derivatives), flux_body F (2.4a), schott_body S (2.4b),
+    torque_body N = dL/dt of the model, L_body = J Omega, and the states' omega_body,
+    omega_dot_body, omega_ddot_body.  Scalars (...): power P, energy E, schott_energy E_S.
     """
 
-    omega: np.ndarray
-    omega_dot: np.ndarray
-    omega_ddot: np.ndarray
+    omega_body: np.ndarray
+    omega_dot_body: np.ndarray
+    omega_ddot_body: np.ndarray
     b1: np.ndarray
     b2: np.ndarray
     b3: np.ndarray
     power: np.ndarray
-    flux: np.ndarray
-    schott: np.ndarray
-    torque: np.ndarray
+    flux_body: np.ndarray
+    schott_body: np.ndarray
+    torque_body: np.ndarray
     energy: np.ndarray
     schott_energy: np.ndarray
-    L: np.ndarray
+    L_body: np.ndarray
 
     def dipole_torque(self, g) -> np.ndarray:
         """g x b3 = (2/3c^3) d x d_dddot: the right-hand side of (2.1) with the model's own
@@ -123,7 +127,7 @@ class Balance:
     @property
     def work(self) -> np.ndarray:
         """Omega . N = dE/dt, the power the torque takes from the rotation, (...)."""
-        return np.sum(self.omega * self.torque, axis=-1)
+        return np.sum(self.omega_body * self.torque_body, axis=-1)
 
     @property
     def dipole_work(self) -> np.ndarray:
@@ -131,25 +135,26 @@ class Balance:
         return np.sum(self.b1 * self.b3, axis=-1)
 
 
-def balance(model: str, omega, J, g) -> Balance:
-    """All radiation observables of ``model`` at body-frame states ``omega`` (..., 3), in the
+def balance(model: str, omega_body, J, g) -> Balance:
+    """All radiation observables of ``model`` at body-frame states ``omega_body`` (..., 3), in the
     variables (4.1): J = (1, J2, J3), g the unit coupling (``System.inertia``, ``.coupling``)."""
-    w = np.asarray(omega, dtype=float)
+    w = np.asarray(omega_body, dtype=float)
     Jv = np.asarray(J, dtype=float)
     g = np.asarray(g, dtype=float)
     wd, wr, wdd = model_rates(model, w, J, g)
     b1, b2, b3 = dipole_derivatives(w, wd, g, wdd)
     b1xb2 = np.cross(b1, b2)
-    return Balance(omega=w, omega_dot=wd, omega_ddot=wdd, b1=b1, b2=b2, b3=b3,
-                   power=np.sum(b2 * b2, axis=-1), flux=-b1xb2,
-                   schott=b1xb2 + np.cross(np.broadcast_to(g, b3.shape), b3), torque=Jv * wr,
-                   energy=0.5 * np.sum(Jv * w * w, axis=-1), schott_energy=np.sum(b1 * b2, axis=-1), L=Jv * w)
+    return Balance(omega_body=w, omega_dot_body=wd, omega_ddot_body=wdd, b1=b1, b2=b2, b3=b3,
+                   power=np.sum(b2 * b2, axis=-1), flux_body=-b1xb2,
+                   schott_body=b1xb2 + np.cross(np.broadcast_to(g, b3.shape), b3), torque_body=Jv * wr,
+                   energy=0.5 * np.sum(Jv * w * w, axis=-1), schott_energy=np.sum(b1 * b2, axis=-1), L_body=Jv * w)
 
 
-def free_dipole_torque(omega, J, g) -> np.ndarray:
+def free_dipole_torque(omega_body, J, g) -> np.ndarray:
     """g x b3 with the free-motion Omega_dot (2.3a) and Omega_ddot (2.3b) (the latter by the same
-    complex step): (2.1)'s right-hand side as the reduced equation (2.2)+(2.3) evaluates it."""
-    w = np.asarray(omega, dtype=float)
+    complex step): (2.1)'s right-hand side as the reduced equation (2.2)+(2.3) evaluates it.
+    Body frame, (..., 3), at body-frame states ``omega_body`` (..., 3), (4.1) units."""
+    w = np.asarray(omega_body, dtype=float)
     _, _, wdd = model_rates("free", w, J, g)
     Jt = tuple(float(x) for x in J)
     wd = _components(free_rate, w, Jt, tuple(float(x) for x in g))
@@ -157,9 +162,10 @@ def free_dipole_torque(omega, J, g) -> np.ndarray:
     return np.cross(np.broadcast_to(np.asarray(g, dtype=float), b3.shape), b3)
 
 
-def larmor_power(model: str, omega, J, g) -> np.ndarray:
-    """P = |b2|^2 (Larmor, 2/3c^3 |d_ddot|^2) at states (..., 3), with the model's own Omega_dot."""
-    w = np.asarray(omega, dtype=float)
+def larmor_power(model: str, omega_body, J, g) -> np.ndarray:
+    """P = |b2|^2 (Larmor, 2/3c^3 |d_ddot|^2), (...), I1/tau0^3, at body-frame states
+    ``omega_body`` (..., 3) in (4.1) units, with the model's own Omega_dot."""
+    w = np.asarray(omega_body, dtype=float)
     wd, _, _ = model_rates(model, w, J, g, second=False)
     _, b2, _ = dipole_derivatives(w, wd, g)
     return np.sum(b2 * b2, axis=-1)
@@ -171,42 +177,44 @@ def precession_phases(M: int) -> np.ndarray:
     return 2.0 * np.pi * np.arange(M) / M
 
 
-def about_e3(omega, angle) -> np.ndarray:
+def about_e3(omega_body, angle) -> np.ndarray:
     """Omega rotated about e3 by ``-angle``: where the free precession of a symmetric top takes
-    body-frame Omega after the phase ``angle`` = delta Omega3 t.  omega (N, 3), angle (M,) ->
-    (N, M, 3)."""
-    w = np.asarray(omega, dtype=float)
+    body-frame Omega after the phase ``angle`` = delta Omega3 t (rad).  omega_body (N, 3),
+    angle (M,) -> (N, M, 3), body frame, the units of ``omega_body``."""
+    w = np.asarray(omega_body, dtype=float)
     c, s = np.cos(angle)[None, :], np.sin(angle)[None, :]
     w1, w2, w3 = w[:, None, 0], w[:, None, 1], w[:, None, 2]
     return np.stack(np.broadcast_arrays(c * w1 + s * w2, c * w2 - s * w1, w3 + 0.0 * c), axis=-1)
 
 
-def precession_rates(omega, J):
-    """(phi_dot, psi_dot) of a symmetric top's free motion at body-frame states (..., 3): the turn
-    about L at |L|/I1 and the body precession at delta Omega3 (``Lines``)."""
-    w = np.asarray(omega, dtype=float)
+def precession_rates(omega_body, J):
+    """(phi_dot, psi_dot), each (...), of a symmetric top's free motion at body-frame states
+    ``omega_body`` (..., 3): the turn about L at |L|/I1 and the body precession at delta Omega3
+    (``Lines``), in the units of ``omega_body``."""
+    w = np.asarray(omega_body, dtype=float)
     J = np.asarray(J, dtype=float)
     return np.linalg.norm(J * w, axis=-1) / J[0], (1.0 - J[2] / J[0]) * w[..., 2]
 
 
-def precesses(omega, J) -> np.ndarray:
-    """Whether the body frame precesses at a state, (...): |delta Omega3| above 1e-12 |L|/I1 (a
-    sphere, or a spin with Omega3 = 0 such as (3.9), keeps Omega fixed in the body)."""
-    phi_dot, psi_dot = precession_rates(omega, J)
+def precesses(omega_body, J) -> np.ndarray:
+    """Whether the body frame precesses at a body-frame state, (...): |delta Omega3| above
+    1e-12 |L|/I1 (a sphere, or a spin with Omega3 = 0 such as (3.9), keeps Omega fixed in the body)."""
+    phi_dot, psi_dot = precession_rates(omega_body, J)
     return np.abs(psi_dot) > 1e-12 * phi_dot
 
 
-def precession_averaged_power(model: str, omega, J, g, M: int = 16) -> np.ndarray:
+def precession_averaged_power(model: str, omega_body, J, g, M: int = 16) -> np.ndarray:
     """P averaged over the free precession of a symmetric top (I1 = I2): Omega_perp turns about
     e3 at delta Omega3 in the body, |Omega_perp| and Omega3 stay (the slow variables).  What a
     detector integrating over many precession turns sees; needs no phase, so it is physical
     also for ``secular`` runs.  Exact for the free part (P is a trigonometric polynomial of
     degree 2 in the phase; M = 16 leaves the radiation part's degree-4 terms unaliased).  Where
-    nothing precesses (``precesses`` False) it is the instantaneous P."""
-    w = np.atleast_2d(np.asarray(omega, dtype=float))
+    nothing precesses (``precesses`` False) it is the instantaneous P.  ``omega_body`` (..., 3)
+    body frame, (4.1) units; returns (...), I1/tau0^3."""
+    w = np.atleast_2d(np.asarray(omega_body, dtype=float))
     avg = larmor_power(model, about_e3(w, precession_phases(M)), J, g).mean(axis=-1)
     out = np.where(precesses(w, J), avg, larmor_power(model, w, J, g))
-    return out.reshape(np.shape(omega)[:-1])
+    return out.reshape(np.shape(omega_body)[:-1])
 
 
 # --- the far field along a line of sight ----------------------------------------------------
@@ -251,16 +259,22 @@ class Lines:
     precession about e3 at Psi_dot = delta Omega3 (I1 - I3 = delta I1).  So d_ddot(t) is
     sum_k 2 Re(amplitude_k exp(i omega_k t)) with omega_k = m Phi_dot + kappa Psi_dot.
 
-    omega : (N, K) signed angular frequencies of the lines, 1/tau0.
+    angular_frequency : (N, K) signed angular frequencies of the lines, 1/tau0 (also read as
+    ``omega``, its earlier name: a rate, not a vector).
     amplitude : (N, K, 3) complex world-frame amplitudes of d_ddot (g units); the phases are
     those of the state at each sample (true where the orientation's phase is resolved).
     phi_dot, psi_dot : (N,) the rotation and the body precession rates.
     """
 
-    omega: np.ndarray
+    angular_frequency: np.ndarray
     amplitude: np.ndarray
     phi_dot: np.ndarray
     psi_dot: np.ndarray
+
+    @property
+    def omega(self) -> np.ndarray:
+        """``angular_frequency`` under its earlier name (kept for existing callers)."""
+        return self.angular_frequency
 
     @property
     def power(self) -> np.ndarray:
@@ -280,7 +294,7 @@ class Lines:
         lines (incoherent: lines of different frequency do not interfere on average), (N, 4),
         in the units of ``far_field`` squared.  V > 0: the field turns from u1 towards u2."""
         e, _ = self.toward(line_of_sight)
-        e = np.where((self.omega < 0)[..., None], np.conj(e), e)    # a negative frequency is its conjugate's
+        e = np.where((self.angular_frequency < 0)[..., None], np.conj(e), e)    # a negative frequency is its conjugate's
         e1, e2 = e[..., 0], e[..., 1]
         i = 2.0 * (np.abs(e1) ** 2 + np.abs(e2) ** 2)
         q = 2.0 * (np.abs(e1) ** 2 - np.abs(e2) ** 2)
@@ -292,14 +306,14 @@ class Lines:
         """The two polarizations of the field at times ``t`` (M,) after each sample (seconds of
         the lines' own time unit), synthesized from the lines: (N, M, 2)."""
         e, _ = self.toward(line_of_sight)
-        ph = np.exp(1j * self.omega[:, :, None] * np.asarray(t, dtype=float)[None, None, :])   # (N, K, M)
+        ph = np.exp(1j * self.angular_frequency[:, :, None] * np.asarray(t, dtype=float)[None, None, :])   # (N, K, M)
         return 2.0 * np.real(np.einsum("nkp,nkm->nmp", e, ph))
 
 
-def symmetric_top_lines(model: str, omega, q, J, g, M: int = 16) -> Lines:
+def symmetric_top_lines(model: str, omega_body, q, J, g, M: int = 16) -> Lines:
     """The spectral lines of d_ddot near each state (``Lines``) of a symmetric top (J1 = J2).
 
-    omega (N, 3) body frame, q (N, 4) (w, x, y, z), dimensionless (4.1).  Over the body-frame
+    omega_body (N, 3) body frame, q (N, 4) (w, x, y, z), dimensionless (4.1).  Over the body-frame
     precession phase Psi the state is rotated about e3 (``about_e3``), d_ddot = O b2 is formed
     with the model's own Omega_dot at each phase, and its harmonics in Psi (FFT over M phases)
     and in the turn about L (analytic: R_L(Phi) A = A_par + cos Phi A_perp + sin Phi L x A) give
@@ -309,7 +323,7 @@ def symmetric_top_lines(model: str, omega, q, J, g, M: int = 16) -> Lines:
     J = tuple(float(x) for x in J)
     if abs(J[0] - J[1]) > 1e-12 * max(abs(J[0]), abs(J[1])):
         raise ValueError("the line spectrum needs a symmetric top (I1 = I2)")
-    w = np.atleast_2d(np.asarray(omega, dtype=float))
+    w = np.atleast_2d(np.asarray(omega_body, dtype=float))
     q = np.atleast_2d(np.asarray(q, dtype=float))
     n = w.shape[0]
     L_world = world_from_body(q, np.asarray(J) * w)
@@ -339,14 +353,14 @@ def symmetric_top_lines(model: str, omega, q, J, g, M: int = 16) -> Lines:
         amp[still] = 0.0
         amp[still, 0] = rot[still, 0]
         freq[still] = phi_dot[still, None]
-    return Lines(omega=freq, amplitude=amp, phi_dot=phi_dot, psi_dot=psi_dot)
+    return Lines(angular_frequency=freq, amplitude=amp, phi_dot=phi_dot, psi_dot=psi_dot)
 
 
 # --- a run's observables, in its body's units -----------------------------------------------
-def observables(body, model: str, omega, q=None, line_of_sight=None) -> dict:
+def observables(body, model: str, omega_body, q=None, line_of_sight=None) -> dict:
     """The radiation observables of states of ``body`` under ``model``, in the body's units.
 
-    omega (N, 3) body frame (rad/s for "cgs" bodies, 1/tau0 for dimensionless ones); q (N, 4)
+    omega_body (N, 3) body frame (rad/s for "cgs" bodies, 1/tau0 for dimensionless ones); q (N, 4)
     (w, x, y, z) or None.  Returns {name: (dims, values, attrs)} ready for ``xarray.Dataset``:
     the invariants power (Larmor), power_precession_averaged (symmetric tops), energy,
     schott_energy and work (= dE/dt) always; with q the world-frame vectors dipole, dipole_dot,
@@ -356,7 +370,7 @@ def observables(body, model: str, omega, q=None, line_of_sight=None) -> dict:
     """
     s = body.system(model)
     tau0, I1, cgs = body.tau0, body.I1, body.units == "cgs"
-    w = U.omega_to_dimensionless(np.atleast_2d(omega), tau0)
+    w = U.omega_to_dimensionless(np.atleast_2d(omega_body), tau0)
     b = balance(model, w, s.inertia, s.coupling)
 
     def conv(x, kind):
@@ -386,10 +400,12 @@ def observables(body, model: str, omega, q=None, line_of_sight=None) -> dict:
     for k, (name, vec) in enumerate(zip(names, (g, b.b1, b.b2, b.b3))):
         out[name] = (("time", "xyz"), d * world_from_body(q, vec) / tau0**k,
                      {"units": dip_unit[k], "long_name": f"space-frame dipole, derivative {k} (world frame)"})
-    for name, vec, kind, long in (("flux_2_4a", b.flux, "torque", "-(2/3c^3) d_dot x d_ddot, (2.4a)"),
-                                  ("schott_2_4b", b.schott, "torque", "d/dt (2/3c^3) d x d_ddot, (2.4b)"),
-                                  ("torque", b.torque, "torque", "dL/dt of the model (world frame)"),
-                                  ("L", b.L, "angular_momentum", "angular momentum (world frame)")):
+    # the saved names ("torque", "L", ...) stay as they are in files written before; their
+    # long_name says the frame
+    for name, vec, kind, long in (("flux_2_4a", b.flux_body, "torque", "-(2/3c^3) d_dot x d_ddot, (2.4a)"),
+                                  ("schott_2_4b", b.schott_body, "torque", "d/dt (2/3c^3) d x d_ddot, (2.4b)"),
+                                  ("torque", b.torque_body, "torque", "dL/dt of the model (world frame)"),
+                                  ("L", b.L_body, "angular_momentum", "angular momentum (world frame)")):
         out[name] = (("time", "xyz"), conv(world_from_body(q, vec), kind), attrs(kind, long))
     if line_of_sight is not None:
         n, u1, u2 = polarization_basis(line_of_sight)

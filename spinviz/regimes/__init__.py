@@ -8,8 +8,12 @@ written to a resumable Zarr store (issue 12).  Modules, in the order data flows:
 * ``spec`` -- the TOML spec, validated like a scene;
 * ``runs`` -- one run (decade by decade) and a batch of runs, each classified;
 * ``classify`` -- the classifier: label, confidence, evidence;
-* ``store`` -- the xarray / Zarr store: creation, identity, region writes, reading;
-* ``cluster`` -- LocalCluster or an existing scheduler, worker warm-up, progress;
+* ``store`` -- the xarray / Zarr store: creation, identity, chunk writes, reading;
+* ``integrity`` -- the store's checksums: a record per chunk, verified before a resume;
+* ``cluster`` -- LocalCluster or an existing scheduler, worker warm-up, progress, and
+  what a lost task or a lost cluster means (never a written result);
+* ``faults`` -- how the atlas fails, in one line each (``AtlasIncomplete``, ``StoreDamaged``,
+  ``OptionError``);
 * ``api`` -- ``atlas(spec, out, ...)``; ``plot`` -- the diagram and the hodographs;
 * ``command`` -- the ``atlas`` subcommand; ``bench`` -- its benchmark; ``crosscheck`` --
   the paper discrepancies re-checked with an independent integrator (scipy).
@@ -28,6 +32,9 @@ _API = {
     "parse_spec": ("spec", "parse_spec"),
     "AtlasSpec": ("spec", "AtlasSpec"),
     "open_atlas": ("store", "open_atlas"),
+    "verify": ("store", "verify"),
+    "AtlasIncomplete": ("faults", "AtlasIncomplete"),
+    "StoreDamaged": ("faults", "StoreDamaged"),
 }
 
 __all__ = sorted(_API)

@@ -5,25 +5,32 @@
     ds = res.dataset          # xarray, straight from the Zarr store (xarray.open_zarr works too)
 
 Order of work, chosen so that nothing half-made is ever left behind: the spec is validated,
-the output is checked (an existing store must be of this very spec), the cluster is reached
-(an unreachable scheduler stops everything here), and only then is the store created -- in
-one atomic step -- and filled batch by batch.  Running it again computes only what the
-store lacks, with the same numbers.
+the output is checked (an existing store must be of this very spec, its checksums are
+verified, and the runs of any damaged chunk are recomputed, said in one line), the cluster is
+reached (an unreachable scheduler stops everything here), and only then is the store created
+-- in one atomic step -- and filled batch by batch.  Running it again computes only what the
+store lacks, with the same numbers.  Runs the cluster failed to compute (the scheduler gone,
+no worker left, a task killing its workers) are never written: ``AtlasIncomplete`` says how
+many and why, and the same call completes the store.
 """
 
 from __future__ import annotations
 
 import os
+import sys
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..atomic import check_parent_writable
-from ..errors import UsageError, printable
+from ..errors import SpecTypeError, UsageError, printable
 from ..inputs.atlas import AtlasArguments
+from ..interrupt import check, deferred
+from . import integrity as IN
 from . import runs as RN
 from . import store as ST
+from .faults import AtlasIncomplete, StoreDamaged
 from .spec import AtlasSpec, check_feasible, load_spec
 
 RUNS_PER_TASK = 32          # a task of ~32 runs lasts ~0.2-10 s: scheduling (~ms) stays below 1 %
@@ -36,6 +43,8 @@ class AtlasResult:
     path : the store.  computed : runs computed now.  reused : runs already in the store.
     failed : runs recorded as failed now.  seconds : wall time.  cluster : where it ran.
     plots : pictures written.  stats : the execution's measurements (``cluster.Stats``) or None.
+    repaired : runs of damaged or unverified chunks found on resume, recomputed now.
+    notices : what was said about the store on the way (one line each).
     """
 
     path: str
@@ -47,6 +56,8 @@ class AtlasResult:
     cluster: str
     plots: list = field(default_factory=list)
     stats: object = None
+    repaired: int = 0
+    notices: list = field(default_factory=list)
 
     @property
     def dataset(self):
@@ -75,7 +86,8 @@ def plan(spec: AtlasSpec, chunks: tuple, done: np.ndarray, runs_per_task: int = 
     """Batches covering exactly the runs not yet done, each inside one storage chunk, in store
     order (a block that is partly done is cut into the missing stretches of members).
 
-    Returns (batches, chunk keys, expected batches per chunk)."""
+    Returns (batches, the storage chunk of each -- its Zarr chunk index (model, delta, chi
+    block, member block) --, expected batches per chunk)."""
     _, _, cc, cm = chunks
     tm = min(cm, max(1, runs_per_task))
     tc = max(1, min(cc, runs_per_task // tm))
@@ -84,10 +96,10 @@ def plan(spec: AtlasSpec, chunks: tuple, done: np.ndarray, runs_per_task: int = 
     for mi, model in enumerate(spec.models):
         for di in range(nd):
             for c0 in range(0, nc, cc):
-                key = (mi, di, c0)
                 for a in range(c0, min(c0 + cc, nc), tc):
                     b = min(a + tc, c0 + cc, nc)
                     for m0 in range(0, nm, cm):
+                        key = (mi, di, c0 // cc, m0 // cm)
                         for ma in range(m0, min(m0 + cm, nm), tm):
                             mb = min(ma + tm, m0 + cm, nm)
                             block = done[mi, di, a:b, ma:mb]
@@ -102,7 +114,7 @@ def plan(spec: AtlasSpec, chunks: tuple, done: np.ndarray, runs_per_task: int = 
                                 batches.append(RN.Batch(model, (float(spec.deltas[di]),),
                                                         tuple(float(x) for x in spec.chis[pa:pb]),
                                                         np.asarray(spec.omega0[pma:pmb]), spec.settings,
-                                                        (mi, (di, di + 1), (pa, pb), (pma, pmb))))
+                                                        (mi, (di, di + 1), (pa, pb), (pma, pmb)), spec.series))
                                 keys.append(key)
                                 expected[key] = expected.get(key, 0) + 1
     return batches, keys, expected
@@ -133,24 +145,33 @@ def check_out(path: str, spec_path: str | None = None) -> None:
 
 def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers: int | None = None,
           plot: str | None = None, progress: bool = True, runs_per_task: int = RUNS_PER_TASK,
-          processes: bool = True, flush_s: float = 30.0, retry_failed: bool = False, on_result=None) -> AtlasResult:
+          processes: bool = True, flush_s: float = 30.0, retry_failed: bool = False, on_result=None,
+          notify=None) -> AtlasResult:
     """Compute (or complete) the regime atlas of ``spec`` into the Zarr store ``out``.
 
     spec : a path to an atlas spec (TOML) or an ``AtlasSpec``.
     out : the store (a directory, default ``<spec stem>.zarr``); an existing store of the same
-        spec is completed, one of another spec refused.
+        spec is verified against its checksums and completed, one of another spec refused.
     scheduler : address of an existing Dask cluster (``tcp://HOST:8786``); default: a
-        LocalCluster with ``workers`` single-threaded processes (default one per core) that
-        starts and stops here.
+        LocalCluster with ``workers`` single-threaded processes (default and at most one per
+        core) that starts and stops here.
     plot : also draw the delta-chi diagram there (PNG) and the hodographs beside it
         (``<stem>_hodographs.png``).
     progress : the progress bar on stderr.
     runs_per_task : runs per Dask task (the store's chunking is fixed when it is created).
     processes : LocalCluster workers as processes (default) or threads of this process.
     flush_s : results waiting longer than this for the rest of their chunk are written anyway.
-    retry_failed : also recompute the runs recorded as failed (e.g. after workers died).
+    retry_failed : also recompute the runs recorded as failed (runs that failed physically:
+        a runaway, a singular start, an exception inside the run).
     on_result : called with (batches done so far, the batch's result) after each result
         (tests interrupt with it, or kill the worker that ran the batch).
+    notify : called with each notice about the store (one line: damaged chunks recomputed,
+        leftovers removed); default: printed on stderr.
+
+    Raises ``AtlasIncomplete`` when runs could not be computed (the cluster failed, or tasks
+    failed as a whole): nothing of them is written, the store holds every finished run, and
+    the same call computes what is missing.  ``StoreDamaged`` for a store whose metadata do
+    not match their checksums.
     """
     from .cluster import Cluster, Progress, execute
 
@@ -163,6 +184,9 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
     check_feasible(spec, args)
     out = args.out if args.out is not None else default_out(spec)
     check_out(out, spec.path)
+    if notify is not None and not callable(notify):
+        raise SpecTypeError("notify", f"must be callable (line) or None, got {type(notify).__name__}")
+    say = notify if notify is not None else _say
     plots = []
     if plot is not None:
         from .plot import check_plot_paths
@@ -170,41 +194,99 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
         plots = check_plot_paths(plot, out, spec)
     t0 = time.perf_counter()
     exists = os.path.exists(out)
-    if exists:
-        ST.check_identity(spec, out)
-        chunks = ST.chunks_of(out)
-        done = ST.done_mask(out)
-        if retry_failed:
-            done &= ST.regime_codes(out) != -1
-    else:
-        chunks = ST.chunk_shape(spec)
-        done = np.zeros((len(spec.models), len(spec.deltas), len(spec.chis), spec.members), dtype=bool)
-    reused = int(done.sum())
-    batches, keys, expected = plan(spec, chunks, done, runs_per_task)
-    todo = int(sum(b.runs for b in batches))
-    stats = None
-    where = "nothing to compute"
-    if batches:
-        with Cluster(scheduler, workers, processes=processes) as cl:
-            where = cl.describe
-            if not exists:
-                ST.create(spec, out, chunks)
-            writer = ST.Writer(out, expected, flush_s=flush_s)
-            bar = Progress(todo, f"atlas {printable(os.path.basename(out), 80)}", enabled=progress)
-            try:
-                stats = execute(cl, batches, keys, writer, bar, on_result=on_result)
-            finally:
-                writer.close()
-                bar.finish()
-    elif not exists:                               # an empty plan and no store: cannot happen
-        raise UsageError(f"{spec.path}: the spec holds no runs")
+    notices, repaired = [], 0
+    # stop signals are recorded, and acted on where this code looks (check()), never raised
+    # inside Dask or Zarr, whose callbacks could swallow them
+    with deferred():
+        if exists:
+            chunks, done, repaired, notices = _resume(spec, out, say)
+            if retry_failed:
+                done &= ST.regime_codes(out) != -1
+        else:
+            chunks = ST.chunk_shape(spec)
+            done = np.zeros((len(spec.models), len(spec.deltas), len(spec.chis), spec.members), dtype=bool)
+        check()
+        reused = int(done.sum())
+        batches, keys, expected = plan(spec, chunks, done, runs_per_task)
+        todo = int(sum(b.runs for b in batches))
+        stats = None
+        where = "nothing to compute"
+        if batches:
+            with Cluster(scheduler, workers, processes=processes) as cl:
+                where = cl.describe
+                if not exists:
+                    ST.create(spec, out, chunks)
+                writer = ST.Writer(out, expected, flush_s=flush_s)
+                bar = Progress(todo, f"atlas {printable(os.path.basename(out), 80)}", enabled=progress)
+                try:
+                    stats = execute(cl, batches, keys, writer, bar, on_result=on_result)
+                finally:
+                    writer.close()
+                    bar.finish()
+                    if stats is not None:
+                        stats.write_s, stats.checksum_s = writer.write_s, writer.checksum_s
+                        stats.chunk_writes = writer.chunk_writes
+                if stats.incomplete is not None and stats.incomplete.cluster_lost:
+                    cl.close(fast=True)            # no point waiting for a cluster that is gone
+        elif not exists:                           # an empty plan and no store: cannot happen
+            raise UsageError(f"{spec.path}: the spec holds no runs")
     seconds = time.perf_counter() - t0
+    if stats is not None and stats.incomplete is not None:
+        inc = stats.incomplete
+        raise AtlasIncomplete(out, inc.cause, int(spec.runs - ST.done_mask(out).sum()), spec.runs,
+                              int(ST.done_mask(out).sum()), inc.cluster_lost)
     failed = 0
     if batches:
         failed = int(((ST.regime_codes(out) == -1) & ~done).sum())
-    res = AtlasResult(out, spec.runs, todo, reused, failed, seconds, where, [], stats)
+    res = AtlasResult(out, spec.runs, todo, reused, failed, seconds, where, [], stats, repaired, notices)
     if plot is not None:
         from .plot import draw
 
         res.plots = draw(out, plots)
     return res
+
+
+def _say(line: str) -> None:
+    print(f"spinviz: {printable(line)}", file=sys.stderr, flush=True)
+
+
+def _resume(spec: AtlasSpec, out: str, say) -> tuple:
+    """An existing store: its skeleton verified, then its identity, then every chunk against
+    its checksums; damaged or unverified chunks are emptied (their runs recomputed) and
+    leftover temporary files removed, each said in one line.
+
+    Returns (chunks, done mask, runs to recompute, notices)."""
+    rep = ST.verify(out)
+    if rep.skeleton is None:
+        if not os.path.exists(os.path.join(out, ".zgroup")):
+            raise UsageError(f"{out}: exists and is not an atlas store (no .zgroup); choose another store path")
+        ST.check_identity(spec, out)                 # another Zarr store, or another spec: said as such
+        raise StoreDamaged(f"{out}: carries no checksums (made by an earlier spinviz, or its {IN.DIR} was deleted), "
+                           f"so its runs cannot be trusted; move it away and compute the atlas again")
+    if rep.skeleton:
+        raise StoreDamaged(f"{out}: its metadata are damaged ({IN.summary(rep.skeleton, 4)}); they cannot be "
+                           f"recomputed from the runs: move it away and compute the atlas again")
+    ST.check_identity(spec, out)
+    notices = []
+    shape, chunks = IN.layout(out)
+    bad = rep.bad_keys
+    repaired = 0
+    if bad:
+        with deferred():
+            IN.discard(out, ST.run_variables(out), bad, rep.leftovers)
+        n = sum(int(np.prod([r.stop - r.start for r in IN.chunk_region(k, shape, chunks)])) for k in bad)
+        repaired = n
+        what = "damaged" if rep.damaged else "unverified"
+        if rep.damaged and rep.unrecorded:
+            what = "damaged or unverified"
+        notices.append(f"{out}: {len(bad)} {what} chunk{'s' if len(bad) != 1 else ''} ({IN.summary(rep.problems())}); "
+                       f"{'their' if len(bad) != 1 else 'its'} {n} runs are recomputed")
+    elif rep.leftovers:
+        with deferred():
+            IN.discard(out, ST.run_variables(out), [], rep.leftovers)
+    if rep.leftovers and not bad:
+        notices.append(f"{out}: removed {len(rep.leftovers)} temporary file{'s' if len(rep.leftovers) != 1 else ''} "
+                       f"of an interrupted write ({IN.summary([IN.Problem(x, 'leftover') for x in rep.leftovers], 3)})")
+    for line in notices:
+        say(line)
+    return tuple(chunks), ST.done_mask(out), repaired, notices

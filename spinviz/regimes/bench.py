@@ -7,10 +7,15 @@ Measured on the spec as given, each time into a fresh temporary store, one after
   runs per second (of the execution phase, and of the whole command with the cluster's
   start and stop), the speed-up, peak resident memory per worker process, and the
   scheduling overhead as a share of worker time, 1 - (time inside tasks)/(wall x threads);
+* the client's writing of the store: chunk writes, ms each, and the share of it spent on
+  the checksums (hashing the chunk files just written, recording them);
 * the bare cost of a Dask task: 200 empty tasks on the 2-worker cluster, ms each, beside the
   mean task's compute time;
 * the per-call cost of the driver (``simulate(..., kinematics="none")``) against the kernel
   called directly, on a run of a few steps (why ``runs`` calls the kernel);
+* (``--store``, on its own: no run is integrated) the store's write path at the spec's full
+  size, fed synthetic results: ms per chunk write with and without the checksums, and the
+  time to verify the finished store (``store_cost``);
 * projections of a figure-quality atlas, 64 x 64 cells x 32 members per model, on 1, 2 and
   64 cores: runs x (one worker's seconds per run) / cores, on 64 with the empty-task cost as
   a share and the longest task as the tail.
@@ -74,6 +79,9 @@ def run(spec, workers: int | None = None, progress: bool = True) -> dict:
                 "mean_run_s": float(np.nanmean(secs)), "median_run_s": float(np.nanmedian(secs)),
                 "p99_run_s": float(np.nanpercentile(secs, 99)), "max_run_s": float(np.nanmax(secs)),
                 "median_steps": float(np.nanmedian(ds["nsteps"].values)),
+                "chunk_writes": st.chunk_writes, "write_ms_per_chunk": 1e3 * st.write_s / max(1, st.chunk_writes),
+                "checksum_share_of_writes": st.checksum_s / st.write_s if st.write_s > 0 else float("nan"),
+                "write_share_of_wall": st.write_s / st.wall_s if st.wall_s > 0 else float("nan"),
             }
             shutil.rmtree(out, ignore_errors=True)
         rows["by_workers"] = per
@@ -97,6 +105,75 @@ def run(spec, workers: int | None = None, progress: bool = True) -> dict:
     return rows
 
 
+def _synthetic(batch, evidence: int) -> dict:
+    """A batch result of the right shapes and types, random numbers (incompressible, as real ones)."""
+    from . import runs as RN
+
+    rng = np.random.default_rng([abs(int(x)) for x in np.ravel(batch.region[1:])] + [batch.region[0]])
+    sh = (len(batch.deltas), len(batch.chis), len(batch.omega0))
+    ints = {k: rng.integers(1, 14, sh).astype(np.int8) for k in ("regime", "regime_early", "candidate")}
+    return {"region": batch.region, "data": {
+        **ints, "status": np.zeros(sh, np.int8), "method": np.zeros(sh, np.int8), "confidence": rng.random(sh),
+        "tau_reached": rng.random(sh), "run_seconds": rng.random(sh), "nsteps": rng.integers(10**3, 10**6, sh),
+        "nfev": np.zeros(sh, np.int64), "evidence": rng.random(sh + (evidence,)), "omega_final": rng.random(sh + (3,)),
+        "reason": np.full(sh, "type 3: slopes -0.50, -0.50; the phase turning", dtype=f"<U{RN.REASON_CHARS}")}}
+
+
+def store_cost(spec, repeats: int = 3) -> dict:
+    """The store's write path at the spec's size without integrating anything: the Writer fed
+    synthetic results, with the checksums and with ``integrity.record`` replaced by a no-op;
+    medians over ``repeats``.  Returns ms per chunk write (with, without, of which the
+    checksums), the store's size and the time to verify it."""
+    from . import classify as C
+    from . import integrity as IN
+    from . import store as ST
+    from .api import RUNS_PER_TASK, plan
+
+    spec = spec if isinstance(spec, AtlasSpec) else load_spec(spec)
+    rows = {True: [], False: []}
+    tmp = tempfile.mkdtemp(prefix="spinviz-atlas-store-")
+    real = IN.record
+    try:
+        for _ in range(repeats):
+            for sums in (False, True):
+                out = os.path.join(tmp, f"s{int(sums)}.zarr")
+                chunks = ST.chunk_shape(spec)
+                ST.create(spec, out, chunks)
+                done = np.zeros((len(spec.models), len(spec.deltas), len(spec.chis), spec.members), dtype=bool)
+                batches, keys, expected = plan(spec, chunks, done, RUNS_PER_TASK)
+                results = [_synthetic(b, len(C.EVIDENCE)) for b in batches]
+                IN.record = real if sums else (lambda *a, **k: None)
+                try:
+                    w = ST.Writer(out, expected, flush_s=float("inf"))
+                    for k, res in zip(keys, results):
+                        w.add(k, res)
+                    w.close()
+                finally:
+                    IN.record = real
+                t0 = time.perf_counter()
+                if sums:
+                    assert ST.verify(out).clean
+                size = sum(os.path.getsize(os.path.join(r, f)) for r, _, fs in os.walk(out) for f in fs)
+                rows[sums].append((1e3 * w.write_s / w.chunk_writes, 1e3 * w.checksum_s / w.chunk_writes,
+                                   time.perf_counter() - t0, size, w.chunk_writes))
+                shutil.rmtree(out)
+    finally:
+        IN.record = real
+        shutil.rmtree(tmp, ignore_errors=True)
+    med = {k: np.median(np.array(v), axis=0) for k, v in rows.items()}
+    return {"runs": spec.runs, "chunk_writes": int(med[True][4]), "ms_per_chunk_with": float(med[True][0]),
+            "ms_per_chunk_without": float(med[False][0]), "ms_checksums_per_chunk": float(med[True][1]),
+            "verify_s": float(med[True][2]), "store_mb": float(med[True][3]) / 1e6}
+
+
+def format_store_cost(r: dict) -> str:
+    return (f"store write path, {r['runs']} runs in {r['chunk_writes']} chunk writes ({r['store_mb']:.1f} MB): "
+            f"{r['ms_per_chunk_with']:.1f} ms per chunk with checksums, {r['ms_per_chunk_without']:.1f} ms without; "
+            f"hashing and recording {r['ms_checksums_per_chunk']:.2f} ms per chunk "
+            f"({100 * r['ms_checksums_per_chunk'] / r['ms_per_chunk_with']:.0f} % of a write); verifying the store "
+            f"{1e3 * r['verify_s']:.0f} ms")
+
+
 def format_table(r: dict) -> str:
     lines = [f"atlas benchmark: {r['spec']}, {r['runs']} runs ({', '.join(r['models'])}), {r['cores']} cores", "",
              "| workers | runs/s | runs/s per worker | whole command runs/s | tasks | mean task | overhead share | "
@@ -118,6 +195,9 @@ def format_table(r: dict) -> str:
         f"cost of one run (1 worker): mean {p1['mean_run_s'] * 1e3:.1f} ms, median {p1['median_run_s'] * 1e3:.1f} ms, "
         f"99th percentile {p1['p99_run_s'] * 1e3:.0f} ms, max {p1['max_run_s']:.2f} s; median {p1['median_steps']:.0f} steps",
         f"an empty Dask task: {r['task_ms']:.2f} ms = {100 * r['task_overhead_share']:.2f} % of a mean task",
+        f"writing the store (1 worker): {p1['chunk_writes']} chunk writes, {p1['write_ms_per_chunk']:.1f} ms each, "
+        f"{100 * p1['checksum_share_of_writes']:.0f} % of it the checksums; {100 * p1['write_share_of_wall']:.2f} % "
+        f"of the wall time",
         f"projected 64 x 64 x 32 x {len(r['models'])} model(s) = {pj['runs']} runs: {pj['1_core_h']:.2f} h on 1 core, "
         f"{pj['2_cores_h']:.2f} h on 2, {pj['64_cores_min']:.1f} min on 64 (with the longest task, "
         f"{max(p['max_task_s'] for p in r['by_workers'].values()):.0f} s, as the tail)",
@@ -136,9 +216,14 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=None)
     ap.add_argument("--json", metavar="PATH")
     ap.add_argument("--quiet", action="store_true")
+    ap.add_argument("--store", action="store_true", help="only the store's write path at the spec's size (no runs)")
     a = ap.parse_args(argv)
-    r = run(a.spec, a.workers, progress=not a.quiet)
-    print(format_table(r))
+    if a.store:
+        r = store_cost(a.spec)
+        print(format_store_cost(r))
+    else:
+        r = run(a.spec, a.workers, progress=not a.quiet)
+        print(format_table(r))
     if a.json:
         write_json(a.json, r)
     else:

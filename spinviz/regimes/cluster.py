@@ -1,18 +1,29 @@
 """Running batches of runs on Dask: the embedded LocalCluster or an existing cluster.
 
 * ``Cluster(scheduler=None, workers=None)``: with no address, a ``LocalCluster`` with one
-  single-threaded worker process per core (the kernels hold the GIL-free compiled loop, but one
-  process per core keeps each worker's memory and numba state its own); with an address
-  (``tcp://HOST:8786``), a client of a cluster started with the stock ``dask scheduler`` and
-  ``dask worker`` commands.  Leaving the ``with`` block closes the client and stops the
-  LocalCluster, also on an exception or a stop signal.
+  single-threaded worker process per core (at most one per core: more would only share
+  them); with an address (``tcp://HOST:8786``), a client of a cluster started with the stock
+  ``dask scheduler`` and ``dask worker`` commands.  Leaving the ``with`` block closes the
+  client and stops the LocalCluster -- at once on an exception or a stop signal: the worker
+  processes are killed (their work is not needed: only results the client holds are ever
+  written), so the command exits within a fraction of a second instead of waiting for
+  the running tasks.
 * ``WarmUp``: a ``WorkerPlugin`` that loads the compiled kernel once per worker process
-  (from numba's on-disk cache; the client compiles it first when the cluster is local), so
+  (from the on-disk cache; the client compiles it first when the cluster is local), so
   no task pays for it, and that checks the worker runs the client's spinviz version.
 * ``execute``: submits the batches in store order, keeps a bounded number in flight (so a
   stop cancels little and a big atlas does not flood the scheduler), hands each result to
-  the store's writer as it arrives, records a batch that failed as failed runs with the
-  reason, and draws the progress bar.
+  the store's writer as it arrives, and draws the progress bar.  A task that did not finish
+  (its workers killed, the scheduler gone, cancelled, an exception outside the runs) is
+  counted, never written: ``Stats.incomplete`` says what and why.
+
+Signals.  Everything here blocks only in short waits that look at ``interrupt.check()``
+(results arrive through a queue; connecting, waiting for workers, registering the plugin and
+gathering run in helper threads), so a stop signal -- recorded, never raised inside Dask,
+where a library callback or a garbage-collection hook could swallow it -- is acted on within
+~50 ms whatever Dask is doing.  The LocalCluster's processes (its workers and
+multiprocessing's resource tracker) are started with SIGINT, SIGTERM and SIGHUP blocked: a
+terminal's signal to the whole process group reaches only the client, which stops them.
 """
 
 from __future__ import annotations
@@ -21,19 +32,26 @@ import contextlib
 import logging
 import math
 import os
+import queue
+import signal
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 
-import numpy as np
 from distributed.diagnostics.plugin import WorkerPlugin
 
-from ..errors import UsageError, printable
-from ..interrupt import check
-from . import classify as C
+from ..errors import printable
+from ..inputs.render import usable_cores
+from ..interrupt import SIGNALS, check
 from . import runs as RN
+from .faults import OptionError
 
 CONNECT_TIMEOUT_S = 10.0
+START_TIMEOUT_S = 120.0          # LocalCluster workers (spawned Python, imports, the kernel loaded)
+NO_WORKER_S = 60.0               # an existing cluster without any worker this long: the atlas gives up
+POLL_S = 0.05                    # how often the client looks at a stop signal while it waits
+HEALTH_S = 0.5                   # how often the monitor asks the scheduler how many workers it has
 
 
 def worker_info() -> dict:
@@ -47,8 +65,8 @@ class WarmUp(WorkerPlugin):
     """Dask ``WorkerPlugin``: load the kernel when a worker starts (also a restarted one).
 
     ``quiet_terminal``: for the LocalCluster's own worker processes, ignore SIGINT and SIGHUP
-    (the terminal sends them to the whole process group): the client stops the cluster
-    itself, cleanly, instead of every worker dying with a traceback."""
+    (the terminal sends them to the whole process group; they are blocked from the start,
+    this is the second line): the client stops the cluster itself."""
 
     name = "spinviz-atlas-warmup"
     idempotent = True
@@ -58,89 +76,257 @@ class WarmUp(WorkerPlugin):
 
     def setup(self, worker=None):
         if self.quiet_terminal:
-            import signal
-            import threading
-
             if threading.current_thread() is threading.main_thread():
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
                 signal.signal(signal.SIGHUP, signal.SIG_IGN)
         RN.warm()
 
 
+class GaveUp(Exception):
+    """``polled``'s ``give_up`` said the call can no longer succeed."""
+
+
+def polled(fn, *args, give_up=None, **kwargs):
+    """``fn(*args, **kwargs)`` in a helper thread while this one waits in ``POLL_S`` slices,
+    looking at ``interrupt.check()``: a blocking Dask call (connect, gather, an RPC) never
+    holds a stop signal back.  ``give_up()``, if given, is asked at each slice too: when it
+    says so, ``GaveUp`` is raised.  An abandoned helper is a daemon thread: whatever it waits
+    for returns or fails on its own (at the latest when the client closes)."""
+    box: dict = {}
+    done = threading.Event()
+
+    def run():
+        try:
+            box["value"] = fn(*args, **kwargs)
+        except BaseException as e:                 # handed to the caller
+            box["error"] = e
+        finally:
+            done.set()
+
+    threading.Thread(target=run, name="spinviz-dask-call", daemon=True).start()
+    while not done.wait(POLL_S):
+        check()
+        if give_up is not None and give_up():
+            raise GaveUp
+    if "error" in box:
+        raise box["error"]
+    return box["value"]
+
+
+@contextlib.contextmanager
+def _children_deaf_to_terminal():
+    """Threads (hence processes) started inside are born with SIGINT, SIGTERM and SIGHUP
+    blocked; this thread's mask is restored after (a signal meanwhile stays pending, then
+    arrives).  multiprocessing's resource tracker is started here first: started later, from
+    Dask's thread, it would unblock SIGINT and SIGTERM in that thread (its own start-up
+    does), and it would die of a SIGHUP to the group and be relaunched with tracebacks."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+    try:
+        with contextlib.suppress(Exception):
+            from multiprocessing import resource_tracker
+
+            resource_tracker.ensure_running()
+        signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)       # ensure_running unblocked SIGINT, SIGTERM
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+@contextlib.contextmanager
+def _quiet_distributed():
+    """Dask's own log lines (reconnect attempts, restarted workers) are not for the user:
+    what matters is said in one line by the atlas."""
+    names = ("distributed", "distributed.client", "distributed.nanny", "distributed.scheduler", "distributed.worker",
+             "distributed.core", "distributed.comm", "distributed.deploy", "distributed.batched")
+    loggers = [logging.getLogger(n) for n in names]
+    levels = [lg.level for lg in loggers]
+    for lg in loggers:
+        lg.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for lg, lv in zip(loggers, levels):
+            lg.setLevel(lv)
+
+
+def check_workers(workers, scheduler=None) -> None:
+    """``workers=``: 1 .. the cores this process may use, and only for the embedded cluster --
+    checked by the one schema (``inputs.atlas.AtlasArguments``; ``SpecError`` naming
+    ``workers``), also for a ``Cluster`` made directly (the benchmark)."""
+    from ..inputs.atlas import AtlasArguments
+
+    AtlasArguments(scheduler=scheduler, workers=workers)
+
+
 class Cluster:
-    """``with Cluster(scheduler, workers) as cl:`` -- ``cl.client``, ``cl.nthreads``, ``cl.describe``."""
+    """``with Cluster(scheduler, workers) as cl:`` -- ``cl.client``, ``cl.nthreads``, ``cl.describe``,
+    ``cl.problem()`` (why the cluster cannot go on, or None)."""
 
     def __init__(self, scheduler: str | None = None, workers: int | None = None, processes: bool = True,
                  connect_timeout: float | None = None):
-        if scheduler is not None and workers is not None:
-            raise UsageError("--workers: applies to the embedded cluster only; an existing cluster (--scheduler) "
-                             "has the workers it was started with")
-        if workers is not None and not 1 <= workers <= 1024:
-            raise UsageError(f"--workers: must be 1..1024, got {workers}")
+        check_workers(workers, scheduler)
         self.scheduler, self.workers, self.processes = scheduler, workers, processes
         self.connect_timeout = CONNECT_TIMEOUT_S if connect_timeout is None else connect_timeout
         self.client = None
         self.cluster = None
+        self._quiet = None
+        self._monitor = None
 
     def __enter__(self) -> Cluster:
-        from distributed import Client, LocalCluster
+        from distributed import Client
 
-        logging.getLogger("distributed").setLevel(logging.ERROR)
+        self._quiet = _quiet_distributed()
+        self._quiet.__enter__()
         try:
             if self.scheduler is None:
-                RN.warm()                            # compile once into numba's cache; the workers load it
-                n = self.workers or os.cpu_count() or 1
-                self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=self.processes,
-                                            dashboard_address=None, silence_logs=logging.ERROR)
-                self.client = Client(self.cluster)
-                self.client.register_plugin(WarmUp(quiet_terminal=self.processes))
+                self._start_local()
             else:
                 try:
-                    self.client = Client(self.scheduler, timeout=self.connect_timeout)
+                    self.client = polled(Client, self.scheduler, timeout=self.connect_timeout)
                 except (OSError, TimeoutError, ValueError, TypeError) as e:
-                    raise UsageError(f"--scheduler {printable(self.scheduler, 80)}: cannot connect "
-                                     f"({printable(str(e) or type(e).__name__, 160)})") from None
+                    raise OptionError("scheduler", self.scheduler, f"cannot connect "
+                                      f"({printable(str(e) or type(e).__name__, 160)})") from None
                 try:
-                    self.client.wait_for_workers(1, timeout=self.connect_timeout)
+                    polled(self.client.wait_for_workers, 1, timeout=self.connect_timeout)
                 except (TimeoutError, OSError):
-                    raise UsageError(f"--scheduler {printable(self.scheduler, 80)}: no worker joined within "
-                                     f"{self.connect_timeout:g} s; start some with 'dask worker {self.scheduler}'") from None
-                self.client.register_plugin(WarmUp(quiet_terminal=False))
+                    raise OptionError("scheduler", self.scheduler, f"no worker joined within {self.connect_timeout:g} s; "
+                                      f"start some with 'dask worker {self.scheduler}'") from None
+                polled(self.client.register_plugin, WarmUp(quiet_terminal=False))
                 self._check_versions()
+            self._monitor = _Monitor(self.client)
         except BaseException:
-            self.close()
+            self.close(fast=True)
             raise
         return self
+
+    def _start_local(self) -> None:
+        from distributed import Client, LocalCluster
+
+        RN.warm()                                    # compile once into the on-disk cache; the workers load it
+        n = self.workers or usable_cores()
+        opts = dict(n_workers=0, threads_per_worker=1, processes=self.processes,
+                    dashboard_address=None, silence_logs=logging.CRITICAL + 1,
+                    # the scheduler's HTTP server (health routes) on a free port of localhost, not the
+                    # default 8787 (whose "already in use" warning appeared though no dashboard was asked)
+                    scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"})
+        if self.processes:
+            with _children_deaf_to_terminal():
+                self.cluster = LocalCluster(host="127.0.0.1", **opts)
+        else:
+            self.cluster = LocalCluster(**opts)
+        self.client = Client(self.cluster)
+        self.cluster.scale(n)
+        t0 = time.monotonic()
+        while len(self.cluster.scheduler.workers) < n:
+            check()
+            if time.monotonic() - t0 > START_TIMEOUT_S:
+                raise RuntimeError(f"the embedded cluster's {n} workers did not start within {START_TIMEOUT_S:g} s")
+            time.sleep(POLL_S)
+        polled(self.client.register_plugin, WarmUp(quiet_terminal=self.processes))
 
     def _check_versions(self) -> None:
         from .. import __version__
 
-        for addr, info in self.client.run(worker_info).items():
+        for addr, info in polled(self.client.run, worker_info).items():
             if info["version"] != __version__:
-                raise UsageError(f"--scheduler: worker {addr} runs spinviz {info['version']}, this client "
-                                 f"{__version__}; the atlas needs the same version everywhere")
+                raise OptionError("scheduler", self.scheduler, f"worker {addr} runs spinviz {info['version']}, this "
+                                  f"client {__version__}; the atlas needs the same version everywhere")
 
     @property
     def nthreads(self) -> int:
-        return max(1, sum(self.client.nthreads().values()))
+        return max(1, sum(polled(self.client.nthreads).values()))
 
     @property
     def describe(self) -> str:
-        n = len(self.client.nthreads())
+        n = len(polled(self.client.nthreads))
         where = "embedded LocalCluster" if self.scheduler is None else f"cluster at {self.scheduler}"
         return f"{where}, {n} worker{'s' if n != 1 else ''}, {self.nthreads} thread{'s' if self.nthreads != 1 else ''}"
 
-    def close(self) -> None:
-        with contextlib.suppress(Exception):
-            if self.client is not None:
-                self.client.close(timeout=5)
-        with contextlib.suppress(Exception):
-            if self.cluster is not None:
-                self.cluster.close(timeout=10)
-        self.client = self.cluster = None
+    @property
+    def where(self) -> str:
+        """The scheduler, for messages: its address, or "the embedded cluster"."""
+        return f"the scheduler at {self.scheduler}" if self.scheduler else "the embedded cluster's scheduler"
 
-    def __exit__(self, *exc) -> None:
-        self.close()
+    def problem(self) -> str | None:
+        """Why the cluster cannot go on (the scheduler gone, no worker for ``NO_WORKER_S``), or None."""
+        return self._monitor.problem(self.where) if self._monitor is not None else None
+
+    def close(self, fast: bool = False) -> None:
+        """Close the client and stop the LocalCluster.  ``fast`` (an exception, a stop signal, a
+        lost cluster): kill the LocalCluster's worker processes first instead of waiting for
+        their running tasks, and give Dask little time."""
+        if self._monitor is not None:
+            self._monitor.stop()
+        if fast and self.cluster is not None and self.processes:
+            _kill_workers(self.cluster)
+        with contextlib.suppress(BaseException):
+            if self.client is not None:
+                self.client.close(timeout=1 if fast else 5)
+        with contextlib.suppress(BaseException):
+            if self.cluster is not None:
+                self.cluster.close(timeout=2 if fast else 10)
+        self.client = self.cluster = self._monitor = None
+        if self._quiet is not None:
+            self._quiet.__exit__(None, None, None)
+            self._quiet = None
+
+    def __exit__(self, kind, value, tb) -> None:
+        self.close(fast=kind is not None)
+
+
+def _kill_workers(cluster, wait_s: float = 0.5) -> None:
+    """SIGKILL the LocalCluster's worker processes, after telling their nannies not to restart
+    them, and wait (at most ``wait_s``) until they are reaped (Dask's watcher threads join
+    them): no process of the command outlives it, not even as a zombie."""
+    pids = []
+    for nanny in list(getattr(cluster, "workers", {}).values()):
+        with contextlib.suppress(Exception):
+            nanny.close_gracefully()
+        with contextlib.suppress(Exception):
+            pid = nanny.process.process.pid if nanny.process is not None and nanny.process.process is not None else None
+            if pid:
+                os.kill(pid, signal.SIGKILL)
+                pids.append(pid)
+    end = time.monotonic() + wait_s
+    while pids and time.monotonic() < end:
+        pids = [p for p in pids if os.path.exists(f"/proc/{p}")]
+        if pids:
+            time.sleep(0.01)
+
+
+class _Monitor:
+    """A daemon thread asking the scheduler, every ``HEALTH_S``, how many workers it has (an
+    RPC that may block: never in the main thread); ``problem()`` reads what it saw."""
+
+    def __init__(self, client):
+        self.client = client
+        self.last_worker = time.monotonic()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="spinviz-cluster-monitor", daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        while not self._stop.wait(HEALTH_S):
+            if self.client.status != "running":
+                continue
+            with contextlib.suppress(Exception):
+                if self.client.scheduler_info(n_workers=0).get("n_workers", 0) > 0:
+                    self.last_worker = time.monotonic()
+
+    def problem(self, where: str) -> str | None:
+        if self.client.status not in ("running", "newly-created"):
+            return f"{where} went away"
+        idle = time.monotonic() - self.last_worker
+        if idle > NO_WORKER_S:
+            return f"no worker at {where} for {idle:.0f} s"
+        return None
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join(0.2)                     # an RPC in progress fails when the client closes
 
 
 # --- progress ------------------------------------------------------------------------------
@@ -187,6 +373,15 @@ class Progress:
 
 # --- execution -------------------------------------------------------------------------------
 @dataclass
+class Incomplete:
+    """Runs an execution did not compute (none of them written): why, and how many."""
+
+    cause: str                   # one phrase: the first reason met
+    runs: int                    # runs not computed (tasks failed or lost, and batches never submitted)
+    cluster_lost: bool           # the cluster itself failed (not only some tasks)
+
+
+@dataclass
 class Stats:
     """What an execution measured (for the benchmark and the summary line)."""
 
@@ -199,6 +394,10 @@ class Stats:
     threads: int = 0
     max_rss_mb: dict = field(default_factory=dict)        # worker pid -> peak RSS, MiB
     task_compute_s: list = field(default_factory=list)
+    incomplete: Incomplete | None = None
+    write_s: float = 0.0                                  # the client writing the store (data, done, checksums)
+    checksum_s: float = 0.0                               # of which: hashing the chunk files, recording the sums
+    chunk_writes: int = 0
 
     @property
     def overhead_share(self) -> float:
@@ -214,82 +413,110 @@ class Stats:
         return self.cpu_s / self.compute_s if self.compute_s > 0 else math.nan
 
 
-def failed_result(batch: RN.Batch, message: str) -> dict:
-    """A batch whose task failed as a whole (a worker died repeatedly, an error outside the
-    runs): every run recorded as failed with the reason."""
-    nd, nc, nm = len(batch.deltas), len(batch.chis), len(batch.omega0)
-    shape = (nd, nc, nm)
-    data = {
-        "regime": np.full(shape, C.CODE["failed"], dtype=np.int8), "regime_early": np.full(shape, C.CODE["failed"], np.int8),
-        "candidate": np.full(shape, C.CODE["other"], dtype=np.int8), "status": np.full(shape, RN.ERROR, dtype=np.int8),
-        "method": np.zeros(shape, dtype=np.int8), "confidence": np.zeros(shape), "tau_reached": np.full(shape, np.nan),
-        "run_seconds": np.full(shape, np.nan), "nsteps": np.zeros(shape, dtype=np.int64), "nfev": np.zeros(shape, np.int64),
-        "evidence": np.full(shape + (len(C.EVIDENCE),), np.nan), "omega_final": np.full(shape + (3,), np.nan),
-        "reason": np.full(shape, f"task failed: {message}"[:RN.REASON_CHARS], dtype=f"<U{RN.REASON_CHARS}"),
-    }
-    return {"region": batch.region, "data": data, "worker_pid": -1, "compute_s": 0.0, "cpu_s": 0.0, "max_rss_mb": math.nan}
+def _why_not_finished(f) -> str:
+    """One phrase for a task that did not finish: its workers killed, cancelled (by the
+    scheduler's loss), or the exception it raised outside the runs."""
+    from distributed.scheduler import KilledWorker
+
+    if f.status == "error":
+        try:
+            err = f.exception(timeout=5)
+        except Exception as e:                     # the error could not even be fetched
+            return f"a task's error could not be fetched ({type(e).__name__})"
+        if isinstance(err, KilledWorker):
+            return f"a task killed the workers that ran it ({err.allowed_failures + 1} times)"
+        return f"a task raised {type(err).__name__}: {printable(str(err), 160)}"
+    return f"a task was {f.status}"
 
 
 def execute(cluster: Cluster, batches: list, keys: list, writer, progress: Progress, on_result=None) -> Stats:
     """Run ``batches`` (``keys[i]``: the storage chunk of batch i) and write each result.
 
+    Only finished results are written.  A task that did not finish is counted in
+    ``Stats.incomplete`` (its runs stay "not computed") and the others go on; when the
+    cluster itself fails (``cluster.problem()``) the execution ends there.
+
     ``on_result(n_done_batches, result)`` is called after each result is handed to the writer
     (tests use it to interrupt, or to kill the worker that ran it)."""
-    from distributed import as_completed
-
     client = cluster.client
     stats = Stats(threads=cluster.nthreads)
     t0 = time.perf_counter()
     window = 4 * stats.threads + 4
-    queue = list(range(len(batches)))
-    queue.reverse()
-    by_future = {}
-    ac = as_completed()
+    todo = list(range(len(batches)))
+    todo.reverse()
+    in_flight = {}
+    relost = {}                                   # futures whose result was lost after it finished
+    arrived: queue.Queue = queue.Queue()
+    not_done = 0                                  # runs of tasks that did not finish
+    cause = None
+    cluster_lost = False
 
     def submit_one():
-        i = queue.pop()
+        i = todo.pop()
         f = client.submit(RN.run_batch, batches[i], key=f"spinviz-atlas-{keys[i]}-{i}-{os.getpid()}", pure=False)
-        by_future[f] = i
-        ac.add(f)
+        in_flight[f.key] = (f, i)
+        f.add_done_callback(arrived.put)           # in Dask's callback thread: only a hand-over
 
     try:
-        for _ in range(min(window, len(queue))):
+        for _ in range(min(window, len(todo))):
             submit_one()
         done_runs = 0
-        while by_future:
+        while in_flight:
             check()
             try:
-                f = next(ac)
-            except StopIteration:
-                break
-            i = by_future.pop(f)
+                f = arrived.get(timeout=POLL_S)
+            except queue.Empty:
+                f = next((g for g in relost.values() if g.status in ("finished", "error", "cancelled")), None)
+                if f is None:
+                    problem = cluster.problem()
+                    if problem:
+                        cause, cluster_lost = problem, True
+                        break
+                    continue
+            if f.key not in in_flight:
+                continue
+            relost.pop(f.key, None)
+            res = None
             if f.status == "finished":
-                res = f.result()
+                try:                               # its worker may die before the gather
+                    res = polled(f.result, give_up=lambda f=f: f.status != "finished" or cluster.problem())
+                except Exception:
+                    res = None
+            if res is None and f.status not in ("error", "cancelled"):
+                # the result was lost with its worker: the scheduler recomputes it (we hold the
+                # future); it is "lost" or "pending" until then, and its callback has fired already
+                relost[f.key] = f
+                continue
+            i = in_flight.pop(f.key)[1]
+            if res is None:
+                problem = cluster.problem()
+                if problem:                        # the scheduler went away: every task in flight is lost
+                    cause, cluster_lost = problem, True
+                    not_done += batches[i].runs
+                    break
+                cause = cause or _why_not_finished(f)
+                not_done += batches[i].runs
+                stats.failed_tasks += 1
+            else:
                 stats.compute_s += res["compute_s"]
                 stats.cpu_s += res.get("cpu_s", 0.0)
                 stats.task_compute_s.append(res["compute_s"])
                 stats.max_rss_mb[res["worker_pid"]] = max(stats.max_rss_mb.get(res["worker_pid"], 0.0), res["max_rss_mb"])
-            else:
-                try:
-                    err = f.exception()
-                    msg = f"{type(err).__name__}: {err}"
-                except Exception as e:                    # cancelled, lost
-                    msg = f"{type(e).__name__}"
-                res = failed_result(batches[i], msg)
-                stats.failed_tasks += 1
-            writer.add(keys[i], res)
+                writer.add(keys[i], res)
+                done_runs += batches[i].runs
             stats.tasks += 1
-            done_runs += batches[i].runs
             stats.runs = done_runs
-            progress.update(done_runs)
-            if on_result is not None:
+            progress.update(done_runs + not_done)
+            if on_result is not None and res is not None:
                 on_result(stats.tasks, res)
-            if queue:
+            if todo and not cluster_lost:
                 submit_one()
     finally:
         stats.wall_s = time.perf_counter() - t0
-        pending = list(by_future)
-        if pending:
-            with contextlib.suppress(Exception):
-                client.cancel(pending)
+    if cause is not None:
+        missing = not_done + sum(batches[i].runs for _, i in in_flight.values()) + sum(batches[i].runs for i in todo)
+        stats.incomplete = Incomplete(cause, missing, cluster_lost)
+        with contextlib.suppress(BaseException):
+            if in_flight and not cluster_lost:
+                client.cancel([f for f, _ in in_flight.values()])
     return stats

@@ -1,8 +1,13 @@
-"""``spinviz atlas SPEC.toml [--out PATH] [--scheduler ADDRESS] [--workers N] [--plot PATH]``.
+"""``spinviz atlas SPEC.toml [--out PATH] [--scheduler ADDRESS] [--workers N] [--plot PATH]``
+and ``spinviz atlas --verify STORE``.
 
 ``add_parser(subparsers)`` adds the subcommand to spinviz's parser; ``run(args) -> int`` does
 the work and raises spinviz's errors (``SceneError`` for the spec, ``UsageError`` for the
-options, the store and the scheduler), which the command line maps to exit status 2.
+options, the store and the scheduler), which the command line maps to exit status 2; the
+library's ``OptionError`` is said here with the option's name (``--workers``).  Exit statuses
+of its own: 75 when the cluster failed and runs were not computed (sysexits' EX_TEMPFAIL: the
+same command resumes), 1 when tasks failed as a whole, 128 + the signal after a stop; for
+``--verify``, 0 (every chunk matches its checksums) or 1 (damaged), 2 (not an atlas store).
 ``python -m spinviz.regimes`` runs the same command on its own.
 """
 
@@ -12,8 +17,14 @@ import argparse
 import json
 import sys
 
-from ..errors import UsageError, printable
-from ..interrupt import Interrupted
+from ..errors import SpecError, UsageError, printable
+from ..interrupt import Interrupted, check
+from .faults import AtlasIncomplete, OptionError
+
+# the library's argument -> the option that sets it (as spinviz.cli's ATLAS_FLAGS), so that
+# ``spinviz atlas`` and ``python -m spinviz.regimes`` say the same
+FLAGS = {"out": "--out", "scheduler": "--scheduler", "workers": "--workers", "plot": "--plot",
+         "runs_per_task": "--runs-per-task"}
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -22,7 +33,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         description="Integrate the Euler equation (no orientation) for every cell and member of an atlas spec, "
                     "classify each run into the paper's asymptotic types, and write an xarray Dataset to a Zarr "
                     "store, resumably.")
-    a.add_argument("spec", help="the atlas spec (TOML)")
+    a.add_argument("spec", nargs="?", help="the atlas spec (TOML)")
     a.add_argument("--out", help="the Zarr store (a directory; default <spec stem>.zarr); an existing store of the "
                                  "same spec is completed, one of another spec refused")
     a.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing Dask cluster (tcp://HOST:8786) instead "
@@ -33,6 +44,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     a.add_argument("--retry-failed", action="store_true", help="also recompute the runs the store records as failed")
     a.add_argument("--json", action="store_true", help="print the summary as JSON")
     a.add_argument("--quiet", action="store_true", help="no progress bar")
+    a.add_argument("--verify", metavar="STORE", help="instead: check every chunk of an atlas store against its "
+                                                     "checksums and say, per variable, whether it is intact "
+                                                     "(exit status 0) or damaged (1)")
     a.add_argument("--bench", action="store_true",
                    help="instead: measure runs per second on 1 and 2 workers, the scheduling overhead and the memory "
                         "per worker on this spec (temporary stores), and project a 64 x 64 x 32 atlas")
@@ -50,9 +64,26 @@ def _count(text: str) -> int:
 
 
 def run(args) -> int:
+    try:
+        return _run(args)
+    except OptionError as e:                          # the library's words, with the option's name
+        raise UsageError(e.cli_message()) from None
+    except SpecError as e:                            # the schema's, about an argument
+        if e.key in FLAGS:
+            raise UsageError(f"{FLAGS[e.key]}: {e.reason}") from None
+        raise
+
+
+def _run(args) -> int:
     from .api import RUNS_PER_TASK, atlas, default_out
     from .spec import load_spec
 
+    if args.verify is not None:
+        if args.spec is not None or args.out or args.scheduler or args.plot or args.bench:
+            raise UsageError("--verify: checks a store on its own; give no spec and no other option")
+        return verify(args.verify, as_json=args.json)
+    if args.spec is None:
+        raise UsageError("atlas: the spec is missing (spinviz atlas SPEC.toml, or spinviz atlas --verify STORE)")
     spec = load_spec(args.spec)                       # SceneError: file, key, reason
     if args.bench:
         from . import bench
@@ -67,6 +98,7 @@ def run(args) -> int:
         res = atlas(spec, args.out, scheduler=args.scheduler, workers=args.workers, plot=args.plot,
                     progress=not args.quiet, runs_per_task=args.runs_per_task or RUNS_PER_TASK,
                     retry_failed=args.retry_failed)
+        check()                                       # a signal that reached a library that swallowed it
     except Interrupted as e:
         # said here, not by the command line's generic "nothing was written": the finished
         # chunks are on disk, and that is the point
@@ -74,10 +106,14 @@ def run(args) -> int:
         print(f"spinviz: atlas stopped by {e}; every finished chunk is in {printable(out, 200)} and the same command "
               f"computes only what is missing", file=sys.stderr)
         return e.exit_status
+    except AtlasIncomplete as e:
+        print(f"spinviz: {printable(e.cli_message())}", file=sys.stderr)
+        return e.exit_status
     if args.json:
         st = res.stats
         print(json.dumps({"path": res.path, "total": res.total, "computed": res.computed, "reused": res.reused,
-                          "failed": res.failed, "seconds": res.seconds, "cluster": res.cluster, "plots": res.plots,
+                          "failed": res.failed, "repaired": res.repaired, "seconds": res.seconds,
+                          "cluster": res.cluster, "plots": res.plots,
                           "runs_per_s": (st.runs / st.wall_s) if st and st.wall_s else None,
                           "overhead_share": st.overhead_share if st else None}, indent=2, default=float))
     else:
@@ -85,3 +121,56 @@ def run(args) -> int:
         for p in res.plots:
             print(printable(p, 2000))
     return 0
+
+
+def verify(path: str, as_json: bool = False) -> int:
+    """``--verify STORE``: one line per variable (chunks intact, or the damaged ones named),
+    the metadata, and a verdict; 0 if everything matches its checksums, 1 if not."""
+    import os
+
+    from . import store as ST
+
+    if not os.path.isdir(path) or not os.path.exists(os.path.join(path, ".zgroup")):
+        raise UsageError(f"--verify {printable(path, 200)}: not an atlas store (no such directory, or no .zgroup in it)")
+    rep = ST.verify(path)
+    lines = []
+    if rep.skeleton is None:
+        lines.append("metadata: NO CHECKSUMS (made by an earlier spinviz, or its .checksums was deleted)")
+    elif rep.skeleton:
+        lines.append(f"metadata: DAMAGED ({_names(rep.skeleton)})")
+    else:
+        lines.append("metadata: ok")
+    if rep.skeleton_ok:
+        by_var = {v: [] for v in rep.variables}
+        records = []                                  # chunks whose record is missing or unreadable
+        for prob in rep.problems():
+            v = prob.file.split("/", 1)[0]
+            (by_var[v] if v in by_var else records).append(prob)
+        for v in rep.variables:
+            ok, bad = rep.per_variable[v][0], by_var[v]
+            lines.append(f"{v}: ok ({ok} chunk{'s' if ok != 1 else ''})" if not bad else
+                         f"{v}: DAMAGED ({len(bad)} chunk{'s' if len(bad) != 1 else ''}: {_names(bad)})")
+        if records:
+            lines.append(f"checksums: {len(records)} chunk{'s' if len(records) != 1 else ''} with runs marked done "
+                         f"and no usable record ({_names(records)})")
+    if rep.leftovers:
+        lines.append(f"leftovers: {len(rep.leftovers)} temporary file(s) of an interrupted write (removed on resume)")
+    verdict = "ok" if rep.clean else "DAMAGED"
+    n_bad = len(rep.bad_keys)
+    tail = (f"{rep.runs_done} runs verified" if rep.clean else
+            f"{n_bad} chunk(s) to recompute; the same atlas command recomputes their runs" if rep.skeleton_ok else
+            "the metadata cannot be recomputed; compute the atlas again into a new store")
+    if as_json:
+        print(json.dumps({"path": path, "ok": rep.clean, "lines": lines, "runs_verified": rep.runs_done,
+                          "damaged_chunks": n_bad}, indent=2))
+    else:
+        for line in lines:
+            print(printable(line, 2000))
+        print(printable(f"{path}: {verdict}: {tail}", 2000))
+    return 0 if rep.clean else 1
+
+
+def _names(problems, limit: int = 4) -> str:
+    from .integrity import summary
+
+    return summary(problems, limit)

@@ -285,16 +285,20 @@ def _spec(ds) -> dict:
 def representatives(ds) -> list[tuple]:
     """(model, label, delta, chi, member index, confidence) for each type found, per model:
     the cell where the type has its largest share (ties: the one nearest the centre of that
-    type's cells), and there the member labelled so with the highest confidence."""
+    type's cells), and there the member labelled so with the highest confidence -- preferring
+    the members whose series the store keeps (``[output].series``), so that drawing needs no
+    integration unless a type was met only among the others."""
     out = []
     d_all, c_all = ds["delta"].values, ds["chi"].values
+    kept = ds.sizes["start"] if "series" in ds else 0
     for model in [str(m) for m in ds["model"].values]:
-        lab = ds["label"].sel(model=model).values
-        conf = ds["confidence"].sel(model=model).values
+        lab_all = ds["label"].sel(model=model).values
+        conf_all = ds["confidence"].sel(model=model).values
         for name in ORDER:
             if name in ("other", "failed", "missing", "approaching"):
                 continue
-            m = lab == name
+            width = kept if (lab_all[..., :kept] == name).any() else lab_all.shape[-1]
+            m, conf = lab_all[..., :width] == name, conf_all[..., :width]
             if not m.any():
                 continue
             share = m.mean(axis=-1)
@@ -307,33 +311,45 @@ def representatives(ds) -> list[tuple]:
     return out
 
 
-def hodographs(ds, path: str):
-    """One panel per type found (per model), the most confident run of that type."""
-    from .runs import Settings, integrate
+def series_of(ds, model: str, i: int, j: int, k: int):
+    """(tau, omega (N, 3)) of member ``k`` of cell (i, j): read from the store when it kept
+    that series, else integrated again (the runs are deterministic)."""
+    if "series" in ds and k < ds.sizes["start"]:
+        w = ds["series"].sel(model=model).isel(delta=i, chi=j, start=k).values.astype(float)
+        if np.isfinite(w).any():
+            return ds["tau"].values, w
+    from .runs import integrate
+    from .spec import settings_from_canonical
 
+    st = settings_from_canonical(_spec(ds))
+    r = integrate(model, float(ds["delta"].values[i]), float(ds["chi"].values[j]), ds["omega0"].values[k], st)
+    return r.tau, r.omega
+
+
+def hodographs(ds, path: str):
+    """One panel per type found (per model), the most confident run of that type, its series
+    read from the store."""
     plt = pyplot()
     reps = representatives(ds)
-    s = _spec(ds)
-    rs = s["run"]
-    st = Settings(tau_end=rs["tau_end"], tau_start=rs["tau_start"], per_decade=max(60, rs["samples_per_decade"]),
-                  rtol=rs["rtol"], max_steps=rs["max_steps"], window=s["classify"]["window_decades"])
     n = max(1, len(reps))
     cols = min(n, 3)
     rows = math.ceil(n / cols)
     fig = plt.figure(figsize=(3.7 * cols, 3.5 * rows))
     omega0 = ds["omega0"].values
+    d_all, c_all = list(ds["delta"].values), list(ds["chi"].values)
+    tau_start = float(_spec(ds)["run"].get("tau_start", 1e-2))
     for idx, (model, name, d, c, k, conf) in enumerate(reps):
-        r = integrate(model, d, c, omega0[k], st)
+        tau, omega = series_of(ds, model, d_all.index(d), c_all.index(c), k)
         w0 = float(np.linalg.norm(omega0[k]))
         # omega sqrt(tau) has a limit for every braking type; a residual rotation does not brake
-        scale = np.full_like(r.tau, 1.0 / w0) if name == "R" else np.sqrt(r.tau + 1.0 / w0**2)
-        x = r.omega * scale[:, None]
+        scale = np.full_like(tau, 1.0 / w0) if name == "R" else np.sqrt(tau + 1.0 / w0**2)
+        x = omega * scale[:, None]
         ax = fig.add_subplot(rows, cols, idx + 1, projection="3d")
-        lt = np.log10(np.maximum(r.tau, st.tau_start))
+        lt = np.log10(np.maximum(tau, tau_start))
         # points, not a line: log-spaced samples alias the precession, and chords between
         # them would draw a motion that never happened
         ax.scatter(x[:, 0], x[:, 1], x[:, 2], c=lt, cmap="viridis", s=2.5, linewidths=0, depthshade=False)
-        lim = float(np.max(np.abs(x))) * 1.05 or 1.0
+        lim = float(np.nanmax(np.abs(x))) * 1.05 or 1.0
         ax.set_xlim(-lim, lim)
         ax.set_ylim(-lim, lim)
         ax.set_zlim(-lim, lim)

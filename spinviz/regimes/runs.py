@@ -182,10 +182,17 @@ class Batch:
     omega0: np.ndarray
     settings: Settings
     region: tuple
+    series: int = 0               # the store keeps the omega(tau) series of members 0 .. series - 1
 
     @property
     def runs(self) -> int:
         return len(self.deltas) * len(self.chis) * len(self.omega0)
+
+    @property
+    def series_members(self) -> int:
+        """How many of this batch's members (its first ones) have their series kept."""
+        m0, m1 = self.region[3]
+        return max(0, min(m1, self.series) - m0)
 
 
 def run_batch(batch: Batch) -> dict:
@@ -209,13 +216,21 @@ def run_batch(batch: Batch) -> dict:
     }
     cells = [(float(d), float(c)) for d in batch.deltas for c in batch.chis for _ in range(nm)]
     starts = [np.asarray(batch.omega0[k], dtype=float) for _ in batch.deltas for _ in batch.chis for k in range(nm)]
+    ks = batch.series_members
+    if ks:
+        out["series"] = np.full((nd, nc, ks, len(batch.settings.times()), 3), np.nan, dtype=np.float32)
     try:
         runs = integrate_many(batch.model, cells, starts, batch.settings)
         records = [classify_run(r, batch.model, d, c, batch.settings) for r, (d, c) in zip(runs, cells)]
     except InterruptedError:
         raise
     except Exception as e:                        # the whole batch failed: every run says why
-        records = [_error_record(e)] * len(cells)
+        runs, records = [], [_error_record(e)] * len(cells)
+    for n, run in enumerate(runs):
+        i, rest = divmod(n, nc * nm)
+        j, k = divmod(rest, nm)
+        if k < ks:
+            out["series"][i, j, k] = run.omega
     for n, r in enumerate(records):
         i, rest = divmod(n, nc * nm)
         j, k = divmod(rest, nm)

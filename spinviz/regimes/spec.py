@@ -79,6 +79,9 @@ class AtlasSpec:
     deltas : shape (n_delta,), (3.6), each in (-1, 1).  chis : shape (n_chi,), rad, in [0, pi/2].
     omega0 : shape (members, 3), body-frame starts (dimensionless), the same at every cell.
     settings : how each run is integrated and classified.
+    axes : {"delta": (min, max, cells), "chi": (min, max, cells) in rad} when both axes were
+        given as {min, max, cells} (the grid refinement needs), else None.
+    refine_levels, refine_agree : ``[refine]``; series : ``[output].series``.
     """
 
     path: str
@@ -91,6 +94,10 @@ class AtlasSpec:
     settings: Settings
     seed: int | None = None
     omega_magnitude: float | None = None
+    axes: dict | None = None
+    refine_levels: int = 0
+    refine_agree: float = 0.9
+    series: int = 1
 
     def __post_init__(self):
         models = tuple(self.models) if isinstance(self.models, list | tuple) else None
@@ -113,6 +120,8 @@ class AtlasSpec:
         object.__setattr__(self, "omega0", w)
         if not isinstance(self.settings, Settings):
             raise SpecTypeError("settings", f"must be a regimes.runs.Settings, got {type(self.settings).__name__}")
+        if self.refine_levels and self.axes is None:
+            raise SpecError("refine", "levels > 0 needs both grid axes as {min, max, cells} (a quadtree of equal cells)")
 
     @property
     def members(self) -> int:
@@ -134,6 +143,8 @@ class AtlasSpec:
                         "omega0": [[float(x) for x in row] for row in self.omega0]},
             "run": _identity_values(IA.RunTable, self.settings),
             "classify": _identity_values(IA.ClassifyTable, self.settings),
+            **({"refine": {"levels": self.refine_levels, "agree": self.refine_agree}} if self.refine_levels else {}),
+            **({"output": {"series": self.series}} if self.series != 1 else {}),
         }
 
     def canonical_json(self) -> str:
@@ -223,6 +234,11 @@ def parse_spec(data: dict, path: str = "<atlas spec>") -> AtlasSpec:
         omega0, seed = directions(members.count, members.seed) * mag, int(members.seed)
     run = table(IA.RunTable, top.run or {}, "run", path)
     classify = table(IA.ClassifyTable, top.classify or {}, "classify", path)
+    refine = table(IA.RefineTable, top.refine or {}, "refine", path)
+    output = table(IA.OutputTable, top.output or {}, "output", path)
+    axes = _ranges(grid)
+    if refine.levels and axes is None:
+        raise SceneError(path, "[refine].levels", "needs [grid].delta and [grid].chi (or chi_deg) as {min, max, cells}")
     settings = settings_from(run, classify)
     _check_horizon(path, settings, omega0)
     models = top.model_names
@@ -230,7 +246,19 @@ def parse_spec(data: dict, path: str = "<atlas spec>") -> AtlasSpec:
     if n_runs > MAX_RUNS:
         raise SceneError(path, "[grid]", f"{n_runs} runs exceed the limit of {MAX_RUNS}")
     return AtlasSpec(path=path, title=top.title, description=top.description, models=models, deltas=deltas, chis=chis,
-                     omega0=omega0, settings=settings, seed=seed, omega_magnitude=mag)
+                     omega0=omega0, settings=settings, seed=seed, omega_magnitude=mag, axes=axes,
+                     refine_levels=refine.levels, refine_agree=refine.agree,
+                     series=min(output.series, len(omega0)))
+
+
+def _ranges(grid) -> dict | None:
+    """{axis: (min, max, cells)} (chi in rad) when both axes are {min, max, cells}, else None."""
+    chi = grid.chi_deg if grid.chi_deg is not None else grid.chi
+    if not (isinstance(grid.delta, dict) and isinstance(chi, dict)):
+        return None
+    scale = math.pi / 180.0 if grid.chi_deg is not None else 1.0
+    return {"delta": (float(grid.delta["min"]), float(grid.delta["max"]), int(grid.delta["cells"])),
+            "chi": (float(chi["min"]) * scale, float(chi["max"]) * scale, int(chi["cells"]))}
 
 
 def _axis(path, k: str, v, bounds: tuple, open_ends: bool, unit: str) -> np.ndarray:

@@ -20,11 +20,15 @@ Attributes: ``spec`` (canonical JSON), ``spec_sha256`` (identity), ``seed``, ``s
 
 Safety.  The store is created complete but empty in a temporary directory and renamed into
 place, so a path either holds a whole atlas skeleton or nothing.  Results are written as they
-arrive, one storage chunk (one model, one delta, a row of chi, the members) at a time, each
-chunk file atomically (Zarr writes a temporary file and renames it), with stop signals held
-back for the few milliseconds of the write, and ``done`` is written last: a run counts as
-computed only when everything it produced is on disk.  A later run of the same spec computes
-what ``done`` lacks; a store of another spec is refused, never mixed.
+arrive, one storage chunk (one model, one delta, a row of chi, the members) at a time and
+whole (its earlier runs read back first when it was written in part before), each chunk file
+atomically (Zarr writes a temporary file and renames it), with stop signals held back for the
+few milliseconds of the write, ``done`` last and the chunk's checksums after it
+(``integrity``): a run counts as computed only when everything it produced is on disk and
+vouched for.  Only results count: a task lost with a worker or the scheduler is never
+written.  A later run of the same spec verifies the checksums, recomputes the runs of any
+chunk that does not match, and computes what ``done`` lacks; a store of another spec is
+refused, never mixed.
 """
 
 from __future__ import annotations
@@ -43,6 +47,7 @@ from ..errors import UsageError
 from ..interrupt import deferred
 from . import classify as C
 from . import formulas as FM
+from . import integrity as IN
 from . import runs as RN
 
 DIMS = ("model", "delta", "chi", "member")
@@ -68,6 +73,13 @@ FORMULAS = (
     "A2 (4.42)", "B (4.42)", "M2 (4.42)", "K (4.45) printed", "in (4.43)",
     "truncated T4 A2", "truncated T4 beta", "truncated T2 B2", "truncated T2 alpha",
 )
+RUN_VARIABLES = tuple(PER_RUN) + ("evidence", "omega_final")   # what a run writes (``done`` among them)
+SERIES = "series"          # omega(tau) of a cell's first members (``[output].series``), when the spec keeps any
+
+
+def run_variables(path: str) -> tuple:
+    """The per-run variables of the store at ``path``: ``RUN_VARIABLES``, and ``series`` where kept."""
+    return RUN_VARIABLES + ((SERIES,) if os.path.isdir(os.path.join(path, SERIES)) else ())
 MAX_CHUNK_RUNS = 4096
 MAX_CHUNK_MEMBERS = 256
 
@@ -119,6 +131,13 @@ def template(spec, chunks: tuple):
                         {"description": "the classifier's measurements (see the quantity coordinate and classify.EVIDENCE)"})
     data["omega_final"] = (DIMS + ("axis",), da.full(shape + (3,), np.nan, chunks=chunks + (-1,)),
                            {"description": "body-frame omega at tau_reached (dimensionless)"})
+    if spec.series:
+        n = len(spec.settings.times())
+        data[SERIES] = (("model", "delta", "chi", "start", "sample", "axis"),
+                        da.full(shape[:3] + (spec.series, n, 3), np.nan, dtype=np.float32,
+                                chunks=chunks[:3] + (spec.series, n, 3)),
+                        {"description": "omega(tau) of the first members of every cell, body frame, dimensionless "
+                                        "(float32; samples at the coordinate tau); the hodographs read these"})
     data["omega0"] = (("member", "axis"), np.asarray(spec.omega0, dtype=float),
                       {"description": "body-frame omega(0), the same at every cell and model (dimensionless)"})
     pred = np.array([[predictions(float(d), float(c)) for c in spec.chis] for d in spec.deltas], dtype=float)
@@ -135,6 +154,9 @@ def template(spec, chunks: tuple):
         "quantity": list(C.EVIDENCE),
         "formula": list(FORMULAS),
     }
+    if spec.series:
+        coords["start"] = np.arange(spec.series)
+        coords["tau"] = ("sample", spec.settings.times(), {"long_name": "tau = t/tau0 of the series' samples"})
     s = spec.settings
     attrs = {
         "title": spec.title or os.path.basename(spec.path),
@@ -159,6 +181,7 @@ def create(spec, path: str, chunks: tuple | None = None) -> None:
     try:
         store = os.path.join(tmp, "atlas.zarr")
         template(spec, chunks).to_zarr(store, mode="w-", compute=False, zarr_format=2, consolidated=True)
+        IN.record_skeleton(store)                      # checksums of the skeleton, inside the store before it lands
         with deferred():
             if os.path.exists(path):
                 raise UsageError(f"{path}: appeared while the atlas was being created; not overwritten")
@@ -174,13 +197,13 @@ def check_identity(spec, path: str) -> None:
     try:
         attrs = dict(zarr.open_group(path, mode="r", zarr_format=2).attrs)
     except Exception as e:                             # not a Zarr group at all
-        raise UsageError(f"{path}: exists and is not an atlas store ({type(e).__name__}); choose another --out") from None
+        raise UsageError(f"{path}: exists and is not an atlas store ({type(e).__name__}); choose another store path") from None
     if "spec_sha256" not in attrs:
-        raise UsageError(f"{path}: exists and is not an atlas store (no spec_sha256); choose another --out")
+        raise UsageError(f"{path}: exists and is not an atlas store (no spec_sha256); choose another store path")
     if attrs["spec_sha256"] != spec.identity():
         what = "the same spec from another classifier version" if _same_spec(attrs, spec) else "another spec"
         raise UsageError(f"{path}: holds an atlas of {what} (sha256 {attrs['spec_sha256'][:12]}, this spec "
-                         f"{spec.identity()[:12]}); refusing to mix them: choose another --out or delete it")
+                         f"{spec.identity()[:12]}); refusing to mix them: choose another store path or delete it")
 
 
 def _same_spec(attrs: dict, spec) -> bool:
@@ -221,18 +244,29 @@ class _Pending:
 
 class Writer:
     """Writes batch results into the store: a storage chunk as soon as all its batches are
-    in, and whatever has waited ``flush_s`` seconds (read-modify-write of the chunk); ``done``
-    last.  ``close()`` writes everything still waiting (also on an interrupt)."""
+    in, and whatever has waited ``flush_s`` seconds; ``close()`` writes everything still
+    waiting (also on an interrupt: those are finished results).
+
+    ``expected`` : chunk index (model, delta, chi block, member block) -> batches in it.
+    A chunk is written whole, one file per variable: its earlier runs are read back first
+    if this write does not cover all of it; then ``done``; then its checksums."""
 
     def __init__(self, path: str, expected: dict, flush_s: float = 30.0):
         import zarr
 
+        self.path = path
         self.group = zarr.open_group(path, mode="r+", zarr_format=2)
-        self.arrays = {k: self.group[k] for k in list(PER_RUN) + ["evidence", "omega_final"]}
-        self.expected = expected              # chunk key -> number of batches in it
+        self.variables = run_variables(path)
+        self.arrays = {k: self.group[k] for k in self.variables}
+        self.shape = tuple(self.arrays["done"].shape)
+        self.chunks = tuple(self.arrays["done"].chunks)
+        self.expected = expected
         self.pending: dict = {}
         self.flush_s = flush_s
         self.written_runs = 0
+        self.write_s = 0.0                    # wall time inside _write (data, done, checksums)
+        self.checksum_s = 0.0                 # of which: hashing and recording the checksums
+        self.chunk_writes = 0
 
     def add(self, chunk_key, result: dict) -> None:
         p = self.pending.setdefault(chunk_key, _Pending([], time.monotonic(), self.expected[chunk_key]))
@@ -252,21 +286,61 @@ class Writer:
 
     def _write(self, key) -> None:
         p = self.pending.pop(key)
+        t0 = time.perf_counter()
+        region = IN.chunk_region(key, self.shape, self.chunks)
+        lo = [r.start for r in region]
+        shape = tuple(r.stop - r.start for r in region)
+        new = np.zeros(shape, dtype=bool)
+        for res in p.parts:
+            new[_relative(res["region"], lo)] = True
+        whole = bool(new.all())
         with deferred():                      # a stop signal waits for these few milliseconds
-            for res in p.parts:
-                region = _region(res["region"])
-                for name, values in res["data"].items():
-                    self.arrays[name][region] = values[None]
-            for res in p.parts:
-                region = _region(res["region"])
-                shape = tuple(s.stop - s.start for s in region)
-                self.arrays["done"][region] = np.ones(shape, dtype=np.int8)
-                self.written_runs += int(np.prod(shape))
+            IN.forget(self.path, key)         # from here until the record below, the chunk is unverified
+            for name, arr in self.arrays.items():
+                if name in ("done", SERIES):
+                    continue
+                buf = np.empty(shape + tuple(arr.shape[4:]), dtype=arr.dtype) if whole else np.asarray(arr[region])
+                for res in p.parts:
+                    buf[_relative(res["region"], lo)] = res["data"][name][None]
+                arr[region] = buf
+            if SERIES in self.arrays and key[3] == 0:
+                self._write_series(region, lo, p.parts, whole)
+            done = new if whole else (np.asarray(self.arrays["done"][region]) == 1) | new
+            self.arrays["done"][region] = done.astype(np.int8)
+            t1 = time.perf_counter()
+            IN.record(self.path, self.variables, key, int(done.sum()))
+            self.checksum_s += time.perf_counter() - t1
+        self.written_runs += int(new.sum())
+        self.chunk_writes += 1
+        self.write_s += time.perf_counter() - t0
 
 
-def _region(r) -> tuple:
+    def _write_series(self, region, lo, parts, whole: bool) -> None:
+        """The series of the chunk's first members (their own array: (model, delta, chi,
+        start, sample, axis), one chunk file per run chunk whose member block is the first)."""
+        arr = self.arrays[SERIES]
+        sreg = region[:3] + (slice(0, arr.shape[3]),)
+        shape = tuple(r.stop - r.start for r in sreg) + tuple(arr.shape[4:])
+        buf = np.full(shape, np.nan, dtype=arr.dtype) if whole else np.asarray(arr[sreg])
+        for res in parts:
+            if "series" not in res["data"]:
+                continue
+            m, ds, cs, ms = res["region"]
+            ks = res["data"]["series"].shape[2]
+            buf[m - lo[0], ds[0] - lo[1]:ds[1] - lo[1], cs[0] - lo[2]:cs[1] - lo[2], ms[0]:ms[0] + ks] = res["data"]["series"]
+        arr[sreg] = buf
+
+
+def _relative(r, lo) -> tuple:
+    """A batch's region (model, (d0, d1), (c0, c1), (m0, m1)) as slices inside its chunk."""
     m, ds, cs, ms = r
-    return (slice(m, m + 1), slice(*ds), slice(*cs), slice(*ms))
+    return (slice(m - lo[0], m - lo[0] + 1), slice(ds[0] - lo[1], ds[1] - lo[1]), slice(cs[0] - lo[2], cs[1] - lo[2]),
+            slice(ms[0] - lo[3], ms[1] - lo[3]))
+
+
+def verify(path: str) -> IN.Report:
+    """The store's files against their checksums (``integrity.verify``)."""
+    return IN.verify(path, run_variables(path))
 
 
 def open_atlas(path: str):

@@ -9,7 +9,6 @@ rendering package.  Pure Python: importing it loads no drawing library.
 from __future__ import annotations
 
 from ..inputs.render import (  # noqa: F401  (re-exported)
-    CAPTIONS,
     DEFAULT_SHOW,
     MAX_DURATION_S,
     MAX_FPS,

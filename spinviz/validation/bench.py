@@ -41,6 +41,13 @@ N_OUT = 41
 # --- the problems --------------------------------------------------------------------------
 @dataclass
 class BenchProblem:
+    """One benchmark problem at one horizon, dimensionless (4.1) in spin units.
+
+    system : the model and body; omega0 : (3,) body frame; q0 : (4,) (w, x, y, z); t : (41,)
+    output instants; omega_exact (41, 3) body frame and q_exact (41, 4), where a closed form
+    gives them ((6.9), (6.10), (3.9), (5.2)), else None (a tight reference is used).
+    """
+
     name: str
     turns: float
     system: System
@@ -152,6 +159,10 @@ def baseline_rhs(system: System):
 
 @dataclass
 class Row:
+    """One configuration's measurement: the largest misorientation (rad) and |dOmega|/|Omega|
+    over the output instants, the minimum wall time of ``repeats`` runs (s), and the right-hand
+    side evaluations or steps."""
+
     problem: str
     turns: float
     method: str
@@ -164,6 +175,7 @@ class Row:
     note: str = ""
 
     def record(self) -> dict:
+        """The row as a JSON-ready dict (``spinviz bench --json``)."""
         return dict(self.__dict__)
 
 
@@ -204,6 +216,8 @@ class Plan:
 
 
 def quick_plan() -> Plan:
+    """The plan of ``spinviz bench --quick``: two problems, 1e2 and 1e4 turns, fewer
+    tolerances (~2 min)."""
     return Plan(rtols=(1e-8, 1e-11), taylor_rtols=(1e-8, 1e-11, 1e-13), split_per_T=(10, 40), split_per_turn=(8, 32),
                 repeats=3, horizons=(1e2, 1e4), problems=("6.10", "5.2+q"), radau_up_to=0)
 
@@ -335,6 +349,8 @@ def _target(kind, goal) -> str | None:
 
 
 def format_table(rows: list[Row], summ: list[dict], notes) -> str:
+    """The benchmark as ``spinviz bench`` prints it: one line per row, then each problem's time to
+    reach ``TARGET_ERROR`` against the baseline, then the notes."""
     lines = [f"{'problem':<7} {'turns':>6} {'method':<11} {'setting':<16} {'orient. err':>11} {'rel. Omega err':>14} "
              f"{'time s':>10} {'evals|steps':>11}  note", "-" * 110]
     for r in rows:

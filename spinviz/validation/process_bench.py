@@ -39,6 +39,9 @@ EPS = 1e-2
 
 @dataclass
 class Point:
+    """One command's measurement: the largest misorientation over the output instants (rad)
+    and the minimum whole-process time of ``repeats`` runs (s)."""
+
     problem: str
     method: str
     setting: str
@@ -47,6 +50,7 @@ class Point:
     note: str = ""
 
     def record(self) -> dict:
+        """The point as a JSON-ready dict (``spinviz bench --process --json``)."""
         return dict(self.__dict__)
 
 
@@ -68,6 +72,7 @@ class Spec:
 
     @property
     def t(self) -> np.ndarray:
+        """The output instants, shape (samples,), tau0, evenly spaced over [0, t_end]."""
         return np.linspace(0.0, self.t_end, self.samples)
 
 
@@ -206,6 +211,8 @@ def headline(points: list[Point]) -> dict | None:
 
 
 def format_table(points: list[Point]) -> str:
+    """The points as ``spinviz bench --process`` prints them, and the headline (spinviz against the
+    standalone heyoka script on the asymmetric body)."""
     lines = [f"{'problem':<7} {'method':<26} {'setting':<16} {'orient. err':>11} {'whole s':>8}  note", "-" * 90]
     for p in points:
         lines.append(f"{p.problem:<7} {p.method:<26} {p.setting:<16} {p.error:>11.2e} {p.seconds:>8.3f}  {p.note}")
@@ -247,29 +254,3 @@ def plot(points: list[Point], path: str) -> None:
     fig.suptitle("Work-precision, whole process (python -m spinviz simulate, or the standalone scripts), ~400 turns")
     fig.tight_layout()
     save(fig, path, dpi=100)
-
-
-def main(argv=None) -> int:
-    import argparse
-
-    from ..atomic import write_json
-
-    ap = argparse.ArgumentParser(prog="python -m spinviz.validation.process_bench")
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--problems", default=",".join(PROBLEMS))
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--json")
-    ap.add_argument("--plot")
-    a = ap.parse_args(argv)
-    pts = run(tuple(a.problems.split(",")), repeats=a.repeats, quick=a.quick,
-              progress=lambda m: print(f"  {m}", file=sys.stderr, flush=True))
-    print(format_table(pts))
-    if a.json:
-        write_json(a.json, {"points": [p.record() for p in pts], "headline": headline(pts)})
-    if a.plot:
-        plot(pts, a.plot)
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

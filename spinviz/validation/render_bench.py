@@ -39,6 +39,8 @@ def run(scene, fps=None, duration=None, frames: int = 150, workers=None) -> list
 
 
 def format_table(rows: list[dict], scene_path: str) -> str:
+    """The measurements as ``spinviz render --bench`` prints them: per frame size, frames, workers,
+    total and start-up seconds, frames per second overall and steady."""
     lines = [f"render benchmark: {scene_path} ({rows[0]['spin']} spin), encoding included",
              f"{'size':<10} {'frames':>6} {'workers':>7} {'total s':>8} {'start-up s':>10} {'fps':>6} {'steady fps':>10}"]
     for r in rows:
@@ -68,6 +70,8 @@ def plot(rows: list[dict], path: str) -> None:
 
 
 def write(rows: list[dict], json_path=None, plot_path=None) -> None:
+    """The rows as JSON at ``json_path`` and as a plot at ``plot_path`` (PNG), each only when
+    given; both atomic."""
     if json_path:
         write_json(json_path, rows)
     if plot_path:

@@ -1,6 +1,6 @@
 """`secular` against full integration on random symmetric tops: are its stated errors bounds?
 
-    python -m spinviz.validation.secular_sweep [--seeds 1-9] [--runs 40] [--json PATH]
+    spinviz check --sweep [--seeds 1-9] [--runs 40] [--json]
 
 Each run draws delta from the paper's range, chi uniform in [0.1, 1.45] rad, a random spin
 direction (every 7th near the axis, omega_perp = 1e-3 omega3), eps = tau0 |Omega0| = 1e-4 or
@@ -8,16 +8,13 @@ direction (every 7th near the axis, omega_perp = 1e-3 omega3), eps = tau0 |Omega
 resonance refusal lifted (so that the statements are tested through resonances too) and
 `taylor` at rtol 1e-12, and compares the orientation (largest misorientation) with
 ``stats["phase_error_rad"]`` and the slow variables (|d omega_perp| + |d omega3|, relative to
-|Omega0|) with ``stats["slow_error_estimate"]``.  Prints one line per run and a summary table:
-the largest measured/stated ratios must stay below 1.
+|Omega0|) with ``stats["slow_error_estimate"]``.  The command prints one line per run (on
+stderr) and a summary table: the largest measured/stated ratios must stay below 1 (``passed``).
 """
 
 from __future__ import annotations
 
-import argparse
 import math
-import sys
-import time
 
 import numpy as np
 
@@ -66,41 +63,39 @@ def run_case(case: dict) -> dict:
             "resonances": len(st.get("resonances", []))}
 
 
-def _seeds(text: str) -> list[int]:
-    if "-" in text:
-        a, b = text.split("-")
-        return list(range(int(a), int(b) + 1))
-    return [int(x) for x in text.split(",")]
-
-
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m spinviz.validation.secular_sweep", description=__doc__.split("\n")[0])
-    ap.add_argument("--seeds", default="1-3", help="e.g. 1-9 or 1,4,7")
-    ap.add_argument("--runs", type=int, default=40, help="runs per seed")
-    ap.add_argument("--json", help="write every row here")
-    args = ap.parse_args(argv)
-    rows, t0 = [], time.perf_counter()
-    for seed in _seeds(args.seeds):
+def run(seeds, runs: int = 40, progress=None) -> list[dict]:
+    """``runs`` cases of each seed (``draw``, ``run_case``), each row with its "seed";
+    ``progress(row)`` is called after each."""
+    rows = []
+    for seed in seeds:
         rng = np.random.default_rng(seed)
-        for k in range(args.runs):
+        for k in range(runs):
             r = run_case(draw(rng, k))
             r["seed"] = seed
             rows.append(r)
-            print(f"seed {seed} delta={r['delta']:+.2f} chi={r['chi']:.2f} eps={r['eps']:.0e} {r['n_T']}T "
-                  f"w3={r['w3']:+.2f}: q {r['q_err']:.1e} / {r['q_stated']:.1e} (x{r['q_ratio']:.2f})  "
-                  f"slow {r['slow_err']:.1e} / {r['slow_stated']:.1e} (x{r['slow_ratio']:.2f})", flush=True)
-    worst_q = max(rows, key=lambda r: r["q_ratio"])
-    worst_s = max(rows, key=lambda r: r["slow_ratio"])
+            if progress:
+                progress(r)
+    return rows
+
+
+def row_line(r: dict) -> str:
+    """One run in one line: its case, and each measured error against the stated one."""
+    return (f"seed {r['seed']} delta={r['delta']:+.2f} chi={r['chi']:.2f} eps={r['eps']:.0e} {r['n_T']}T "
+            f"w3={r['w3']:+.2f}: q {r['q_err']:.1e} / {r['q_stated']:.1e} (x{r['q_ratio']:.2f})  "
+            f"slow {r['slow_err']:.1e} / {r['slow_stated']:.1e} (x{r['slow_ratio']:.2f})")
+
+
+def passed(rows: list[dict]) -> bool:
+    """Whether every measured error stayed within its statement (both ratios at most 1)."""
+    return max(r["q_ratio"] for r in rows) <= 1.0 and max(r["slow_ratio"] for r in rows) <= 1.0
+
+
+def format_table(rows: list[dict], seconds: float) -> str:
+    """The sweep's summary as a Markdown table: runs, the largest measured/stated ratios, how many
+    runs were called resolved and the worst of those (rad), and the time taken (s)."""
+    worst_q = max(r["q_ratio"] for r in rows)
+    worst_s = max(r["slow_ratio"] for r in rows)
     res = [r for r in rows if r["resolved"]]
-    print(f"\n| runs | largest q error / stated | largest slow error / stated | resolved | largest q error resolved |"
-          f" time |\n|---|---|---|---|---|---|\n| {len(rows)} | {worst_q['q_ratio']:.2f} | {worst_s['slow_ratio']:.2f} | "
-          f"{len(res)} | {max((r['q_err'] for r in res), default=0.0):.1e} rad | {time.perf_counter() - t0:.0f} s |")
-    if args.json:
-        from ..atomic import write_json
-
-        write_json(args.json, rows)
-    return 0 if worst_q["q_ratio"] <= 1.0 and worst_s["slow_ratio"] <= 1.0 else 1
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    return (f"| runs | largest q error / stated | largest slow error / stated | resolved | largest q error resolved |"
+            f" time |\n|---|---|---|---|---|---|\n| {len(rows)} | {worst_q:.2f} | {worst_s:.2f} | "
+            f"{len(res)} | {max((r['q_err'] for r in res), default=0.0):.1e} rad | {seconds:.0f} s |")

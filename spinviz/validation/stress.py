@@ -42,13 +42,16 @@ class StressResult:
 
     @property
     def in_time(self) -> bool:
+        """Whether the run met the case's speed target (True when it has none)."""
         return self.time_limit_s is None or self.runtime_s < self.time_limit_s
 
     @property
     def passed(self) -> bool:
+        """Correct and in time: what ``spinviz stress`` reports as PASS."""
         return bool(self.correct) and self.in_time
 
     def record(self) -> dict:
+        """The case as a JSON-ready dict, with "passed" (``spinviz stress --json``)."""
         rec = {k: (float(v) if isinstance(v, np.floating) else v) for k, v in asdict(self).items()}
         rec["passed"] = self.passed
         return rec
@@ -342,6 +345,8 @@ def run_all(progress=None) -> list[StressResult]:
 
 
 def format_table(results: list[StressResult]) -> str:
+    """The cases as ``spinviz stress`` prints them: PASS, SLOW (correct, over its time target) or
+    FAIL, the error, time and method, then the description and notes."""
     lines = [f"{'case':<24} {'result':<6} {'error':>9}  {'time':>8}  {'method':<11} metric / why / notes", "-" * 120]
     for r in results:
         verdict = "PASS" if r.passed else ("SLOW" if r.correct else "FAIL")

@@ -1,9 +1,16 @@
 """Shared fixtures."""
 
+import json
+import subprocess
+import sys
 import zlib
+from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture
@@ -11,6 +18,23 @@ def rng(request):
     """A generator seeded by the test's own name: each test draws the same numbers whatever
     ran before it (a module-level generator would hand out different draws by test order)."""
     return np.random.default_rng(zlib.crc32(request.node.nodeid.encode()))
+
+
+@pytest.fixture(scope="session")
+def check_quick(tmp_path_factory):
+    """``spinviz check --quick --json`` run once for the whole session, in a fresh interpreter
+    (~9 s, the suite's most expensive command): ``code`` its exit status, ``records`` its JSON,
+    ``modules`` the top-level modules loaded by the end, ``stderr``.  tests/test_cli.py asserts
+    the records, tests/test_imports.py the modules."""
+    modules = tmp_path_factory.mktemp("check_quick") / "modules.json"
+    probe = ("import json, sys\n"
+             "from spinviz.cli import main\n"
+             "code = main(['check', '--quick', '--json'])\n"
+             f"open({str(modules)!r}, 'w').write(json.dumps(sorted({{m.split('.')[0] for m in sys.modules}})))\n"
+             "sys.exit(code)\n")
+    r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, cwd=ROOT)
+    return SimpleNamespace(code=r.returncode, records=json.loads(r.stdout) if r.stdout.strip() else None,
+                           modules=set(json.loads(modules.read_text())) if modules.exists() else None, stderr=r.stderr)
 
 
 # Hypothesis: deterministic and bounded in CI; HYPOTHESIS_PROFILE=fuzz for a long random hunt.

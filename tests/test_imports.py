@@ -31,13 +31,21 @@ def test_import_spinviz_is_light():
 @pytest.mark.parametrize("argv", [
     ["info", "dast_cube"],
     ["simulate", "scenes/check_6_10_cube_truncated.toml", "--out", "{tmp}/t.npz"],
-    ["check", "--quick"],
 ])
 def test_cli_commands_never_import_rendering(argv, tmp_path):
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
     mods = loaded("from spinviz.cli import main\nimport contextlib, io\n"
                   f"with contextlib.redirect_stdout(io.StringIO()):\n    assert main({argv!r}) == 0")
     assert not (mods & set(RENDERING)), mods
+
+
+@pytest.mark.slow
+def test_check_never_imports_rendering(check_quick):
+    """``spinviz check --quick``, the session's one run of it (conftest.py; its records are
+    asserted in test_cli.py): the integrators were loaded, no rendering stack was."""
+    assert check_quick.code == 0, check_quick.stderr
+    assert {"spinviz", "numba", "heyoka"} <= check_quick.modules          # the probe saw a real run
+    assert not (check_quick.modules & set(RENDERING)), check_quick.modules & set(RENDERING)
 
 
 def test_public_names_work_any_number_of_times():

@@ -17,44 +17,63 @@ ASKEW = B.symmetric_top(-0.6, math.radians(55.0))          # DAST family-1 propo
 
 
 # --- the validation suite, one test per equation --------------------------------------
+# Each asserts the numbers behind the verdict.  Measured (heyoka, rtol 1e-12 as `spinviz
+# check` runs): the bounds are ~3-10x these, far below the checks' own criteria (which a
+# method 1e3x less accurate would pass).
 def test_check_6_5_reduced_rod_converges_as_eps_to_0():
+    """theta and psi converge at first order in eps, phi at second: local orders over eps =
+    1e-2, 1e-3, 1e-4 measured 1.0018, 1.00002 (theta), 0.9998, 0.999998 (psi), 1.9990, 1.99999
+    (phi) -- the departures are the next order, O(eps); bound 0.01."""
     r = checks.check_eps_limit("reduced")
     assert r.passed, r.details
-    # theta and psi converge at first order, phi at second (measured, see `spinviz check`)
-    assert np.allclose(r.details["order_theta"], 1.0, atol=0.05)
-    assert np.allclose(r.details["order_psi"], 1.0, atol=0.05)
-    assert np.allclose(r.details["order_phi"], 2.0, atol=0.05)
+    np.testing.assert_allclose(r.details["order_theta"], 1.0, atol=0.01)
+    np.testing.assert_allclose(r.details["order_psi"], 1.0, atol=0.01)
+    np.testing.assert_allclose(r.details["order_phi"], 2.0, atol=0.01)
 
 
 def test_check_6_6_truncated_rod_converges_as_eps_to_0():
+    """As (6.5): measured orders 0.9996, 0.999996 (theta), 1.0001, 1.000001 (psi), 1.9993, 1.99999 (phi)."""
     r = checks.check_eps_limit("truncated")
     assert r.passed, r.details
-    assert np.allclose(r.details["order_psi"], 1.0, atol=0.05)
+    np.testing.assert_allclose(r.details["order_theta"], 1.0, atol=0.01)
+    np.testing.assert_allclose(r.details["order_psi"], 1.0, atol=0.01)
+    np.testing.assert_allclose(r.details["order_phi"], 2.0, atol=0.01)
 
 
 def test_check_6_8_decay_rate_and_precession_limit():
+    """theta's decay rate and phi_dot's limit over [3 Theta, 8 Theta] against tau0 Omega3^2 and
+    Omega3: measured 2.0e-5 and 3.0e-5 relative (what is left of the exp(-2 t/Theta)
+    corrections), psi_dot / Omega3 2.6e-9."""
     r = checks.check_6_8()
     assert r.passed, r.details
-    assert r.details["rel_error_rate"] < 1e-3 and r.details["rel_error_phi_dot"] < 1e-3
+    assert r.details["rel_error_rate"] < 1e-4 and r.details["rel_error_phi_dot"] < 1e-4, r.details
+    assert abs(r.details["psi_dot_over_Omega3"]) < 1e-7, r.details
 
 
-def test_check_6_10_exact_to_1e_9_rad_over_3T():
+def test_check_6_10_exact_over_3T():
+    """Exact: Euler angles and orientation within 7.3e-15 rad over 3 T (measured), Omega within
+    2e-16 relative of (6.9)."""
     r = checks.check_6_10()
-    assert r.passed and r.max_error <= 1e-9, r.details
+    assert r.passed and r.max_error < 1e-13, r.details
+    assert r.details["rel_error_omega_6_9"] < 1e-14, r.details
 
 
 @pytest.mark.parametrize("model", ["reduced", "truncated"])
 def test_check_3_9_askew_rotation_about_e2(model):
+    """Exact: measured 3.0e-15 (reduced), 3.1e-15 (truncated) of Omega2 and rad."""
     r = checks.check_3_9(model)
-    assert r.passed and r.max_error <= 1e-9, r.details
+    assert r.passed and r.max_error < 3e-14, r.details
 
 
 @pytest.mark.parametrize("model", ["reduced", "truncated"])
 def test_check_5_2_and_5_4_longitudinal(model):
-    """Omega against (5.2)/(5.4) and the orientation against the one the exact Omega implies."""
+    """Omega against (5.2)/(5.4) -- measured 1.8e-16 and 8.6e-16 of |Omega0| -- and the
+    orientation against the one the exact Omega implies (scipy's DOP853 at rtol 1e-13):
+    2.3e-13 and 2.6e-13 rad over 5.4 and 11.7 turns."""
     r = checks.check_longitudinal(model)
-    assert r.passed and r.max_error <= 1e-9, r.details
-    assert r.details["misorientation"] < 1e-9 and r.details["turns"] > 5
+    assert r.passed, r.details
+    assert r.details["rel_error_omega"] < 1e-14 and r.details["misorientation"] < 2e-12, r.details
+    assert r.details["turns"] > 5
 
 
 # --- invariants ---------------------------------------------------------------------------
@@ -80,15 +99,17 @@ def test_free_motion_keeps_energy_and_world_angular_momentum():
     assert tr.omega[:, 1].min() < -0.5
 
 
-def test_askew_energy_is_not_monotonic_but_falls():
-    """Radiation brakes both models on average, but dE/dt = Omega . torque changes sign
-    within a precession period for an askew top (the Schott-like term in the reduced
-    model; the (g . (Omega x Omega_dot)) g term in the truncated one)."""
-    for model in ("reduced", "truncated"):
-        tr = simulate(ASKEW, model, (0.1, 0.1, 0.1), t_end=200.0, samples=50)
-        E = tr.energy()
-        assert E[-1] < 0.5 * E[0]
-        assert np.any(np.diff(E) > 0)
+@pytest.mark.parametrize("model, fraction_left, rises", [("reduced", 0.153899916, 5), ("truncated", 0.147693833, 3)])
+def test_askew_energy_is_not_monotonic_but_falls(model, fraction_left, rises):
+    """Radiation brakes both models on average (E(200)/E(0) = 0.1539, 0.1477: measured at the
+    default rtol 1e-10, held to 1e-6), but dE/dt = Omega . torque changes sign within a
+    precession period for an askew top (the Schott-like term in the reduced model; the
+    (g . (Omega x Omega_dot)) g term in the truncated one): E rises over 5 and 3 of the 49
+    sampling intervals."""
+    tr = simulate(ASKEW, model, (0.1, 0.1, 0.1), t_end=200.0, samples=50)
+    E = tr.energy()
+    assert E[-1] / E[0] == pytest.approx(fraction_left, rel=1e-6)
+    assert np.sum(np.diff(E) > 0) == rises
 
 
 # --- every registered method against an exact solution ------------------------------------
@@ -174,7 +195,7 @@ def test_cgs_and_dimensionless_runs_agree_through_4_1():
     I1 = 2.0e-26
     d = math.sqrt(1.5 * I1 * 2.99792458e10**3 * 1e-11)         # tau0 = 2 d^2 / (3 I1 c^3) = 1e-11 s
     cgs = B.custom((I1, I1, 0.7 * I1), (d * math.sin(0.6), 0.0, d * math.cos(0.6)), units="cgs")
-    assert cgs.tau0 == pytest.approx(1e-11, rel=1e-12)
+    assert cgs.tau0 == pytest.approx(1e-11, rel=1e-12, abs=0)
     dim = B.symmetric_top(0.3, 0.6)
     W0 = np.array([0.1, 0.2, 0.25]) / 1e-11
     a = simulate(cgs, "reduced", W0, t_end=50e-11, samples=20, rtol=1e-12, atol=1e-14)
@@ -192,7 +213,7 @@ def test_real_cellulose_rod_parameters_do_not_underflow():
     tr = simulate(rod, "reduced", W, t_end=t_end, samples=11, rtol=1e-12, atol=1e-14)
     assert np.all(np.isfinite(tr.omega))
     np.testing.assert_allclose(tr.omega[:, 1], W[1], rtol=1e-12)
-    assert tr.stats["eps_rad"] == pytest.approx(rod.tau0 * W[1], rel=1e-12)
+    assert tr.stats["eps_rad"] == pytest.approx(rod.tau0 * W[1], rel=1e-12, abs=0)
 
 
 def test_sample_interpolation_orders():

@@ -27,12 +27,12 @@ def averaged(delta, chi, wp, w3, scale=1.0):
     return dwp, dw3, dp - delta * w3
 
 
-def test_slow_flow_is_4_12_for_the_reduced_model():
+@pytest.mark.parametrize("wp, w3", [(0.2, 0.5), (0.05, -0.3)])
+@pytest.mark.parametrize("delta, chi", [(0.3, 0.7), (-0.6, math.radians(55.0)), (0.5, 1.2)])
+def test_slow_flow_is_4_12_for_the_reduced_model(delta, chi, wp, w3):
     """The M-point phase average of the model's own rate equals the printed (4.12)."""
-    for delta, chi in [(0.3, 0.7), (-0.6, math.radians(55.0)), (0.5, 1.2)]:
-        for wp, w3 in [(0.2, 0.5), (0.05, -0.3)]:
-            got = averaged(delta, chi, wp, w3)
-            np.testing.assert_allclose(got, CF.averaged_rate_eq4_12(wp, w3, delta, chi), rtol=1e-12, atol=1e-16)
+    got = averaged(delta, chi, wp, w3)
+    np.testing.assert_allclose(got, CF.averaged_rate_eq4_12(wp, w3, delta, chi), rtol=1e-12, atol=1e-16)
 
 
 @pytest.mark.parametrize("model,form", [("reduced", CF.omega_eq6_7), ("truncated", CF.omega_eq6_9)])
@@ -166,12 +166,12 @@ def test_slow_flow_keeps_a_1e_16_torque_above_round_off():
 
 @pytest.mark.parametrize("model", ["reduced", "truncated", "free"])
 def test_radiation_part_plus_free_rate_is_the_rate(model):
+    """At 200 random states (the rate functions take arrays): round-off, measured at most
+    3.6e-15 absolute."""
     from spinviz.physics import equations as E
 
-    rng = np.random.default_rng(3)
+    w = np.random.default_rng(3).normal(size=(3, 200))
     J, g = (1.0, 0.8, 0.5), (0.3, -0.2, 0.7)
-    for _ in range(5):
-        w = rng.normal(size=3)
-        total = np.array(E.rate_function(model)(*w, J, g))
-        parts = np.array(E.radiation_function(model)(*w, J, g)) + np.array(E.free_rate(*w, J, g))
-        np.testing.assert_allclose(parts, total, rtol=1e-13, atol=1e-14)
+    total = np.array(E.rate_function(model)(*w, J, g))
+    parts = np.array(E.radiation_function(model)(*w, J, g)) + np.array(E.free_rate(*w, J, g))
+    np.testing.assert_allclose(parts, total, rtol=1e-13, atol=1e-14)

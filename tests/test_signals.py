@@ -74,9 +74,13 @@ def gone(sid: int, timeout: float = 5.0) -> list[int]:
     return session_alive(sid)
 
 
-@pytest.mark.parametrize("sig,to_group,ext", [(signal.SIGINT, True, ".mp4"), (signal.SIGTERM, False, ".mp4"),
-                                              (signal.SIGHUP, False, ".mp4"), (signal.SIGINT, True, ".gif")],
-                         ids=["ctrl-c-to-group", "sigterm", "sighup", "ctrl-c-gif-in-process"])
+# the MP4 cases start two render workers and ffmpeg each (1-3.5 s): slow, like the atlas's stop signals
+@pytest.mark.parametrize("sig,to_group,ext", [
+    pytest.param(signal.SIGINT, True, ".mp4", marks=pytest.mark.slow, id="ctrl-c-to-group"),
+    pytest.param(signal.SIGTERM, False, ".mp4", marks=pytest.mark.slow, id="sigterm"),
+    pytest.param(signal.SIGHUP, False, ".mp4", marks=pytest.mark.slow, id="sighup"),
+    pytest.param(signal.SIGINT, True, ".gif", id="ctrl-c-gif-in-process"),
+])
 def test_stop_signal_mid_render(tmp_path, sig, to_group, ext):
     """MP4s render in two worker processes; a GIF in this process, where a signal can land
     inside a VTK callback (which swallowed it: the render ran to the end and replaced the
@@ -97,6 +101,7 @@ def test_stop_signal_mid_render(tmp_path, sig, to_group, ext):
     assert gone(proc.pid) == []                                           # no worker, tracker or ffmpeg left
 
 
+@pytest.mark.slow
 def test_sigterm_stops_a_compiled_run_promptly(tmp_path):
     """An asymmetric body over ~5e6 turns (allowed; about a minute of compiled loop, ~3 s per
     1e5 turns measured): SIGTERM ends it within a second with nothing written."""

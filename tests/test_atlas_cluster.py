@@ -143,6 +143,7 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
+@pytest.mark.slow
 def test_existing_scheduler_with_two_workers(spec_path, reference, tmp_path):
     """The stock ``dask scheduler`` and two ``dask worker`` processes on localhost; the atlas
     through ``--scheduler`` gives the reference's numbers."""
@@ -190,6 +191,7 @@ def test_unreachable_scheduler_exit_2_nothing_written(spec_path, tmp_path, monke
     assert not out.exists() and list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_sigterm_stops_cleanly_and_resume_completes(spec_path, reference, tmp_path):
     """The command in a subprocess, stopped by SIGTERM once the first chunk is on disk:
     exit 143, a one-line note, the cluster gone; the same command then completes the store."""

@@ -75,8 +75,11 @@ class AtlasResult:
              f"{f', over {self.levels + 1} refinement levels' if self.levels else ''}) in {self.seconds:.1f} s on {self.cluster}")
         if self.stats is not None and self.stats.runs:
             st = self.stats
-            s += (f"; {st.runs / st.wall_s:.1f} runs/s, {st.tasks} tasks, overhead {100 * st.overhead_share:.0f} % "
-                  f"of worker time")
+            b = {k: 100 * v for k, v in st.breakdown().items() if k != "write_s"}
+            s += (f"; {st.runs / st.wall_s:.1f} runs/s, {st.tasks} tasks; of the workers' time "
+                  f"{b['integrate_share']:.0f} % integrating, {b['classify_share']:.0f} % classifying, "
+                  f"{b['overhead_share']:.0f} % overhead; writing the store {st.write_s:.1f} s "
+                  f"({b['write_share_of_wall']:.1f} % of the wall time)")
         return s
 
 

@@ -418,6 +418,7 @@ class Stats:
     failed_tasks: int = 0
     wall_s: float = 0.0
     compute_s: float = 0.0
+    classify_s: float = 0.0                               # of compute_s: the classifier
     cpu_s: float = 0.0
     threads: int = 0
     max_rss_mb: dict = field(default_factory=dict)        # worker pid -> peak RSS, MiB
@@ -433,13 +434,24 @@ class Stats:
         if other is None:
             return self
         out = Stats(threads=max(self.threads, other.threads), incomplete=other.incomplete)
-        for name in ("runs", "tasks", "failed_tasks", "wall_s", "compute_s", "cpu_s", "write_s", "checksum_s",
+        for name in ("runs", "tasks", "failed_tasks", "wall_s", "compute_s", "classify_s", "cpu_s", "write_s", "checksum_s",
                      "chunk_writes"):
             setattr(out, name, getattr(self, name) + getattr(other, name))
         out.task_compute_s = self.task_compute_s + other.task_compute_s
         out.max_rss_mb = {pid: max(self.max_rss_mb.get(pid, 0), other.max_rss_mb.get(pid, 0))
                           for pid in {*self.max_rss_mb, *other.max_rss_mb}}
         return out
+
+    def breakdown(self) -> dict:
+        """Where the time went: shares of the workers' time (wall x threads) spent integrating,
+        classifying, and in neither (scheduling, transfer, start-up, the idle tail), and the
+        client's store writes (seconds, and as a share of the wall time)."""
+        cap = self.wall_s * max(1, self.threads)
+        if cap <= 0:
+            return {}
+        return {"integrate_share": (self.compute_s - self.classify_s) / cap, "classify_share": self.classify_s / cap,
+                "overhead_share": self.overhead_share, "write_s": self.write_s,
+                "write_share_of_wall": self.write_s / self.wall_s}
 
     @property
     def overhead_share(self) -> float:
@@ -555,6 +567,7 @@ def execute(cluster: Cluster, batches: list, keys: list, writer, progress: Progr
                 stats.failed_tasks += 1
             else:
                 stats.compute_s += res["compute_s"]
+                stats.classify_s += res.get("classify_s", 0.0)
                 stats.cpu_s += res.get("cpu_s", 0.0)
                 stats.task_compute_s.append(res["compute_s"])
                 stats.max_rss_mb[res["worker_pid"]] = max(stats.max_rss_mb.get(res["worker_pid"], 0.0), res["max_rss_mb"])

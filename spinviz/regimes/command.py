@@ -147,8 +147,9 @@ def _run(args) -> int:
         print(json.dumps({"path": res.path, "total": res.total, "computed": res.computed, "reused": res.reused,
                           "failed": res.failed, "repaired": res.repaired, "seconds": res.seconds,
                           "cluster": res.cluster, "plots": res.plots,
-                          "runs_per_s": (st.runs / st.wall_s) if st and st.wall_s else None,
-                          "overhead_share": st.overhead_share if st else None}, indent=2, default=float))
+                          "levels": res.levels, "runs_per_s": (st.runs / st.wall_s) if st and st.wall_s else None,
+                          "overhead_share": st.overhead_share if st else None,
+                          "breakdown": st.breakdown() if st else None}, indent=2, default=float))
     else:
         print(printable(res.summary(), 2000))
         for p in res.plots:

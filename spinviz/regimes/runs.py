@@ -199,9 +199,9 @@ def run_batch(batch: Batch) -> dict:
     """Run and classify every run of ``batch``; arrays shaped (n_delta, n_chi, n_member[, k]).
 
     Also returns where and how it ran: ``worker_pid``, ``compute_s`` (wall time inside this
-    function), ``cpu_s`` (the process's CPU time meanwhile: below ``compute_s`` when other
-    work on the machine took the core) and ``max_rss_mb`` (the worker process's peak
-    resident memory so far)."""
+    function), ``classify_s`` (of which: classifying the runs), ``cpu_s`` (the process's CPU
+    time meanwhile: below ``compute_s`` when other work on the machine took the core) and
+    ``max_rss_mb`` (the worker process's peak resident memory so far)."""
     start, cpu0 = time.perf_counter(), time.process_time()
     nd, nc, nm = len(batch.deltas), len(batch.chis), len(batch.omega0)
     shape = (nd, nc, nm)
@@ -219,9 +219,12 @@ def run_batch(batch: Batch) -> dict:
     ks = batch.series_members
     if ks:
         out["series"] = np.full((nd, nc, ks, len(batch.settings.times()), 3), np.nan, dtype=np.float32)
+    classify_s = 0.0
     try:
         runs = integrate_many(batch.model, cells, starts, batch.settings)
+        t_cls = time.perf_counter()
         records = [classify_run(r, batch.model, d, c, batch.settings) for r, (d, c) in zip(runs, cells)]
+        classify_s = time.perf_counter() - t_cls
     except InterruptedError:
         raise
     except Exception as e:                        # the whole batch failed: every run says why
@@ -247,7 +250,7 @@ def run_batch(batch: Batch) -> dict:
         out["omega_final"][i, j, k] = r.omega_final
         out["reason"][i, j, k] = r.reason[:REASON_CHARS]
     return {"region": batch.region, "data": out, "worker_pid": os.getpid(), "compute_s": time.perf_counter() - start,
-            "cpu_s": time.process_time() - cpu0, "max_rss_mb": max_rss_mb()}
+            "classify_s": classify_s, "cpu_s": time.process_time() - cpu0, "max_rss_mb": max_rss_mb()}
 
 
 REASON_CHARS = 96

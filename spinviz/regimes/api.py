@@ -409,7 +409,7 @@ def _resume(spec: AtlasSpec, out: str, say) -> tuple:
             IN.discard(out, ST.run_variables(out), [], rep.leftovers)
     if rep.leftovers and not bad:
         notices.append(f"{out}: removed {len(rep.leftovers)} temporary file{'s' if len(rep.leftovers) != 1 else ''} "
-                       f"of an interrupted write ({IN.summary([IN.Problem(x, 'leftover') for x in rep.leftovers], 3)})")
+                       f"of an interrupted write ({IN.summary([IN.Damage(x, 'leftover') for x in rep.leftovers], 3)})")
     for line in notices:
         say(line)
     return tuple(chunks), ST.done_mask(out), repaired, notices

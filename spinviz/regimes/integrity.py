@@ -125,7 +125,7 @@ def _walk(path: str):
 
 
 @dataclass
-class Problem:
+class Damage:
     """One file that does not match the record: ``what`` is "missing", "checksum mismatch",
     "not recorded" (a file where the record says there is none) or "no record"."""
 
@@ -173,10 +173,10 @@ class Report:
         return self.skeleton_ok and not self.damaged and not self.unrecorded
 
     def problems(self) -> list:
-        """Every chunk problem, one ``Problem`` per file."""
+        """Every chunk problem, one ``Damage`` per file."""
         out = []
         for key in self.bad_keys:
-            out.extend(self.damaged.get(key) or [Problem(f"{DIR}/{CHUNKS}/{key_name(key)}.json", "no record")])
+            out.extend(self.damaged.get(key) or [Damage(f"{DIR}/{CHUNKS}/{key_name(key)}.json", "no record")])
         return out
 
 
@@ -210,7 +210,7 @@ def verify(path: str, variables) -> Report:
                 rep.unrecorded.append(key)
             continue
         except (OSError, ValueError, KeyError, TypeError):
-            rep.damaged[key] = [Problem(f"{DIR}/{CHUNKS}/{key_name(key)}.json", "record unreadable")]
+            rep.damaged[key] = [Damage(f"{DIR}/{CHUNKS}/{key_name(key)}.json", "record unreadable")]
             continue
         problems = []
         for v, rel in files.items():
@@ -222,7 +222,7 @@ def verify(path: str, variables) -> Report:
             rep.per_variable[v][1] += 1
             what = ("missing" if have is None else "not recorded" if want is None else
                     "checksum mismatch" if isinstance(want, str) and len(want) == 64 else "record unreadable")
-            problems.append(Problem(rel, what))
+            problems.append(Damage(rel, what))
         if problems:
             rep.damaged[key] = problems
         else:
@@ -247,12 +247,12 @@ def verify_skeleton(path: str) -> list | None:
     except FileNotFoundError:
         return None
     except (OSError, ValueError, KeyError, TypeError):
-        return [Problem(f"{DIR}/{SKELETON}", "record unreadable")]
+        return [Damage(f"{DIR}/{SKELETON}", "record unreadable")]
     out = []
     for rel, want in sorted(recorded.items()):
         have = sha256_file(os.path.join(path, rel))
         if have != want:
-            out.append(Problem(rel, "missing" if have is None else "checksum mismatch"))
+            out.append(Damage(rel, "missing" if have is None else "checksum mismatch"))
     return out
 
 

@@ -16,7 +16,7 @@ import numpy as np
 from .atomic import check_outputs
 from .driver import simulate_request
 from .errors import SpecError, SpecTypeError, UsageError
-from .inputs.render import RenderArguments, RenderSpec, poster_for
+from .inputs.render import RenderArguments, RenderSpec, default_output, poster_for
 from .rendering.timeline import FramePlan, frame_times, plan_frames
 from .scene import Scene, load_scene
 from .trajectory import Trajectory
@@ -308,15 +308,6 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
     finally:
         if pool is not None:
             pool.close()
-
-
-def default_output(scene, directory: str = "renders") -> str:
-    """Where a scene's video goes by default: ``renders/<scene file's stem>.mp4``.  ``scene``: a
-    ``Scene`` or the path of its file (trajectories have no default: ``SpecError`` naming ``out``)."""
-    if not isinstance(scene, (Scene, str, os.PathLike)):
-        raise SpecError("out", "missing value: trajectories have no default video path; give a .mp4 or .gif path")
-    stem = os.path.splitext(os.path.basename(scene.path if isinstance(scene, Scene) else os.fspath(scene)))[0]
-    return os.path.join(directory, f"{stem}.mp4")
 
 
 def contact_sheet(sources: Sequence[Source], out: str, *, size=(640, 360), columns: int = 2, at: float = 0.5,

@@ -40,7 +40,7 @@ from .errors import SceneError, SpecError, brief, printable
 from .inputs import scene as IS
 from .inputs.render import MAX_TITLE, RenderSpec
 from .inputs.simulation import SimulationRequest
-from .inputs.toml import read_toml, table
+from .inputs.toml import document, read_document, read_toml
 from .physics import bodies as B
 
 __all__ = ["Scene", "ObserveSpec", "SceneError", "load_scene", "parse_scene", "read_toml"]
@@ -125,12 +125,17 @@ class Scene:
 def parse_scene(data: dict, path: str = "<scene>") -> Scene:
     """Validate a parsed TOML document; raise SceneError (file, key, reason) on the first problem."""
     path = os.fspath(path)
-    top = table(IS.SceneFile, data, "", path, IS.SUBTABLES)
-    # a title from the file name is escaped and cut: a name may hold anything a file system allows
-    title = top.title if top.title is not None else printable(os.path.splitext(os.path.basename(path))[0], MAX_TITLE)
-    bt = table(IS.BodyTable, top.body, "body", path)
-    it = table(IS.InitialTable, top.initial, "initial", path)
-    st = table(IS.SimulationTable, top.simulation, "simulation", path)
+    return _scene(*document(IS.SceneFile, data, path, _TABLES, ("render",)), path)
+
+
+# every table of a scene, validated in one place (inputs.toml.document) before anything is computed
+_TABLES = {"body": IS.BodyTable, "initial": IS.InitialTable, "simulation": IS.SimulationTable, "render": RenderSpec,
+           "observe": IS.ObserveTable}
+
+
+def _scene(top, tables: dict, path: str) -> Scene:
+    """The scene of a validated document."""
+    bt, it, st = tables["body"], tables["initial"], tables["simulation"]
     try:
         body = bt.build(st.units)
     except SpecError as e:
@@ -145,8 +150,11 @@ def parse_scene(data: dict, path: str = "<scene>") -> Scene:
     t_end = _horizon(path, "simulation", st, st.horizon_key, body, omega0, keys)
     requests = [_checked(path, keys, body=body, model=m, omega0=omega0, q0=q0, t_end=t_end, samples=st.samples,
                          method=st.method, rtol=st.rtol, atol=st.atol, step=st.step) for m in st.model_names]
-    render = _render(top.render, path, title, t_end)
-    observe = _observe(top.observe, path, body, omega0, requests)
+    title = top.title
+    if title is None:   # from the file name, escaped and cut: a name may hold anything a file system allows
+        title = printable(os.path.splitext(os.path.basename(path))[0], MAX_TITLE)
+    render = _render(tables["render"], "title" in (top.render or {}), title, path, t_end)
+    observe = _observe(tables["observe"], path, body, omega0, requests)
     return Scene(path=path, title=title, body=body, models=st.model_names, omega0=omega0, q0=q0, t_end=t_end,
                  samples=st.samples, method=requests[0].method, rtol=st.rtol, atol=st.atol, step=st.step, render=render,
                  observe=observe)
@@ -202,9 +210,14 @@ def _horizon(path, name: str, t, key: str, body: B.Body, omega0, keys: dict) -> 
     return horizon
 
 
-def _render(data, path: str, title: str, t_end: float) -> RenderSpec:
-    """[render], validated by ``RenderSpec`` (the one place render inputs are checked)."""
-    spec = table(RenderSpec, {"title": title, **(data or {})}, "render", path)
+def _render(spec: RenderSpec, own_title: bool, title: str, path: str, t_end: float) -> RenderSpec:
+    """[render] (validated by ``RenderSpec``, the one place render inputs are checked) with the
+    scene's title unless it has its own, checked against the scene's horizon."""
+    if not own_title:
+        try:
+            spec = replace(spec, title=title)
+        except SpecError as e:
+            raise SceneError(path, "title", e.reason) from None
     try:
         spec.check_horizon(t_end)
     except SpecError as e:
@@ -212,12 +225,11 @@ def _render(data, path: str, title: str, t_end: float) -> RenderSpec:
     return spec
 
 
-def _observe(data, path: str, body: B.Body, omega0, requests: list) -> ObserveSpec:
-    """[observe], optional: the detector's horizon (checked like the scene's: it is simulated),
-    line of sight, distance and resolutions."""
-    if data is None:
+def _observe(ot, path: str, body: B.Body, omega0, requests: list) -> ObserveSpec:
+    """[observe] (``ot``, validated; None when absent): the detector's horizon (checked like
+    the scene's: it is simulated), line of sight, distance and resolutions."""
+    if ot is None:
         return ObserveSpec()
-    ot = table(IS.ObserveTable, data, "observe", path)
     t_end = None
     key = ot.horizon_key
     if key is not None:
@@ -239,4 +251,4 @@ def load_scene(path) -> Scene:
 
         raise SpecTypeError("path", f"must be the path of a scene file (str or os.PathLike), got {type(path).__name__}")
     path = os.fsdecode(path)
-    return parse_scene(read_toml(path), path)
+    return _scene(*read_document(path, IS.SceneFile, _TABLES, ("render",)), path)

@@ -237,3 +237,14 @@ class RenderArguments:
 def poster_for(out: str) -> str:
     """The PNG poster written beside a video: the same name with the extension .png."""
     return os.path.splitext(os.fspath(out))[0] + ".png"
+
+
+def default_output(scene, directory: str = "renders") -> str:
+    """Where a scene's video goes by default: ``renders/<scene file's stem>.mp4``.  ``scene``: a
+    ``Scene`` (anything with a ``path``) or the path of its file; trajectories have no default
+    (``SpecError`` naming ``out``).  Beside ``RenderSpec.check_output``, which checks it."""
+    path = scene if isinstance(scene, (str, os.PathLike)) else getattr(scene, "path", None)
+    if not isinstance(path, (str, os.PathLike)):
+        raise SpecError("out", "missing value: trajectories have no default video path; give a .mp4 or .gif path")
+    stem = os.path.splitext(os.path.basename(os.fspath(path)))[0]
+    return os.path.join(directory, f"{stem}.mp4")

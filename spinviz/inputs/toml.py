@@ -83,3 +83,22 @@ def read_toml(path, kind: str = "scene") -> dict:
         raise SceneError(path, "(file)", f"invalid TOML: {e}") from None
     except RecursionError:
         raise SceneError(path, "(file)", f"values nested too deeply to be a {kind}") from None
+
+
+def document(cls, data, path: str, tables: dict, empty: tuple = ()) -> tuple:
+    """A whole parsed document validated in one place: its top level as ``cls`` (every field
+    named in ``tables`` a sub-table), then each sub-table ``name`` as ``tables[name]``.
+
+    Returns ``(top, {name: validated})``; an absent sub-table is None, or validated from ``{}``
+    (its defaults) when its name is in ``empty``.  Errors as ``table``'s."""
+    top = table(cls, data, "", path, tuple(tables))
+    subs = {}
+    for name, sub in tables.items():
+        value = getattr(top, name)
+        subs[name] = None if value is None and name not in empty else table(sub, {} if value is None else value, name, path)
+    return top, subs
+
+
+def read_document(path, cls, tables: dict, empty: tuple = (), kind: str = "scene") -> tuple:
+    """``document`` of the file at ``path`` (``read_toml``)."""
+    return document(cls, read_toml(path, kind), os.fspath(path), tables, empty)

@@ -11,8 +11,6 @@ Measured on the spec as given, each time into a fresh temporary store, one after
   the checksums (hashing the chunk files just written, recording them);
 * the bare cost of a Dask task: 200 empty tasks on the 2-worker cluster, ms each, beside the
   mean task's compute time;
-* the per-call cost of the driver (``simulate(..., kinematics="none")``) against the kernel
-  called directly, on a run of a few steps (why ``runs`` calls the kernel);
 * (``--store``, on its own: no run is integrated) the store's write path at the spec's full
   size, fed synthetic results: ms per chunk write with and without the checksums, and the
   time to verify the finished store (``store_cost``);

@@ -49,7 +49,7 @@ from . import runs as RN
 from .faults import OptionError
 
 CONNECT_TIMEOUT_S = 10.0
-START_TIMEOUT_S = 120.0          # LocalCluster workers (spawned Python, imports, the kernel loaded)
+START_TIMEOUT_S = 120.0          # LocalCluster workers (spawned Python, imports, the Taylor integrators loaded)
 NO_WORKER_S = 60.0               # an existing cluster without any worker this long: the atlas gives up
 POLL_S = 0.05                    # how often the client looks at a stop signal while it waits
 HEALTH_S = 0.5                   # how often the monitor asks the scheduler how many workers it has
@@ -57,7 +57,7 @@ STALL_S = 10.0                   # nothing arrived this long: ask the scheduler 
 
 
 def worker_info() -> dict:
-    """Run on a worker: its pid and spinviz version (``WarmUp`` has already loaded the kernel)."""
+    """Run on a worker: its pid and spinviz version (``WarmUp`` has already loaded the Taylor integrators)."""
     from .. import __version__
 
     return {"pid": os.getpid(), "version": __version__}

@@ -259,7 +259,7 @@ def _cells(ax, cells: list[dict]) -> set:
 LINE_STYLE = {  # name prefix -> (colour, style, where to write its label: delta)
     "(4.15)": ("k", "-", -0.72), "(4.17)": ("k", "--", -0.38), "(4.20)": ("k", ":", 0.62),
     "(4.43) as printed": ("k", "-.", 0.93), "(4.43) corrected": ("#a3001b", "-.", 0.72),
-    "alpha": ("#0b3d91", "-", -0.62), "beta = -3/4": ("#a3001b", "-", 0.1),
+    "alpha": ("#0b3d91", "-", -0.62), "beta = -3/4": ("#a3001b", "-", 0.3),
     "delta = 0": ("#0b3d91", "-", 0.0), "beta_T": ("#a3001b", "-", 0.75),
 }
 
@@ -272,13 +272,18 @@ def _lines(ax, model: str) -> None:
         d, c = line["delta"], np.degrees(line["chi"])
         ax.plot(d, c, color=color, ls=ls, lw=1.6)
         ok = np.isfinite(c) & (c > 2) & (c < 88)
-        if ok.any():
+        if np.ptp(d) == 0.0:  # a vertical line (delta = 0): its label half way up
+            ax.annotate(line["label"], (d[0], 47.0), fontsize=7.5, color=color, ha="center", va="bottom", **_BOX)
+        elif ok.any():
             k = int(np.argmin(np.where(ok, np.abs(d - at), np.inf)))
-            ax.annotate(line["label"], (d[k], c[k]), fontsize=7.5, color=color, ha="center", va="bottom",
-                        bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8})
+            ax.annotate(line["label"], (d[k], c[k]), fontsize=7.5, color=color, ha="center", va="bottom", **_BOX)
     for fam in FM.dast_families():
         ax.plot(fam["delta"], np.degrees(fam["chi"]), color="0.25", ls=fam["style"], lw=1.2, alpha=0.9)
-        ax.text(-0.98, np.degrees(fam["chi"][0]) + 0.8, fam["short"], fontsize=7, color="0.2")
+        ax.text(-0.98, np.degrees(fam["chi"][0]) + 0.8, fam["short"], fontsize=7, color="0.2", **_BOX)
+
+
+# Labels above the cells' bars, hatching and coexistence dots (zorder 5), on a white box.
+_BOX = {"zorder": 6, "bbox": {"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85}}
 
 
 def _legend(fig, seen: set, ncol: int = 3) -> None:

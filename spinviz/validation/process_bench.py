@@ -242,9 +242,9 @@ STYLE = {"taylor": ("tab:blue", "D"), "taylor-long": ("navy", "d"), "dop853": ("
 
 def plot(points: list[Point], path: str) -> None:
     """Error against whole-process time, log-log, one panel per problem, one line per method."""
-    from ..plotting import pyplot, save
-
     from matplotlib.ticker import LogLocator, NullFormatter
+
+    from ..plotting import pyplot, save
 
     plt = pyplot()
     probs = [p for p in PROBLEMS if any(q.problem == p for q in points)]

@@ -27,7 +27,7 @@ from pydantic import Field, PlainValidator, model_validator
 from pydantic_core import PydanticCustomError
 
 from ..errors import SpecError, brief
-from .base import Int, Positive, Real, Text, between, check_vector, refused, request, wrong_type
+from .base import Flag, Int, Path, Positive, Real, Text, between, check_vector, refused, request, wrong_type
 from .toml import Table
 
 MODELS = ("reduced", "truncated")
@@ -233,28 +233,12 @@ SETTINGS_NAMES = {"samples_per_decade": "per_decade", "window_decades": "window"
 
 
 # --- spinviz.atlas(...) ----------------------------------------------------------------------
-def _optional_path(v):
-    import os
-
-    if v is None or isinstance(v, str | os.PathLike):
-        return None if v is None else os.fspath(v)
-    raise wrong_type(f"must be a path (str or os.PathLike), got {type(v).__name__} {brief(v)}")
-
-
-def _flag(v):
-    if not isinstance(v, bool):
-        raise wrong_type(f"must be True or False, got {brief(v)}")
-    return v
-
-
 def _callback(v):
     if v is not None and not callable(v):
         raise wrong_type(f"must be callable (n, result) or None, got {type(v).__name__}")
     return v
 
 
-Path = Annotated[Any, PlainValidator(_optional_path)]
-Flag = Annotated[bool, PlainValidator(_flag)]
 
 
 @request

@@ -25,6 +25,7 @@ import contextlib
 import contextvars
 import functools
 import math
+import os
 import unicodedata
 from typing import Annotated, Any
 
@@ -156,6 +157,23 @@ def check_vector(v, n: int, what: str = "numbers") -> tuple[float, ...]:
 def vector(n: int, what: str = "numbers"):
     """A list (tuple, 1-D array) of ``n`` finite numbers, as a tuple of floats."""
     return Annotated[tuple[float, ...], PlainValidator(lambda v: check_vector(v, n, what))]
+
+
+def _path(v):
+    if v is None or isinstance(v, str | os.PathLike):
+        return None if v is None else os.fspath(v)
+    raise wrong_type(f"must be a path (str or os.PathLike), got {type(v).__name__} {brief(v)}")
+
+
+def _flag(v):
+    if not isinstance(v, bool):
+        raise wrong_type(f"must be True or False, got {brief(v)}")
+    return v
+
+
+# An optional path (str or os.PathLike, kept as str) and a strict True/False argument
+Path = Annotated[Any, PlainValidator(_path)]
+Flag = Annotated[bool, PlainValidator(_flag)]
 
 
 def refused(reason: str):

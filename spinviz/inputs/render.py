@@ -23,7 +23,7 @@ from typing import Annotated, Literal
 from pydantic import AfterValidator, Field, PlainValidator, model_validator
 
 from ..errors import SpecError, brief
-from .base import Int, Line, NonNegative, Positive, Real, one_line, request, wrong_type
+from .base import Flag, Int, Line, NonNegative, Path, Positive, Real, one_line, request, wrong_type
 
 SHOW_ITEMS = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud", "hodograph", "inset", "power")
 DEFAULT_SHOW = ("body", "dipole", "axes", "trail", "sphere", "hud")
@@ -195,18 +195,6 @@ def usable_cores() -> int:
         return os.cpu_count() or 1
 
 
-def _path(v):
-    if v is None or isinstance(v, str | os.PathLike):
-        return None if v is None else os.fspath(v)
-    raise wrong_type(f"must be a path (str or os.PathLike), got {type(v).__name__} {brief(v)}")
-
-
-def _flag(v):
-    if not isinstance(v, bool):
-        raise wrong_type(f"must be True or False, got {brief(v)}")
-    return v
-
-
 def _workers(v):
     cores = usable_cores()
     if v > cores:
@@ -229,9 +217,9 @@ class RenderArguments:
     t_end: Positive | None = None
     frames: Annotated[Int, Field(ge=2, le=MAX_FRAMES)] | None = None
     frame: Int | None = None
-    out: Annotated[str | None, PlainValidator(_path)] = None
+    out: Path = None
     workers: Annotated[Int, Field(ge=1), AfterValidator(_workers)] | None = None
-    progress: Annotated[bool, PlainValidator(_flag)] = False
+    progress: Flag = False
 
 
 def poster_for(out: str) -> str:

@@ -239,8 +239,6 @@ def _callback(v):
     return v
 
 
-
-
 @request
 class AtlasArguments:
     """The arguments of ``spinviz.atlas`` besides the spec (the command line's options)."""

@@ -322,6 +322,3 @@ class SceneFile:
     description: Text | None = None
     render: Table | None = None
     observe: Table | None = None
-
-
-SUBTABLES = ("body", "initial", "simulation", "render", "observe")

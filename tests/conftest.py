@@ -37,6 +37,28 @@ def check_quick(tmp_path_factory):
                            modules=set(json.loads(modules.read_text())) if modules.exists() else None, stderr=r.stderr)
 
 
+@pytest.fixture(scope="session")
+def small_atlas_spec(tmp_path_factory):
+    """The small two-model atlas spec of tests/atlasdata.py as a file."""
+    from atlasdata import SPEC
+
+    p = tmp_path_factory.mktemp("atlas") / "small.toml"
+    p.write_text(SPEC)
+    return p
+
+
+@pytest.fixture(scope="session")
+def small_atlas_reference(small_atlas_spec, tmp_path_factory):
+    """That atlas computed in one go (LocalCluster, one worker thread in this process), once
+    for the cluster and the fault tests, which compare their interrupted stores with it."""
+    from spinviz.regimes import api
+
+    out = tmp_path_factory.mktemp("ref") / "ref.zarr"
+    res = api.atlas(small_atlas_spec, out, workers=1, processes=False, progress=False, runs_per_task=3)
+    assert res.computed == 36 and res.reused == 0
+    return out
+
+
 # Hypothesis: deterministic and bounded in CI; HYPOTHESIS_PROFILE=fuzz for a long random hunt.
 from hypothesis import HealthCheck, settings  # noqa: E402
 

@@ -14,42 +14,23 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from atlasdata import SPEC, VARIABLES
 
 from spinviz.errors import UsageError
 from spinviz.regimes import api, cluster, store
 from spinviz.regimes.spec import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]
-SPEC = """title = "cluster test"
-models = ["reduced", "truncated"]
-[grid]
-delta = [-0.6, 0.5]
-chi_deg = [22.0, 45.0, 70.0]
-[members]
-count = 3
-seed = 5
-omega = 0.05
-[run]
-tau_end = 1e8
-"""
-VARIABLES = ("regime", "regime_early", "candidate", "status", "method", "confidence", "tau_reached", "nsteps", "nfev",
-             "reason", "evidence", "omega_final", "done", "omega0", "paper")
 
 
 @pytest.fixture(scope="module")
-def spec_path(tmp_path_factory):
-    p = tmp_path_factory.mktemp("atlas") / "small.toml"
-    p.write_text(SPEC)
-    return p
+def spec_path(small_atlas_spec):
+    return small_atlas_spec
 
 
 @pytest.fixture(scope="module")
-def reference(spec_path, tmp_path_factory):
-    """The atlas computed in one go (LocalCluster, one worker thread in this process)."""
-    out = tmp_path_factory.mktemp("ref") / "ref.zarr"
-    res = api.atlas(spec_path, out, workers=1, processes=False, progress=False, runs_per_task=3)
-    assert res.computed == 36 and res.reused == 0
-    return out
+def reference(small_atlas_reference):
+    return small_atlas_reference
 
 
 def same_numbers(a, b):

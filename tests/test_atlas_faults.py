@@ -22,6 +22,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from atlasdata import VARIABLES
+from procs import gone
 
 from spinviz import interrupt
 from spinviz.regimes import api, cluster, integrity, store
@@ -30,37 +32,18 @@ from spinviz.regimes.__main__ import main as atlas_main
 from spinviz.regimes.faults import AtlasIncomplete, OptionError, StoreDamaged
 
 ROOT = Path(__file__).resolve().parents[1]
-SPEC = """title = "fault test"
-models = ["reduced", "truncated"]
-[grid]
-delta = [-0.6, 0.5]
-chi_deg = [22.0, 45.0, 70.0]
-[members]
-count = 3
-seed = 5
-omega = 0.05
-[run]
-tau_end = 1e8
-"""
-VARIABLES = ("regime", "regime_early", "candidate", "status", "method", "confidence", "tau_reached", "nsteps", "nfev",
-             "reason", "evidence", "omega_final", "done", "omega0", "paper")
 ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""), "PYTHONUNBUFFERED": "1"}
 DASK = str(Path(sys.executable).parent / "dask")
 
 
 @pytest.fixture(scope="module")
-def spec_path(tmp_path_factory):
-    p = tmp_path_factory.mktemp("faults") / "small.toml"
-    p.write_text(SPEC)
-    return p
+def spec_path(small_atlas_spec):
+    return small_atlas_spec
 
 
 @pytest.fixture(scope="module")
-def reference(spec_path, tmp_path_factory):
-    out = tmp_path_factory.mktemp("ref") / "ref.zarr"
-    res = api.atlas(spec_path, out, workers=1, processes=False, progress=False, runs_per_task=3)
-    assert res.computed == 36
-    return out
+def reference(small_atlas_reference):
+    return small_atlas_reference
 
 
 def arrays(path):
@@ -580,28 +563,6 @@ def test_command_killed_at_random_points_resumes_to_the_same_numbers(spec_path, 
 
 
 # --- stop signals ---------------------------------------------------------------------------------
-def session_alive(sid: int) -> list[int]:
-    """Processes (not zombies) in session ``sid``."""
-    out = []
-    for p in Path("/proc").iterdir():
-        if not p.name.isdigit():
-            continue
-        try:
-            fields = (p / "stat").read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        if int(fields[3]) == sid and fields[0] != "Z":
-            out.append(int(p.name))
-    return out
-
-
-def gone(sid: int, timeout: float = 5.0) -> list[int]:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end and session_alive(sid):
-        time.sleep(0.05)
-    return session_alive(sid)
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("sig, to_group", [(signal.SIGINT, True), (signal.SIGTERM, False), (signal.SIGHUP, True),
                                            (signal.SIGHUP, False)],

@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 import pytest
+from procs import gone
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -50,28 +51,6 @@ def wait_for(proc, text, timeout=90.0):
             return seen
     proc.kill()
     raise AssertionError(f"never saw {text!r}: {seen}")
-
-
-def session_alive(sid: int) -> list[int]:
-    """Processes (not zombies) in session ``sid``."""
-    out = []
-    for p in Path("/proc").iterdir():
-        if not p.name.isdigit():
-            continue
-        try:
-            fields = (p / "stat").read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        if int(fields[3]) == sid and fields[0] != "Z":
-            out.append(int(p.name))
-    return out
-
-
-def gone(sid: int, timeout: float = 5.0) -> list[int]:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end and session_alive(sid):
-        time.sleep(0.1)
-    return session_alive(sid)
 
 
 # the MP4 cases start two render workers and ffmpeg each (1-3.5 s): slow, like the atlas's stop signals

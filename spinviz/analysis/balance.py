@@ -30,11 +30,12 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
 from .. import rotations as R
+from ..atomic import plain
 from ..driver import simulate
 from ..physics import radiation as RA
 from ..physics.bodies import Body
@@ -83,7 +84,7 @@ class BalanceRun:
 
     def record(self) -> dict:
         """The fields as a JSON-ready dict (``spinviz check --json``)."""
-        return {k: v for k, v in vars(self).items()}
+        return plain(asdict(self))
 
 
 def balance_run(body: Body, model: str, eps: float, direction=(0.3, 0.5, 0.8), euler0=(0.3, 1.1, -0.4),

@@ -228,7 +228,6 @@ class AtlasFile:
         return self.models or ((self.model,) if self.model else ("reduced",))
 
 
-SUBTABLES = ("grid", "members", "run", "classify", "refine", "output")
 SETTINGS_NAMES = {"samples_per_decade": "per_decade", "window_decades": "window"}    # TOML key -> Settings field
 
 

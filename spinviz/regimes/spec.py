@@ -60,7 +60,7 @@ from ..errors import SceneError, SpecError, SpecTypeError
 from ..inputs import atlas as IA
 from ..inputs.base import fields_of
 from ..inputs.render import usable_cores
-from ..inputs.toml import read_toml, table
+from ..inputs.toml import document, read_toml, table
 from ..physics.bodies import MIN_INERTIA_RATIO
 from .runs import Settings
 
@@ -210,11 +210,16 @@ def load_spec(path) -> AtlasSpec:
     return parse_spec(read_toml(path, kind="atlas spec"), path)
 
 
+# every table of a spec, validated in one place (inputs.toml.document) before anything is computed
+_TABLES = {"grid": IA.GridTable, "members": IA.MembersTable, "run": IA.RunTable, "classify": IA.ClassifyTable,
+           "refine": IA.RefineTable, "output": IA.OutputTable}
+
+
 def parse_spec(data: dict, path: str = "<atlas spec>") -> AtlasSpec:
     """Validate a parsed TOML document (see the module docstring for every key)."""
     path = os.fspath(path)
-    top = table(IA.AtlasFile, data, "", path, IA.SUBTABLES)
-    grid = table(IA.GridTable, top.grid, "grid", path)
+    top, tables = document(IA.AtlasFile, data, path, _TABLES, ("run", "classify", "refine", "output"))
+    grid, members, run, classify, refine, output = (tables[k] for k in _TABLES)
     deltas = _axis(path, "delta", grid.delta, (-1.0, 1.0), open_ends=True, unit="")
     if grid.chi_deg is not None:
         chis_deg = _axis(path, "chi_deg", grid.chi_deg, (0.0, 90.0), open_ends=False, unit=" deg")
@@ -226,16 +231,11 @@ def parse_spec(data: dict, path: str = "<atlas spec>") -> AtlasSpec:
         if 1.0 - d < MIN_INERTIA_RATIO:
             raise SceneError(path, "[grid].delta", f"delta = {d:g}: 1 - delta = I3/I1 is below {MIN_INERTIA_RATIO:g}, "
                                                    f"too thin to integrate")
-    members = table(IA.MembersTable, top.members, "members", path)
     if members.list is not None:
         omega0, seed, mag = np.array(members.list), None, None
     else:
         mag = members.omega if members.omega is not None else 0.1
         omega0, seed = directions(members.count, members.seed) * mag, int(members.seed)
-    run = table(IA.RunTable, top.run or {}, "run", path)
-    classify = table(IA.ClassifyTable, top.classify or {}, "classify", path)
-    refine = table(IA.RefineTable, top.refine or {}, "refine", path)
-    output = table(IA.OutputTable, top.output or {}, "output", path)
     axes = _ranges(grid)
     if refine.levels and axes is None:
         raise SceneError(path, "[refine].levels", "needs [grid].delta and [grid].chi (or chi_deg) as {min, max, cells}")

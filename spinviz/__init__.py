@@ -27,8 +27,8 @@ __version__ = "0.2.0"
 
 # public name -> (module, attribute)
 _API = {
-    "load_scene": ("scene", "load_scene"),
-    "Scene": ("scene", "Scene"),
+    "load_scene": ("inputs.scene_spec", "load_scene"),
+    "Scene": ("inputs.scene_spec", "Scene"),
     "simulate": ("driver", "simulate"),
     "Trajectory": ("trajectory", "Trajectory"),
     "render": ("pipeline", "render"),
@@ -48,8 +48,8 @@ _API = {
     "atlas": ("regimes.api", "atlas"),
 }
 _SUBMODULES = {
-    "units", "rotations", "errors", "atomic", "plotting", "physics", "integrators", "inputs", "driver", "trajectory", "scene",
-    "rendering", "pipeline", "analysis", "validation", "regimes", "cli",
+    "units", "rotations", "errors", "atomic", "plotting", "physics", "integrators", "inputs", "driver", "trajectory",
+    "rendering", "pipeline", "analysis", "validation", "regimes", "commands",
 }
 
 __all__ = sorted(_API) + ["__version__"]

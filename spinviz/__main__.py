@@ -1,6 +1,6 @@
 """``python -m spinviz``: the same as the ``spinviz`` command."""
 
-from .cli import entry
+from .commands import entry
 
 if __name__ == "__main__":    # guarded: render workers are spawned and re-import __main__
     entry()

@@ -17,8 +17,8 @@ from .atomic import check_outputs
 from .driver import simulate_request
 from .errors import SpecError, SpecTypeError, UsageError
 from .inputs.render import RenderArguments, RenderSpec, default_output, poster_for
+from .inputs.scene_spec import Scene, load_scene
 from .rendering.timeline import FramePlan, frame_times, plan_frames
-from .scene import Scene, load_scene
 from .trajectory import Trajectory
 
 __all__ = ["render", "render_frame", "Renderer", "plan", "require_render_stack", "default_output"]

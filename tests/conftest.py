@@ -28,7 +28,7 @@ def check_quick(tmp_path_factory):
     the records, tests/test_imports.py the modules."""
     modules = tmp_path_factory.mktemp("check_quick") / "modules.json"
     probe = ("import json, sys\n"
-             "from spinviz.cli import main\n"
+             "from spinviz.commands import main\n"
              "code = main(['check', '--quick', '--json'])\n"
              f"open({str(modules)!r}, 'w').write(json.dumps(sorted({{m.split('.')[0] for m in sys.modules}})))\n"
              "sys.exit(code)\n")

@@ -12,14 +12,14 @@ import numpy as np
 import pytest
 
 from spinviz.errors import SceneError
+from spinviz.inputs.atlas_spec import Settings, directions, load_spec, log_times, parse_spec
+from spinviz.physics import asymptotics as FM
 from spinviz.physics import closed_forms as CF
-from spinviz.regimes import classify as C
-from spinviz.regimes import formulas as FM
-from spinviz.regimes import runs as RN
-from spinviz.regimes.spec import directions, load_spec, parse_spec
+from spinviz.regimes.engine import classify as C
+from spinviz.regimes.engine import runs as RN
 
 ROOT = Path(__file__).resolve().parents[1]
-TAU = RN.log_times(1e-2, 1e10, 20)[1:]          # the default sampling: 20 a decade, tau = 1e-2 ... 1e10
+TAU = log_times(1e-2, 1e10, 20)[1:]          # the default sampling: 20 a decade, tau = 1e-2 ... 1e10
 
 
 # --- synthetic series with known exponents -------------------------------------------------
@@ -146,7 +146,7 @@ def test_classifier_rejects_bad_shapes():
 
 # --- full runs deep inside the paper's domains ---------------------------------------------
 MEMBERS = directions(4, 7) * 0.1
-SETTINGS = RN.Settings()                         # tau_end = 1e10: the atlas's default
+SETTINGS = Settings()                         # tau_end = 1e10: the atlas's default
 
 
 def ensemble(delta, chi, model="reduced", members=MEMBERS, settings=SETTINGS):
@@ -226,7 +226,7 @@ def test_residual_rotation_stops_early_where_it_is_exact():
 
 def test_step_budget_gives_other_with_candidate():
     """A run out of steps is never labelled: "other", with what its samples say as candidate."""
-    st = RN.Settings(max_steps=3000)
+    st = Settings(max_steps=3000)
     r = RN.run_and_classify("reduced", 0.5, math.radians(39), MEMBERS[0], st)
     assert r.status == RN.ST.TOO_MANY_STEPS and r.label == "other" and r.tau_reached < st.tau_end
     assert "step" in r.reason
@@ -287,10 +287,12 @@ def test_spec_grid_and_identity():
     assert np.degrees(s.chis).tolist() == pytest.approx([10.0, 45.0])
     assert s.runs == 3 * 2 * 2 and s.omega0.shape == (2, 3)
     assert np.allclose(np.linalg.norm(s.omega0, axis=1), 0.1)
+    from spinviz.regimes.store.dataset import identity
+
     same = parse_spec({**GOOD, "title": "renamed"}, "other.toml")
-    assert same.identity() == s.identity()                     # the title does not change the numbers
+    assert identity(same) == identity(s)                       # the title does not change the numbers
     other = parse_spec({**GOOD, "members": {"count": 2, "seed": 2, "omega": 0.1}}, "g.toml")
-    assert other.identity() != s.identity()
+    assert identity(other) != identity(s)
 
 
 def _with(path, value):
@@ -348,7 +350,7 @@ def test_command_bad_spec_exit_2_nothing_written(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text('models = ["reduced"]\n[grid]\ndelta = [0.5]\nchi_deg = [30.0]\n[members]\ncount = 0\nseed = 1\n')
     out = tmp_path / "a.zarr"
-    r = subprocess.run([sys.executable, "-m", "spinviz.regimes", str(bad), "--out", str(out)], capture_output=True,
+    r = subprocess.run([sys.executable, "-m", "spinviz", "atlas", str(bad), "--out", str(out)], capture_output=True,
                        text=True, cwd=ROOT)
     assert r.returncode == 2
     assert r.stderr.strip() == f"spinviz: error: {bad}: [members].count: must lie in [1, 100000], got 0"
@@ -366,7 +368,7 @@ def test_import_is_light():
 def test_plan_covers_exactly_the_missing_runs():
     """Batches tile the missing runs exactly (never a done one), inside one storage chunk each."""
     from spinviz.regimes.api import plan
-    from spinviz.regimes.store import chunk_shape
+    from spinviz.regimes.store.dataset import chunk_shape
 
     s = parse_spec({**GOOD, "members": {"count": 5, "seed": 1, "omega": 0.1}}, "g.toml")
     chunks = chunk_shape(s)
@@ -415,7 +417,7 @@ def test_dimensionless_atlas_runs_match_physical_unit_simulate(name, model, delt
     tau0 = 1e-20 s (Omega0 ~ 1e19 rad/s), the general (2.2)+(2.3) or (2.5), mapped through
     (4.1): every sample within 1e-7 relative to tau = 1e6 (both at rtol 1e-10; measured <= 3e-9
     to tau = 1e8, spinviz atlas --evidence physical)."""
-    from spinviz.regimes import physical_check as PC
+    from spinviz.validation.atlas import physical as PC
 
     rows = PC.compare([(name, model, delta, chi_deg)], members=2, tau_end=1e6)
     for r in rows:

@@ -17,8 +17,9 @@ import pytest
 from atlasdata import SPEC, VARIABLES
 
 from spinviz.errors import UsageError
-from spinviz.regimes import api, cluster, store
-from spinviz.regimes.spec import load_spec
+from spinviz.inputs.atlas_spec import load_spec
+from spinviz.regimes import api, cluster
+from spinviz.regimes.store import dataset as store
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -161,14 +162,14 @@ def test_existing_scheduler_with_two_workers(spec_path, reference, tmp_path):
 
 
 def test_unreachable_scheduler_exit_2_nothing_written(spec_path, tmp_path, monkeypatch, capsys):
-    from spinviz.regimes.__main__ import main
+    from spinviz.commands import main
 
     monkeypatch.setattr(cluster, "CONNECT_TIMEOUT_S", 1.0)
     out = tmp_path / "u.zarr"
     addr = f"tcp://127.0.0.1:{_free_port()}"
-    assert main([str(spec_path), "--out", str(out), "--scheduler", addr, "--quiet"]) == 2
+    assert main(["atlas", str(spec_path), "--out", str(out), "--scheduler", addr, "--quiet"]) == 2
     err = capsys.readouterr().err.strip()
-    assert err.startswith(f"spinviz: error: --scheduler {addr}: cannot connect") and "\n" not in err
+    assert err.startswith(f"spinviz: error: --scheduler: {addr}: cannot connect") and "\n" not in err
     assert not out.exists() and list(tmp_path.iterdir()) == []
 
 
@@ -181,7 +182,7 @@ def test_sigterm_stops_cleanly_and_resume_completes(spec_path, reference, tmp_pa
     slow = tmp_path / "slow.toml"
     slow.write_text(SPEC)
     env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    cmd = [sys.executable, "-m", "spinviz.regimes", str(slow), "--out", str(out), "--workers", "2", "--quiet",
+    cmd = [sys.executable, "-m", "spinviz", "atlas", str(slow), "--out", str(out), "--workers", "2", "--quiet",
            "--runs-per-task", "1"]
     p = subprocess.Popen(cmd, env=env, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                          start_new_session=True)
@@ -213,17 +214,17 @@ def test_plots_show_every_member(reference, tmp_path):
     """The diagram's shares add up to 1 in every cell; one hodograph per type found."""
     from PIL import Image
 
-    from spinviz.regimes import plot
+    from spinviz.regimes.figures import cells, draw, hodographs
 
     ds = store.open_atlas(reference)
     for model in ("reduced", "truncated"):
-        total = sum(plot.shares(ds, model).values())
+        total = sum(cells.shares(ds, model).values())
         assert np.allclose(total, 1.0)
-    reps = plot.representatives(ds)
+    reps = hodographs.representatives(ds)
     found = {(m, lab) for m, lab, *_ in reps}
     labels = {(m, str(x)) for m in ("reduced", "truncated") for x in np.unique(ds["label"].sel(model=m).values)}
     assert found == {x for x in labels if x[1] not in ("other", "failed", "missing", "approaching")}
-    paths = plot.draw(str(reference), [str(tmp_path / "d.png"), str(tmp_path / "d_hodographs.png")])
+    paths = draw.draw(str(reference), [str(tmp_path / "d.png"), str(tmp_path / "d_hodographs.png")])
     w, h = Image.open(paths[0]).size
     assert (w, h) == (2 * 792, 836)                              # two panels at 7.2 x 7.6 in, 110 dpi
     assert os.path.getsize(paths[0]) < 300_000 and os.path.getsize(paths[1]) < 300_000

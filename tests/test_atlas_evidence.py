@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 
 from spinviz.errors import UsageError
-from spinviz.regimes import api, evidence
-from spinviz.regimes import convergence as CV
-from spinviz.regimes import store as ST
+from spinviz.regimes import api
+from spinviz.regimes.store import dataset as ST
+from spinviz.validation.atlas import convergence as CV
+from spinviz.validation.atlas import evidence
 
 SPEC = """title = "evidence test"
 models = ["reduced"]

@@ -26,10 +26,12 @@ from atlasdata import VARIABLES
 from procs import gone
 
 from spinviz import interrupt
-from spinviz.regimes import api, cluster, integrity, store
-from spinviz.regimes import runs as RN
-from spinviz.regimes.__main__ import main as atlas_main
+from spinviz.commands import main as cli_main
+from spinviz.regimes import api, cluster
+from spinviz.regimes.engine import runs as RN
 from spinviz.regimes.faults import AtlasIncomplete, OptionError, StoreDamaged
+from spinviz.regimes.store import dataset as store
+from spinviz.regimes.store import integrity
 
 ROOT = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""), "PYTHONUNBUFFERED": "1"}
@@ -77,7 +79,7 @@ def copy_store(reference, tmp_path) -> Path:
 
 
 def verify(path, capsys):
-    rc = atlas_main(["--verify", str(path)])
+    rc = cli_main(["atlas", "--verify", str(path)])
     return rc, capsys.readouterr().out.splitlines()
 
 
@@ -163,7 +165,7 @@ def test_verify_a_clean_store(reference, capsys):
 
 
 def test_verify_refuses_what_is_not_a_store(tmp_path, capsys):
-    assert atlas_main(["--verify", str(tmp_path / "nothing.zarr")]) == 2
+    assert cli_main(["atlas", "--verify", str(tmp_path / "nothing.zarr")]) == 2
     assert capsys.readouterr().err.strip() == (f"spinviz: error: --verify {tmp_path / 'nothing.zarr'}: not an atlas "
                                                f"store (no such directory, or no .zgroup in it)")
 
@@ -188,7 +190,7 @@ def test_damaged_metadata_refused_untouched(spec_path, reference, tmp_path, caps
 def test_store_without_checksums_refused(spec_path, reference, tmp_path, capsys):
     s = copy_store(reference, tmp_path)
     shutil.rmtree(s / integrity.DIR)
-    assert atlas_main([str(spec_path), "--out", str(s), "--quiet", "--workers", "1"]) == 2
+    assert cli_main(["atlas", str(spec_path), "--out", str(s), "--quiet", "--workers", "1"]) == 2
     assert capsys.readouterr().err.strip() == (
         f"spinviz: error: {s}: carries no checksums (made by an earlier spinviz, or its .checksums was deleted), "
         f"so its runs cannot be trusted; move it away and compute the atlas again")
@@ -251,17 +253,14 @@ def test_failed_task_is_not_written_and_the_call_fails(spec_path, reference, tmp
 
 # --- options ---------------------------------------------------------------------------------------
 def test_workers_beyond_the_cores_refused(spec_path, tmp_path, capsys):
-    """``--workers 1000`` (before the schema: accepted, 1000 processes on 2 cores): one line
-    naming the option, exit 2, nothing written, by both entry points; the library names
-    ``workers``.  (The bound is the schema's; ``Cluster`` made directly checks it too.)"""
-    from spinviz.cli import main as cli_main
+    """``--workers 1000`` (1000 processes on 2 cores): one line naming the option, exit 2,
+    nothing written; the library names ``workers``.  (The bound is the schema's; ``Cluster``
+    made directly checks it too.)"""
     from spinviz.errors import SpecError
 
     cores = len(os.sched_getaffinity(0))
     out = tmp_path / "w.zarr"
     reason = f"must be at most {cores}, the cores this process may use (more workers than cores only share them), got 1000"
-    assert atlas_main([str(spec_path), "--out", str(out), "--workers", "1000", "--quiet"]) == 2
-    assert capsys.readouterr().err.strip() == f"spinviz: error: --workers: {reason}"
     assert cli_main(["atlas", str(spec_path), "--out", str(out), "--workers", "1000", "--quiet"]) == 2
     assert capsys.readouterr().err.strip() == f"spinviz: error: --workers: {reason}"
     for call in (lambda: api.atlas(spec_path, out, workers=1000, progress=False), lambda: cluster.Cluster(None, 1000)):
@@ -365,7 +364,7 @@ def wait_for_done(out: Path, proc, at_least: int = 1, timeout: float = 90.0) -> 
 
 
 def command(spec_path, out, *extra, cwd):
-    return subprocess.Popen([sys.executable, "-m", "spinviz.regimes", str(spec_path), "--out", str(out), "--quiet",
+    return subprocess.Popen([sys.executable, "-m", "spinviz", "atlas", str(spec_path), "--out", str(out), "--quiet",
                              *map(str, extra)], env=ENV, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, start_new_session=True)
 
@@ -422,7 +421,7 @@ def test_workers_killed_at_random_points_same_numbers(spec_path, reference, tmp_
 
 CRASHER = """
 import os
-from spinviz.regimes import runs
+from spinviz.regimes.engine import runs
 
 _real = getattr(runs, "_unpatched_run_batch", runs.run_batch)     # Dask may load a preload twice
 runs._unpatched_run_batch = _real
@@ -463,7 +462,7 @@ def test_task_that_kills_its_worker_is_not_written(spec_path, reference, tmp_pat
 
 
 DEEP = """
-from spinviz.regimes import runs
+from spinviz.regimes.engine import runs
 
 _real = getattr(runs, "_unpatched_run_batch", runs.run_batch)
 runs._unpatched_run_batch = _real

@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 import zarr
 
-from spinviz.regimes import api, command
-from spinviz.regimes import refine as RF
-from spinviz.regimes import store as ST
+from spinviz.commands import atlas as command
+from spinviz.regimes import api
+from spinviz.regimes.engine import refine as RF
+from spinviz.regimes.store import dataset as ST
 
 SPEC = """title = "refine test"
 models = ["reduced"]
@@ -105,12 +106,13 @@ def test_diagram_tiles_the_plane_once_finer_cells_over_coarser(refined):
     from matplotlib.colors import to_rgb
 
     from spinviz.plotting import pyplot
-    from spinviz.regimes import plot
+    from spinviz.regimes.figures import cells as CE
+    from spinviz.regimes.figures import diagram, draw
 
     _, out, _ = refined
-    levels = plot.open_levels(out)
+    levels = draw.open_levels(out)
     assert len(levels) == 2
-    cells = plot.compose_levels(levels, "reduced")
+    cells = CE.compose_levels(levels, "reduced")
     cover = np.zeros((8, 8), dtype=int)
     for c in cells:
         s = 2 ** (1 - c["level"])
@@ -123,17 +125,17 @@ def test_diagram_tiles_the_plane_once_finer_cells_over_coarser(refined):
     fig, ax = plt.subplots(figsize=(4, 4), dpi=100)
     ax.set_xlim(-1, 1)
     ax.set_ylim(0, 90)
-    plot._cells(ax, cells)
+    diagram._cells(ax, cells)
     fig.canvas.draw()
     img = np.asarray(fig.canvas.buffer_rgba())[..., :3] / 255.0
-    parents = {(c["i"], c["j"]): c for c in plot.compose(levels[0], "reduced")}
+    parents = {(c["i"], c["j"]): c for c in CE.compose(levels[0], "reduced")}
     checked = differ = 0
     for c in cells:
         if c["level"] != 1 or len(c["bars"]) != 1 or c["bars"][0][2] or c["coexist"]:
             continue
         x, y = ax.transData.transform((c["delta"], c["chi_deg"]))
         px = img[img.shape[0] - int(round(y)), int(round(x))]
-        np.testing.assert_allclose(px, to_rgb(plot.COLORS[c["bars"][0][0]]), atol=0.02)
+        np.testing.assert_allclose(px, to_rgb(diagram.COLORS[c["bars"][0][0]]), atol=0.02)
         checked += 1
         differ += parents[(c["i"] // 2, c["j"] // 2)]["bars"][0][0] != c["bars"][0][0]
     plt.close(fig)
@@ -148,18 +150,19 @@ def test_atlas_page_in_chromium(refined, tmp_path):
     dots on the right of the page), which the same page without the fragment does not."""
     from browser import CHROMIUM, page_text, screenshot
 
-    from spinviz.regimes import plot
+    from spinviz.regimes.figures import cells as CE
+    from spinviz.regimes.figures import draw
 
     if CHROMIUM is None:
         if os.environ.get("CI"):
             pytest.fail("CI must test the atlas page, but chromium is missing (see .ci/run)", pytrace=False)
         pytest.skip("needs chromium (apt-get install chromium)")
     _, out, _ = refined
-    paths = plot.draw(out, [str(tmp_path / f"a{ext}") for ext in (".png", "_hodographs.png", ".html")])
+    paths = draw.draw(out, [str(tmp_path / f"a{ext}") for ext in (".png", "_hodographs.png", ".html")])
     page = tmp_path / "a.html"
     assert paths[2] == str(page)
-    levels = plot.open_levels(out)
-    cells = plot.compose_levels(levels, "reduced")
+    levels = draw.open_levels(out)
+    cells = CE.compose_levels(levels, "reduced")
     first = levels[1]["label"].sel(model="reduced").values[..., 0]          # each level-1 cell's first start
     fine = next(c for c in cells if c["level"] == 1 and c["bars"][0][0] == "1" and first[c["i"], c["j"]] == "1")
     dom, text = page_text(page, tmp_path, fragment=f"open={fine['id']}")

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from spinviz import rotations as R
-from spinviz.cli import main
+from spinviz.commands import main
+from spinviz.inputs.scene_spec import load_scene
 from spinviz.physics import closed_forms as CF
-from spinviz.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"

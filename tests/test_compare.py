@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from spinviz.analysis import compare as C
-from spinviz.cli import main
+from spinviz.commands import main
 from spinviz.driver import simulate
 from spinviz.physics import bodies as B
 from spinviz.physics import presets as P

@@ -34,7 +34,7 @@ def test_import_spinviz_is_light():
 ])
 def test_cli_commands_never_import_rendering(argv, tmp_path):
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
-    mods = loaded("from spinviz.cli import main\nimport contextlib, io\n"
+    mods = loaded("from spinviz.commands import main\nimport contextlib, io\n"
                   f"with contextlib.redirect_stdout(io.StringIO()):\n    assert main({argv!r}) == 0")
     assert not (mods & set(RENDERING)), mods
 

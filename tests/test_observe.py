@@ -11,9 +11,9 @@ from scipy.optimize import brentq
 
 from spinviz.analysis import observe as OB
 from spinviz.analysis import sonify as SO
-from spinviz.cli import main
+from spinviz.commands import main
+from spinviz.inputs.scene_spec import load_scene
 from spinviz.physics import closed_forms as CF
-from spinviz.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"

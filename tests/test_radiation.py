@@ -223,7 +223,7 @@ def test_stokes_of_a_rotating_dipole():
 
 def test_simulate_saves_the_radiation(tmp_path):
     """``spinviz simulate`` writes the observables with their units (erg/s ...) beside the state."""
-    from spinviz.cli import main
+    from spinviz.commands import main
 
     out = tmp_path / "cube.npz"
     assert main(["simulate", "scenes/dast_cube.toml", "--out", str(out)]) == 0

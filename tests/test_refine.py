@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from spinviz.regimes import refine as RF
+from spinviz.regimes.engine import refine as RF
 
 BOUNDARY = lambda d: 40.0 + 20.0 * d            # noqa: E731  chi (deg) of the synthetic boundary, delta in (-1, 1)
 
@@ -70,7 +70,7 @@ def test_disagreeing_members_flag_a_cell_even_with_agreeing_neighbours():
 
 
 def test_approaching_counts_for_the_class_it_approaches():
-    from spinviz.regimes import classify as C
+    from spinviz.regimes.engine import classify as C
 
     codes = np.array([C.CODE["3"], C.CODE["approaching"], C.CODE["other"]])
     cand = np.array([C.CODE["3"], C.CODE["3"], C.CODE["1|2"]])

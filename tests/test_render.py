@@ -13,9 +13,9 @@ import pytest
 from spinviz import pipeline
 from spinviz import rotations as R
 from spinviz.errors import RenderError
+from spinviz.inputs.scene_spec import parse_scene
 from spinviz.rendering import timeline
 from spinviz.rendering.video import render_frames, render_video
-from spinviz.scene import parse_scene
 
 DIPOLE_RGB = np.array([0.86, 0.08, 0.24]) * 255
 
@@ -253,7 +253,7 @@ def test_log_time_map_and_slowed_spin_label():
 
 
 def test_render_command_errors_are_one_line(tmp_path, capsys):
-    from spinviz.cli import main
+    from spinviz.commands import main
 
     good = tmp_path / "s.toml"
     good.write_text(ASKEW.format(models='model = "reduced"', show='["dipole"]', w=64, h=48))
@@ -292,7 +292,7 @@ def arrow_rgb(key):
 
 def scene_frames(path, frames=("first", "middle", "last"), size=(640, 360), **overrides):
     """(plan, {name: image}, session) of a shipped scene at ``size``; caller closes the session."""
-    from spinviz.scene import load_scene
+    from spinviz.inputs.scene_spec import load_scene
 
     plan = pipeline.plan(load_scene(path), size=size, **overrides)
     n = plan.frames
@@ -386,7 +386,7 @@ def test_rod_panels_differ_where_the_axial_spin_shows():
     measurably different after 1 T (the reduced rod keeps its axial spin, the truncated one loses
     it), in the rod's own pixels."""
     path = SCENES[[p.stem for p in SCENES].index("cellulose_rod")]
-    from spinviz.scene import load_scene
+    from spinviz.inputs.scene_spec import load_scene
 
     plan = pipeline.plan(load_scene(path), size=(640, 360))
     T = plan.time_scale[1]

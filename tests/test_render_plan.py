@@ -426,8 +426,8 @@ def test_the_parent_computes_the_power_once_per_trajectory(monkeypatch):
     frame times, and keeps its values (erg/s) in the plan: the render workers only draw them.
     A scene that does not show the power never computes it."""
     from spinviz import trajectory
+    from spinviz.inputs.scene_spec import load_scene
     from spinviz.rendering import timeline
-    from spinviz.scene import load_scene
 
     calls = []
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from spinviz.atomic import AtomicPath
-from spinviz.cli import main
+from spinviz.commands import main
 from spinviz.driver import simulate
 from spinviz.physics import bodies as B
 from spinviz.physics import presets as P
@@ -54,7 +54,7 @@ def test_binary_file_as_scene(tmp_path, capsys):
 
 
 def test_preset_name_and_density_are_used(tmp_path):
-    from spinviz.scene import load_scene
+    from spinviz.inputs.scene_spec import load_scene
 
     sc = load_scene(scene(tmp_path, body='preset = "cellulose_rod"\nname = "my rod"\ndensity = 1.5'))
     assert sc.body.name == "my rod"

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import spinviz
-from spinviz.cli import main
+from spinviz.commands import main
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = """

@@ -145,7 +145,7 @@ def test_auto_takes_long_double_below_what_double_holds():
 
 
 def test_the_command_line_says_when_the_tolerance_is_not_met(tmp_path, capsys):
-    from spinviz.cli import main
+    from spinviz.commands import main
 
     sc = tmp_path / "s.toml"
     sc.write_text('[body]\ndelta = 0.3\nchi = 0.7\n[initial]\nomega = [0.0, 0.05, 0.3]\n'

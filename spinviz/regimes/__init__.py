@@ -1,22 +1,20 @@
 """Regime atlas: which asymptotic type of section 4 a top ends in, over the (delta, chi) plane.
 
 Ensembles of Euler-only runs (heyoka's batch mode) classified one by one, computed on Dask and
-written to a resumable Zarr store (issue 12).  Modules, in the order data flows:
+written to a resumable Zarr store.  The spec is an input like any other (``inputs.atlas``:
+its tables; ``inputs.atlas_spec``: the ``AtlasSpec``, built once); the evidence the atlas
+rests on is with the project's other checks (``validation.atlas``).  Rooms, in the order
+data flows:
 
-* ``formulas`` -- the paper's asymptotic solutions and domains, spinviz's derived lines,
-  the DAST families of figure 5;
-* ``spec`` -- the TOML spec, validated like a scene;
-* ``runs`` -- one run (decade by decade) and a batch of runs, each classified;
-* ``classify`` -- the classifier: label, confidence, evidence;
-* ``store`` -- the xarray / Zarr store: creation, identity, chunk writes, reading;
-* ``integrity`` -- the store's checksums: a record per chunk, verified before a resume;
-* ``cluster`` -- LocalCluster or an existing scheduler, worker warm-up, progress, and
-  what a lost task or a lost cluster means (never a written result);
-* ``faults`` -- how the atlas fails, in one line each (``AtlasIncomplete``, ``StoreDamaged``,
-  ``OptionError``);
-* ``api`` -- ``atlas(spec, out, ...)``; ``plot`` -- the diagram and the hodographs;
-* ``command`` -- the ``atlas`` subcommand; ``bench`` -- its benchmark; ``crosscheck`` --
-  the paper discrepancies re-checked with an independent integrator (scipy).
+* ``engine`` -- ``runs`` (a batch of runs through the one driver, each classified where it
+  ran), ``classify`` (label, confidence, evidence), ``refine`` (which cells to cut in four);
+* ``cluster`` -- LocalCluster or an existing scheduler, worker warm-up, progress, and what a
+  lost task or a lost cluster means (never a written result);
+* ``store`` -- ``dataset`` (the xarray / Zarr store), ``integrity`` (its checksums),
+  ``verify`` (``--verify``'s report);
+* ``figures`` -- the diagram and the hodographs (PNG) and the interactive page (HTML);
+* ``api`` -- ``atlas(spec, out, ...)``: levels, resume, execution; ``bench`` -- its
+  benchmark; ``faults`` -- how the atlas fails, one line each.
 
 Importing this package is light (numba, dask and matplotlib load on first use).
 """
@@ -28,11 +26,8 @@ import importlib
 _API = {
     "atlas": ("api", "atlas"),
     "AtlasResult": ("api", "AtlasResult"),
-    "load_spec": ("spec", "load_spec"),
-    "parse_spec": ("spec", "parse_spec"),
-    "AtlasSpec": ("spec", "AtlasSpec"),
-    "open_atlas": ("store", "open_atlas"),
-    "verify": ("store", "verify"),
+    "open_atlas": ("store.dataset", "open_atlas"),
+    "verify": ("store.dataset", "verify"),
     "AtlasIncomplete": ("faults", "AtlasIncomplete"),
     "StoreDamaged": ("faults", "StoreDamaged"),
 }

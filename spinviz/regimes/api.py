@@ -27,12 +27,12 @@ import numpy as np
 from ..atomic import check_parent_writable
 from ..errors import SpecTypeError, UsageError, printable
 from ..inputs.atlas import AtlasArguments
+from ..inputs.atlas_spec import AtlasSpec, check_feasible, load_spec
 from ..interrupt import check, deferred
-from . import integrity as IN
-from . import runs as RN
-from . import store as ST
+from .engine import runs as RN
 from .faults import AtlasIncomplete, StoreDamaged
-from .spec import AtlasSpec, check_feasible, load_spec
+from .store import dataset as ST
+from .store import integrity as IN
 
 RUNS_PER_TASK = 32          # a task of ~32 runs lasts ~0.2-10 s: scheduling (~ms) stays below 1 %
 
@@ -68,6 +68,7 @@ class AtlasResult:
         return ST.open_atlas(self.path)
 
     def summary(self) -> str:
+        """One line for people: runs reused, computed and failed, time, where, and where the time went."""
         if self.computed == 0:
             return f"{self.path}: all {self.total} runs already there, nothing to compute"
         s = (f"{self.path}: {self.total} runs ({self.reused} already there, {self.computed} computed now"
@@ -196,7 +197,7 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
     say = notify if notify is not None else _say
     plots = []
     if plot is not None:
-        from .plot import check_plot_paths
+        from .figures.draw import check_plot_paths
 
         plots = check_plot_paths(plot, out, spec)
     t0 = time.perf_counter()
@@ -231,7 +232,7 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
     res = AtlasResult(out, totals["runs"], totals["todo"], totals["reused"], totals["failed"], seconds, where, [], stats,
                       totals["repaired"], notices, levels=len(levels) - 1)
     if plot is not None:
-        from .plot import draw
+        from .figures.draw import draw
 
         res.plots = draw(out, plots)
     return res
@@ -249,6 +250,7 @@ class Level:
 
     @property
     def runs(self) -> int:
+        """Runs this level holds: all of its spec's, or its wanted cells' members."""
         return self.spec.runs if self.wanted is None else int(self.wanted.sum()) * self.spec.members
 
 
@@ -256,7 +258,7 @@ def level_spec(spec: AtlasSpec, k: int) -> AtlasSpec:
     """The spec of refinement level ``k``: every axis cut 2^k times finer, the rest unchanged."""
     from dataclasses import replace
 
-    from . import refine as RF
+    from .engine import refine as RF
 
     (d0, d1, nd), (c0, c1, nc) = spec.axes["delta"], spec.axes["chi"]
     return replace(spec, title=f"{spec.title or os.path.basename(spec.path)}: refinement level {k}",
@@ -267,7 +269,7 @@ def level_spec(spec: AtlasSpec, k: int) -> AtlasSpec:
 def refined_level(spec: AtlasSpec, out: str, levels: list, k: int) -> Level:
     """Level ``k``: the children of the level-(k - 1) cells that ``refine.flags`` marks, from
     the types the levels below computed (a cell counts as computed when all its members are)."""
-    from . import refine as RF
+    from .engine import refine as RF
 
     sub = level_spec(spec, k)
     wanted = np.zeros((len(spec.models), len(sub.deltas), len(sub.chis)), dtype=bool)
@@ -288,7 +290,7 @@ def level_types(path: str, model_index: int):
     store: an approaching run counts for the type it approaches (``refine.type_of``)."""
     import zarr
 
-    from . import refine as RF
+    from .engine import refine as RF
 
     g = zarr.open_group(path, mode="r", zarr_format=2)
     codes = np.asarray(g["regime"][model_index])

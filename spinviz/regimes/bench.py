@@ -28,8 +28,8 @@ import time
 
 import numpy as np
 
+from ..inputs.atlas_spec import AtlasSpec, load_spec
 from .api import atlas
-from .spec import AtlasSpec, load_spec
 
 FIGURE_RUNS = 64 * 64 * 32
 
@@ -63,7 +63,7 @@ def run(spec, workers: int | None = None, progress: bool = True) -> dict:
             res = atlas(spec, out, workers=n, progress=progress)
             total = time.perf_counter() - t0
             st = res.stats
-            from .store import open_atlas
+            from .store.dataset import open_atlas
 
             ds = open_atlas(out)
             secs = ds["run_seconds"].values
@@ -104,7 +104,7 @@ def run(spec, workers: int | None = None, progress: bool = True) -> dict:
 
 def _synthetic(batch, evidence: int) -> dict:
     """A batch result of the right shapes and types, random numbers (incompressible, as real ones)."""
-    from . import runs as RN
+    from .engine import runs as RN
 
     rng = np.random.default_rng([abs(int(x)) for x in np.ravel(batch.region[1:])] + [batch.region[0]])
     sh = (len(batch.deltas), len(batch.chis), len(batch.omega0))
@@ -121,10 +121,10 @@ def store_cost(spec, repeats: int = 3) -> dict:
     synthetic results, with the checksums and with ``integrity.record`` replaced by a no-op;
     medians over ``repeats``.  Returns ms per chunk write (with, without, of which the
     checksums), the store's size and the time to verify it."""
-    from . import classify as C
-    from . import integrity as IN
-    from . import store as ST
     from .api import RUNS_PER_TASK, plan
+    from .engine import classify as C
+    from .store import dataset as ST
+    from .store import integrity as IN
 
     spec = spec if isinstance(spec, AtlasSpec) else load_spec(spec)
     rows = {True: [], False: []}
@@ -164,6 +164,7 @@ def store_cost(spec, repeats: int = 3) -> dict:
 
 
 def format_store_cost(r: dict) -> str:
+    """The ``--write-path`` measurements as a table for people."""
     return (f"store write path, {r['runs']} runs in {r['chunk_writes']} chunk writes ({r['store_mb']:.1f} MB): "
             f"{r['ms_per_chunk_with']:.1f} ms per chunk with checksums, {r['ms_per_chunk_without']:.1f} ms without; "
             f"hashing and recording {r['ms_checksums_per_chunk']:.2f} ms per chunk "
@@ -172,6 +173,7 @@ def format_store_cost(r: dict) -> str:
 
 
 def format_table(r: dict) -> str:
+    """The benchmark's rows as a table for people."""
     lines = [f"atlas benchmark: {r['spec']}, {r['runs']} runs ({', '.join(r['models'])}), {r['cores']} cores", "",
              "| workers | runs/s | runs/s per worker | whole command runs/s | tasks | mean task | overhead share | "
              "CPU / wall in tasks | peak RSS per worker |",

@@ -45,7 +45,7 @@ from distributed.diagnostics.plugin import WorkerPlugin
 from ..errors import printable
 from ..inputs.render import usable_cores
 from ..interrupt import SIGNALS, check
-from . import runs as RN
+from .engine import runs as RN
 from .faults import OptionError
 
 CONNECT_TIMEOUT_S = 10.0
@@ -77,6 +77,7 @@ class WarmUp(WorkerPlugin):
         self.quiet_terminal = quiet_terminal
 
     def setup(self, worker=None):
+        """Load the Taylor integrators into this worker and check its spinviz version."""
         if self.quiet_terminal:
             if threading.current_thread() is threading.main_thread():
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -241,6 +242,7 @@ class Cluster:
 
     @property
     def nthreads(self) -> int:
+        """Threads over all the cluster's workers."""
         return max(1, sum(polled(self.client.nthreads).values()))
 
     @property
@@ -372,6 +374,7 @@ class Progress:
         self.done = 0
 
     def update(self, done: int) -> None:
+        """Count ``n`` more runs done and redraw the bar (at most a few times a second)."""
         self.done = done
         if not self.enabled:
             return
@@ -394,6 +397,7 @@ class Progress:
                 self.next_mark += 0.1
 
     def finish(self) -> None:
+        """Draw the bar at its end and close its line."""
         if self.enabled and self.tty and self.done < self.total:
             self.stream.write("\n")
             self.stream.flush()
@@ -493,6 +497,8 @@ def execute(cluster: Cluster, batches: list, keys: list, writer, progress: Progr
 
     ``on_result(n_done_batches, result)`` is called after each result is handed to the writer
     (tests use it to interrupt, or to kill the worker that ran it)."""
+    # Long on purpose: the client's one loop (submit, receive, write, watch the cluster and the
+    # stop flag) reads as one story; its pieces share a dozen counters
     client = cluster.client
     stats = Stats(threads=cluster.nthreads)
     t0 = time.perf_counter()

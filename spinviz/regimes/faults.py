@@ -2,9 +2,9 @@
 atlas's own, and their text names library parameters, never command-line flags).
 
 * ``OptionError`` -- a value of ``atlas()``'s ``scheduler=`` that cannot be used (no
-  scheduler there, no worker, another spinviz version), with the value; ``cli_message()``
-  says the same with the command line's option.  (Values wrong in themselves -- ``workers=``
-  beyond the cores -- are the schema's ``SpecError``, ``spinviz.inputs.atlas``.)
+  scheduler there, no worker, another spinviz version), with the value: a ``SpecError``
+  about that argument, which the command line names by its option.  (Values wrong in
+  themselves -- ``workers=`` beyond the cores -- are the schema's, ``spinviz.inputs.atlas``.)
 * ``StoreDamaged`` -- a store whose metadata do not match their checksums (or carry none):
   runs can be recomputed, a damaged catalogue cannot.
 * ``AtlasIncomplete`` -- the atlas ended with runs not computed because the cluster failed
@@ -18,22 +18,23 @@ here: it is a result, recorded in the store with its reason.
 
 from __future__ import annotations
 
-from ..errors import SpinvizError, UsageError, printable
+from ..errors import SpecError, SpinvizError, UsageError, printable
 
 EXIT_CLUSTER_LOST = 75         # sysexits.h EX_TEMPFAIL: the cluster failed, the same command again resumes
 EXIT_TASKS_FAILED = 1          # tasks failed as a whole: rerunning retries them, but they may fail again
 
 
-class OptionError(UsageError):
-    """``name=value`` refused; ``reason`` says why."""
+class OptionError(SpecError):
+    """``name=value`` refused; ``reason`` says why.  A ``SpecError`` about the argument
+    ``name``, so the command line names it by its option like any other."""
 
     def __init__(self, name: str, value, reason: str):
-        self.name, self.value, self.reason = name, value, reason
-        super().__init__(f"{name}={printable(repr(value), 100)}: {reason}")
+        super().__init__(name, f"{printable(value, 100)}: {reason}")
+        self.value = value
+        self.args = (f"{name}={printable(repr(value), 100)}: {reason}",)
 
-    def cli_message(self) -> str:
-        """The same, naming the command line's option (``--workers 1000: ...``)."""
-        return f"--{self.name.replace('_', '-')} {printable(self.value, 100)}: {self.reason}"
+    def __str__(self) -> str:
+        return self.args[0]
 
 
 class StoreDamaged(UsageError):
@@ -54,8 +55,10 @@ class AtlasIncomplete(SpinvizError):
 
     @property
     def exit_status(self) -> int:
+        """75 when the cluster was lost (the same command resumes), else 1."""
         return EXIT_CLUSTER_LOST if self.cluster_lost else EXIT_TASKS_FAILED
 
     def cli_message(self) -> str:
+        """The same, in the command line's words (what to run to resume)."""
         return (f"atlas incomplete: {self.cause}: {self.missing} of {self.total} runs not computed; "
                 f"{printable(self.path, 200)} holds the {self.finished} finished; rerun the same command to resume")

@@ -43,12 +43,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import UsageError
-from ..interrupt import deferred
-from . import classify as C
-from . import formulas as FM
+from ...errors import UsageError
+from ...interrupt import deferred
+from ...physics import asymptotics as FM
+from ..engine import classify as C
+from ..engine import runs as RN
 from . import integrity as IN
-from . import runs as RN
 
 DIMS = ("model", "delta", "chi", "member")
 PER_RUN = {            # name -> (dtype, description)
@@ -108,10 +108,11 @@ def _flags(names) -> dict:
 
 def template(spec, chunks: tuple):
     """The empty Dataset (dask-backed, so writing it writes only metadata)."""
+    # Long on purpose: every variable, coordinate and attribute of the store declared in one place
     import dask.array as da
     import xarray as xr
 
-    from .. import __version__
+    from ... import __version__
 
     shape = (len(spec.models), len(spec.deltas), len(spec.chis), spec.members)
     label_flags = _flags({C.CODE[k]: k for k in C.LABELS})
@@ -161,7 +162,7 @@ def template(spec, chunks: tuple):
     attrs = {
         "title": spec.title or os.path.basename(spec.path),
         "spec": spec.canonical_json(),
-        "spec_sha256": spec.identity(),
+        "spec_sha256": identity(spec),
         "seed": -1 if spec.seed is None else int(spec.seed),
         "spinviz_version": __version__,
         "classifier_version": C.VERSION,
@@ -170,6 +171,14 @@ def template(spec, chunks: tuple):
                        "d = (sin chi, 0, cos chi)",
     }
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def identity(spec) -> str:
+    """sha256 of the spec's canonical JSON with the classifier's version: equal identities,
+    equal numbers (the title and description do not enter)."""
+    import hashlib
+
+    return hashlib.sha256(f"classifier {C.VERSION}\n{spec.canonical_json()}".encode()).hexdigest()
 
 
 def create(spec, path: str, chunks: tuple | None = None) -> None:
@@ -200,10 +209,10 @@ def check_identity(spec, path: str) -> None:
         raise UsageError(f"{path}: exists and is not an atlas store ({type(e).__name__}); choose another store path") from None
     if "spec_sha256" not in attrs:
         raise UsageError(f"{path}: exists and is not an atlas store (no spec_sha256); choose another store path")
-    if attrs["spec_sha256"] != spec.identity():
+    if attrs["spec_sha256"] != identity(spec):
         what = "the same spec from another classifier version" if _same_spec(attrs, spec) else "another spec"
         raise UsageError(f"{path}: holds an atlas of {what} (sha256 {attrs['spec_sha256'][:12]}, this spec "
-                         f"{spec.identity()[:12]}); refusing to mix them: choose another store path or delete it")
+                         f"{identity(spec)[:12]}); refusing to mix them: choose another store path or delete it")
 
 
 def _same_spec(attrs: dict, spec) -> bool:
@@ -242,6 +251,7 @@ def regime_codes(path: str) -> np.ndarray:
 
 
 def chunks_of(path: str) -> tuple:
+    """The storage chunk shape of the store's per-run variables (model, delta, chi, member)."""
     import zarr
 
     return tuple(zarr.open_group(path, mode="r", zarr_format=2)["regime"].chunks)
@@ -283,6 +293,7 @@ class Writer:
         self.chunk_writes = 0
 
     def add(self, chunk_key, result: dict) -> None:
+        """Take one batch's result; write its chunk once every batch of the chunk has arrived."""
         p = self.pending.setdefault(chunk_key, _Pending([], time.monotonic(), self.expected[chunk_key]))
         p.parts.append(result)
         if len(p.parts) >= p.expected:
@@ -291,11 +302,13 @@ class Writer:
             self.flush(older_than=self.flush_s)
 
     def flush(self, older_than: float = 0.0) -> None:
+        """Write the chunks whose results have waited at least ``older_than`` seconds (0: all of them)."""
         now = time.monotonic()
         for key in [k for k, p in self.pending.items() if now - p.since >= older_than]:
             self._write(key)
 
     def close(self) -> None:
+        """Write every pending chunk; the store is then complete for what arrived."""
         self.flush(0.0)
 
     def _write(self, key) -> None:
@@ -327,7 +340,6 @@ class Writer:
         self.written_runs += int(new.sum())
         self.chunk_writes += 1
         self.write_s += time.perf_counter() - t0
-
 
     def _write_series(self, region, lo, parts, whole: bool) -> None:
         """The series of the chunk's first members (their own array: (model, delta, chi,

@@ -33,7 +33,7 @@ import json
 import os
 from dataclasses import dataclass, field
 
-from ..atomic import write_text
+from ...atomic import write_text
 
 DIR = ".checksums"
 SKELETON = "skeleton.json"
@@ -66,6 +66,7 @@ def chunk_files(variables, key) -> dict:
 
 
 def record_path(path: str, key) -> str:
+    """Where the checksum record of chunk ``key`` lives."""
     return os.path.join(path, DIR, CHUNKS, key_name(key) + ".json")
 
 
@@ -161,6 +162,7 @@ class Report:
 
     @property
     def skeleton_ok(self) -> bool:
+        """True when the skeleton has checksums and all of them match."""
         return self.skeleton is not None and not self.skeleton
 
     @property
@@ -170,6 +172,7 @@ class Report:
 
     @property
     def clean(self) -> bool:
+        """True when the skeleton and every chunk match their records (leftover temporary files aside)."""
         return self.skeleton_ok and not self.damaged and not self.unrecorded
 
     def problems(self) -> list:
@@ -239,6 +242,7 @@ def layout(path: str) -> tuple:
 
 
 def verify_skeleton(path: str) -> list | None:
+    """The skeleton's files that do not match their checksums ([] when all do; None without a record)."""
     try:
         with open(os.path.join(path, DIR, SKELETON)) as fh:
             recorded = json.load(fh)["sha256"]

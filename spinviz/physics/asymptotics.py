@@ -31,8 +31,8 @@ import math
 
 import numpy as np
 
-from ..physics import closed_forms as CF
-from ..physics import presets as P
+from . import closed_forms as CF
+from . import presets as P
 
 NAN = float("nan")
 

@@ -23,10 +23,10 @@ import time
 
 import numpy as np
 
-from .. import units as U
-from . import classify as C
-from .runs import Settings, integrate_many
-from .spec import directions
+from ... import units as U
+from ...inputs.atlas_spec import Settings, directions
+from ...regimes.engine import classify as C
+from ...regimes.engine.runs import integrate_many
 
 I1_CGS = 2e-26
 TAU0_S = 1e-20
@@ -46,7 +46,7 @@ POINTS = [
 
 def cgs_body(delta: float, chi: float):
     """A symmetric CGS body with this (delta, chi) and tau0 = ``TAU0_S``: d = sqrt(3 I1 c^3 tau0 / 2) (3.8)."""
-    from ..physics.bodies import Body
+    from ...physics.bodies import Body
 
     d = math.sqrt(1.5 * I1_CGS * U.C_LIGHT**3 * TAU0_S)
     return Body("cross-check body", "cgs", (I1_CGS, I1_CGS, (1.0 - delta) * I1_CGS),
@@ -55,7 +55,7 @@ def cgs_body(delta: float, chi: float):
 
 def physical_run(model: str, delta: float, chi: float, omega0, tau, rtol: float):
     """omega(tau) (N, 3), dimensionless, from ``simulate`` on the CGS body (4.1 undone, then redone)."""
-    from ..driver import simulate
+    from ...driver import simulate
 
     body = cgs_body(delta, chi)
     assert abs(body.tau0 / TAU0_S - 1.0) < 1e-12
@@ -92,6 +92,7 @@ def compare(points=POINTS, members: int = 4, omega: float = 0.1, tau_end: float 
 
 
 def format_table(rows: list[dict]) -> str:
+    """The comparison's rows as a table for people."""
     lines = ["| point | model | delta | chi | member | label (atlas) | label (simulate, CGS) | |omega| sqrt(tau) at the end | "
              "end state, relative difference |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:

@@ -17,10 +17,10 @@ from collections import Counter
 
 import numpy as np
 
-from . import classify as C
-from . import formulas as FM
-from .api import atlas
-from .spec import parse_spec
+from ...inputs.atlas_spec import parse_spec
+from ...physics import asymptotics as FM
+from ...regimes.api import atlas
+from ...regimes.engine import classify as C
 
 # (name, model, delta, chi_deg, |omega0|)
 POINTS = [
@@ -40,6 +40,7 @@ POINTS = [
 
 
 def run(members: int = 32, workers: int | None = None, tau_end: float = 1e10, points=POINTS, progress: bool = False):
+    """A single-cell atlas at each validation point; one row per point with its labels and formulas."""
     rows = []
     tmp = tempfile.mkdtemp(prefix="spinviz-atlas-validate-")
     try:
@@ -49,7 +50,7 @@ def run(members: int = 32, workers: int | None = None, tau_end: float = 1e10, po
                               f"<validation point {name}>")
             out = os.path.join(tmp, f"p{i}.zarr")
             res = atlas(spec, out, workers=workers, progress=progress)
-            from .store import open_atlas
+            from ...regimes.store.dataset import open_atlas
 
             ds = open_atlas(out).isel(model=0, delta=0, chi=0)
             labels = [str(x) for x in ds["label"].values]
@@ -79,6 +80,7 @@ def run(members: int = 32, workers: int | None = None, tau_end: float = 1e10, po
 
 
 def format_table(rows) -> str:
+    """The validation rows as a Markdown table."""
     lines = ["| point | model | δ | χ | labels | median measured | deviation from the formula, median [min, max] |",
              "|---|---|---|---|---|---|---|"]
     for r in rows:

@@ -1,4 +1,5 @@
-"""Scenes: the TOML schema, its validation, and units at the boundary.
+"""A scene: its file read through the schema into a ``Scene``, every rule joining its tables checked
+here, once (units, the spin scale, the horizon, ``[render]``, ``[observe]``).
 
 A scene file describes one run (or two models side by side).  The smallest scene is
 dimensionless::
@@ -18,11 +19,11 @@ Physical bodies are given in CGS with named units (``preset = "dast_cube"``,
 ``shape = "rod"`` with ``length_nm`` ...), and then omega is in rad/s and t_end in s; see
 the README for every key.  Angles are radians unless the key ends in ``_deg``.
 
-Every table is declared once in the schema (``spinviz.inputs.scene``, ``[render]`` in
-``spinviz.inputs.render``) and the simulation settings are checked by the same
-``SimulationRequest`` that checks ``spinviz.simulate``'s arguments, so a file, the command
-line and Python can never disagree.  Every problem is reported as ``SceneError(path, key,
-reason)``: one line naming the file, the key and the reason.
+Every table is declared once (``inputs.scene``, ``[render]`` in ``inputs.render``) and the
+simulation settings are checked by the same ``SimulationRequest`` that checks
+``spinviz.simulate``'s arguments, so a file, the command line and Python can never
+disagree.  Every problem is reported as ``SceneError(path, key, reason)``: one line naming
+the file, the key and the reason.
 
 ``Scene.request(model)`` is the typed, frozen request for one model's run
 (``driver.simulate_request``); no keyword dictionary travels from a scene to the driver.
@@ -36,12 +37,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .errors import SceneError, SpecError, brief, printable
-from .inputs import scene as IS
-from .inputs.render import MAX_TITLE, RenderSpec
-from .inputs.simulation import SimulationRequest
-from .inputs.toml import document, read_document, read_toml
-from .physics import bodies as B
+from ..errors import SceneError, SpecError, SpecTypeError, brief, printable
+from ..physics import bodies as B
+from . import scene as IS
+from .render import MAX_TITLE, RenderSpec
+from .simulation import SimulationRequest
+from .toml import document, read_document, read_toml
 
 __all__ = ["Scene", "ObserveSpec", "SceneError", "load_scene", "parse_scene", "read_toml"]
 
@@ -189,7 +190,7 @@ def _horizon(path, name: str, t, key: str, body: B.Body, omega0, keys: dict) -> 
     if key == "t_end":
         return value
     try:
-        from .integrators.scaling import check_scale
+        from ..integrators.scaling import check_scale  # the integrators' package: loaded only for T and Theta
 
         check_scale(body, omega0)                   # T and Theta need a usable tau0 and spin
     except SpecError as e:
@@ -247,8 +248,6 @@ def _observe(ot, path: str, body: B.Body, omega0, requests: list) -> ObserveSpec
 def load_scene(path) -> Scene:
     """Read and validate a scene file; SceneError (one line: file, key, reason) on any problem."""
     if not isinstance(path, (str, bytes, os.PathLike)):
-        from .errors import SpecTypeError
-
         raise SpecTypeError("path", f"must be the path of a scene file (str or os.PathLike), got {type(path).__name__}")
     path = os.fsdecode(path)
     return _scene(*read_document(path, IS.SceneFile, _TABLES, ("render",)), path)

@@ -1,4 +1,5 @@
-"""The atlas spec: a TOML file, validated like a scene (one line naming file, key, reason).
+"""The atlas spec: a TOML file read through the schema into an ``AtlasSpec`` (errors: one line
+naming file, key, reason), and whether that atlas can finish here.
 
 A spec says which model(s), which (delta, chi) cells, which initial conditions at each cell,
 how far and how finely to integrate, and how to classify::
@@ -40,15 +41,15 @@ method on the scaled omega sqrt(1 + tau/T) / |omega0|, so the tolerance holds re
 braking law to the end of the run (docs/atlas.md: labels and amplitudes against rtol).
 20 samples a decade and a 2-decade window: 41 samples, the labels are the same at 10-50.
 
-Every table is declared in the schema, ``spinviz.inputs.atlas`` (how to add a key is said
-there); this module builds the ``AtlasSpec`` from the validated tables and says, before any
-work, whether the atlas can finish on this machine (``check_feasible``: memory, run count,
-time).
+Every table is declared in ``spinviz.inputs.atlas`` (how to add a key is said there); this
+module builds the ``AtlasSpec`` from the validated tables -- every rule joining keys (the
+axes, the inertia limit, the horizon, the run cap) is checked here, once, and the spec is
+trusted after -- and says, before any work, whether the atlas can finish on this machine
+(``check_feasible``: memory, run count, time).
 """
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import os
@@ -56,25 +57,47 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SceneError, SpecError, SpecTypeError
-from ..inputs import atlas as IA
-from ..inputs.base import fields_of
-from ..inputs.render import usable_cores
-from ..inputs.toml import document, read_toml, table
+from ..errors import SceneError, SpecTypeError
 from ..physics.bodies import MIN_INERTIA_RATIO
-from .runs import Settings
+from . import atlas as IA
+from .base import fields_of
+from .render import usable_cores
+from .toml import document, read_toml, table
 
-MODELS = IA.MODELS
 FORMAT = 2                       # the store's version (identity): 2 = Taylor's method (heyoka), no atol
-MAX_RUNS = IA.MAX_RUNS
-MAX_CELLS = IA.MAX_CELLS         # per axis
-MAX_MEMBERS = IA.MAX_MEMBERS
-OMEGA_MAX = IA.OMEGA_RANGE[1]    # |omega(0)| beyond which the start is hopelessly stiff (tau0 Omega >> 1)
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How every run of an atlas is integrated and classified (part of the spec's identity).
+
+    tau_end : horizon, tau = t/tau0.  tau_start : first sample after 0.  per_decade : samples
+    a decade.  rtol : Taylor tolerance on the scaled omega sqrt(1 + tau/T) / |omega0|.
+    max_steps : step budget of one run (of its SIMD batch).  window : decades the classifier analyses.
+    """
+
+    tau_end: float = 1e10
+    tau_start: float = 1e-2
+    per_decade: int = 20
+    rtol: float = 1e-8
+    max_steps: int = 20_000_000
+    window: float = 2.0
+
+    def times(self) -> np.ndarray:
+        """Output times [0, tau_start, ..., tau_end], ``per_decade`` log-spaced a decade."""
+        return log_times(self.tau_start, self.tau_end, self.per_decade)
+
+
+def log_times(tau_start: float, tau_end: float, per_decade: int) -> np.ndarray:
+    """[0, tau_start, ..., tau_end] with ``per_decade`` samples a decade (shape (N,))."""
+    n = int(round(per_decade * math.log10(tau_end / tau_start))) + 1
+    return np.concatenate([[0.0], np.logspace(math.log10(tau_start), math.log10(tau_end), n)])
 
 
 @dataclass(frozen=True)
 class AtlasSpec:
-    """A validated atlas spec (also when made by hand: every field is checked).
+    """A validated atlas spec, made by ``parse_spec`` or ``load_spec`` (which check every rule
+    once) and trusted after: ``dataclasses.replace`` of one is the caller's responsibility.
 
     deltas : shape (n_delta,), (3.6), each in (-1, 1).  chis : shape (n_chi,), rad, in [0, pi/2].
     omega0 : shape (members, 3), body-frame starts (dimensionless), the same at every cell.
@@ -100,35 +123,20 @@ class AtlasSpec:
     series: int = 1
 
     def __post_init__(self):
-        models = tuple(self.models) if isinstance(self.models, list | tuple) else None
-        if not models or any(m not in MODELS for m in models) or len(set(models)) != len(models):
-            raise SpecError("models", f"must be one or two of {', '.join(MODELS)}, each once, got {self.models!r}")
-        object.__setattr__(self, "models", models)
-        for name, lo, hi in (("deltas", -1.0, 1.0 - MIN_INERTIA_RATIO), ("chis", 0.0, 0.5 * math.pi)):
-            a = _array(name, getattr(self, name), 1)
-            if not (a.size and np.all((a >= lo) & (a <= hi)) and np.all(np.diff(a) > 0)):
-                raise SpecError(name, f"must be increasing values in [{lo:g}, {hi:g}] (at most {MAX_CELLS}), got {a!r}")
-            if a.size > MAX_CELLS:
-                raise SpecError(name, f"at most {MAX_CELLS} values, got {a.size}")
+        for name in ("deltas", "chis", "omega0"):            # read-only views: a spec is shared, never changed
+            a = np.array(getattr(self, name), dtype=float)
+            a.flags.writeable = False
             object.__setattr__(self, name, a)
-        w = _array("omega0", self.omega0, 2)
-        norms = np.linalg.norm(w, axis=1) if w.ndim == 2 and w.shape[1] == 3 else None
-        lo, hi = IA.OMEGA_RANGE
-        if norms is None or not 1 <= len(w) <= MAX_MEMBERS or not np.all((norms >= lo) & (norms <= hi)):
-            raise SpecError("omega0", f"must be 1..{MAX_MEMBERS} starts [w1, w2, w3] with |omega0| in [{lo:g}, {hi:g}], "
-                                      f"got shape {w.shape}")
-        object.__setattr__(self, "omega0", w)
-        if not isinstance(self.settings, Settings):
-            raise SpecTypeError("settings", f"must be a regimes.runs.Settings, got {type(self.settings).__name__}")
-        if self.refine_levels and self.axes is None:
-            raise SpecError("refine", "levels > 0 needs both grid axes as {min, max, cells} (a quadtree of equal cells)")
+        object.__setattr__(self, "models", tuple(self.models))
 
     @property
     def members(self) -> int:
+        """Starts per cell."""
         return int(self.omega0.shape[0])
 
     @property
     def runs(self) -> int:
+        """Runs of the whole grid: models x deltas x chis x members."""
         return len(self.models) * len(self.deltas) * len(self.chis) * self.members
 
     def canonical(self) -> dict:
@@ -148,25 +156,8 @@ class AtlasSpec:
         }
 
     def canonical_json(self) -> str:
+        """``canonical()`` as compact JSON with sorted keys (what the store records)."""
         return json.dumps(self.canonical(), sort_keys=True, separators=(",", ":"))
-
-    def identity(self) -> str:
-        """sha256 of the canonical JSON (with the classifier's version): equal identities,
-        equal numbers."""
-        from .classify import VERSION
-
-        return hashlib.sha256(f"classifier {VERSION}\n{self.canonical_json()}".encode()).hexdigest()
-
-
-def _array(name: str, v, ndim: int) -> np.ndarray:
-    try:
-        a = np.array(v, dtype=float)
-    except (TypeError, ValueError):
-        raise SpecTypeError(name, f"must be an array of numbers, got {type(v).__name__}") from None
-    if a.ndim != ndim or not np.all(np.isfinite(a)):
-        raise SpecError(name, f"must be a finite {ndim}-D array, got shape {a.shape}")
-    a.flags.writeable = False
-    return a
 
 
 def _kept(cls) -> dict:
@@ -243,8 +234,8 @@ def parse_spec(data: dict, path: str = "<atlas spec>") -> AtlasSpec:
     _check_horizon(path, settings, omega0)
     models = top.model_names
     n_runs = len(models) * len(deltas) * len(chis) * len(omega0)
-    if n_runs > MAX_RUNS:
-        raise SceneError(path, "[grid]", f"{n_runs} runs exceed the limit of {MAX_RUNS}")
+    if n_runs > IA.MAX_RUNS:
+        raise SceneError(path, "[grid]", f"{n_runs} runs exceed the limit of {IA.MAX_RUNS}")
     return AtlasSpec(path=path, title=top.title, description=top.description, models=models, deltas=deltas, chis=chis,
                      omega0=omega0, settings=settings, seed=seed, omega_magnitude=mag, axes=axes,
                      refine_levels=refine.levels, refine_agree=refine.agree,

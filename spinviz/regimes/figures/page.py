@@ -20,8 +20,9 @@ import warnings
 
 import numpy as np
 
-from . import formulas as FM
-from .plot import COLORS, LINE_STYLE, WORDS, compose_levels
+from ...physics import asymptotics as FM
+from .cells import compose_levels
+from .style import COLORS, LINE_STYLE, WORDS
 
 W, H = 560, 470                # one panel's plot area, px
 PAD_L, PAD_B, PAD_T = 52, 40, 12

@@ -50,7 +50,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import formulas as F
+from ...physics import asymptotics as F
 
 VERSION = 2                # bump when a rule changes: stores made by another version are not resumed
 # 2: slow hand-overs labelled "approaching" (candidate: the class), no longer "other"

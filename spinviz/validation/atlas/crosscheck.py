@@ -28,10 +28,9 @@ import time
 
 import numpy as np
 
-from . import classify as C
-from . import formulas as FM
-from .runs import Settings
-from .spec import directions
+from ...inputs.atlas_spec import Settings, directions
+from ...physics import asymptotics as FM
+from ...regimes.engine import classify as C
 
 
 def rhs_eq4_2_4(delta: float, chi: float):
@@ -96,6 +95,7 @@ def measures(delta, chi, tau, w) -> dict:
 
 
 def run(members: int = 3, settings: Settings | None = None, progress=None) -> list[dict]:
+    """Integrate every point's starts with SciPy and classify them; one row per start."""
     st = settings or Settings()
     starts = directions(members, 1) * 0.1
     rows = []
@@ -113,6 +113,7 @@ def run(members: int = 3, settings: Settings | None = None, progress=None) -> li
 
 
 def paper_values(d: float, c: float) -> str:
+    """What the paper's formulas give at (d, c), as text for the table."""
     t1, t2, t3, t4, t5 = (FM.type1_eq4_9(d, c), FM.type2_eq4_14(d, c), FM.type3_eq4_16(d, c), FM.type4_eq4_18(d, c),
                           FM.type5_eq4_42(d, c))
     return (f"(4.9) C^2={t1['C2']:.4g} B={t1['B']:.4g} | (4.14) alpha={t2['alpha']:.4g} in (4.15): {t2['in_domain']} | "
@@ -122,6 +123,7 @@ def paper_values(d: float, c: float) -> str:
 
 
 def format_rows(rows: list[dict]) -> str:
+    """The cross-check rows as a table for people."""
     out = []
     last = None
     for r in rows:

@@ -21,7 +21,7 @@ import json
 import sys
 from dataclasses import dataclass
 
-from ..errors import UsageError, printable
+from ...errors import UsageError, printable
 
 
 @dataclass(frozen=True)
@@ -72,7 +72,7 @@ def _compute(kind: str, n: int, given: dict) -> tuple:
                                                 f"({r['seconds']:.1f} s)"))
         return rows, X.format_rows(rows), 0
     if kind == "physical":
-        from . import physical_check as P
+        from . import physical as P
 
         rows = P.compare(members=n, tau_end=given["tau_end"] or 1e10, progress=_say)
         return rows, P.format_table(rows), 0 if all(r["label_atlas"] == r["label_physical"] for r in rows) else 1
@@ -93,7 +93,7 @@ def _compute(kind: str, n: int, given: dict) -> tuple:
     if given["out"]:
         import os
 
-        from .integrity import verify_skeleton
+        from ...regimes.store.integrity import verify_skeleton
 
         if not os.path.exists(os.path.join(given["out"], ".zgroup")) or verify_skeleton(given["out"]) is None:
             raise UsageError(f"--out {printable(given['out'], 200)}: not an atlas store to keep the rows in")

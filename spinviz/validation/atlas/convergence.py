@@ -36,9 +36,9 @@ from collections import Counter
 
 import numpy as np
 
-from . import classify as C
-from .runs import Settings, classify_run, integrate_many
-from .spec import directions
+from ...inputs.atlas_spec import Settings, directions
+from ...regimes.engine import classify as C
+from ...regimes.engine.runs import classify_run, integrate_many
 
 HORIZONS = (1e10, 1e12, 1e14)
 COEXIST = 0.10            # a type held by at least this share of the starts at every horizon
@@ -97,6 +97,7 @@ def _shown(r) -> str:
 
 
 def summarize(name, model, d, cdeg, w, per_h: dict, many: list, seconds: float) -> dict:
+    """One point's row: label shares per horizon, what kept its label, coexistence, slow hand-overs, 'other'."""
     hs = sorted(per_h)
     labels = {h: [_shown(r) for r in per_h[h]] for h in hs}
     types = {h: [_type(r) for r in per_h[h]] for h in hs}
@@ -119,6 +120,7 @@ def summarize(name, model, d, cdeg, w, per_h: dict, many: list, seconds: float) 
 
 
 def format_table(rows: list[dict]) -> str:
+    """The convergence rows as a Markdown table."""
     hs = list(rows[0]["shares"])
     lines = [f"| point | model | delta | chi | labels at tau = {' / '.join(hs)} | keep label {hs[0]} -> {hs[-1]} | "
              f"changing | coexisting | main type share, {rows[0]['members']} / {4 * rows[0]['members']} members | "
@@ -141,7 +143,7 @@ def record(store: str, rows: list[dict]) -> None:
 
     import zarr
 
-    from . import integrity as IN
+    from ...regimes.store import integrity as IN
 
     def write():
         g = zarr.open_group(store, mode="r+", zarr_format=2)
@@ -160,8 +162,8 @@ def tolerance(members: int = 8, rtols=TOLERANCES, cells: int = 12, seed: int = 1
               tau_end: float = 1e10, progress=None) -> list[dict]:
     """Labels and end states against rtol on a ``cells`` x ``cells`` grid (both models),
     against the tightest rtol of ``rtols``; see the module docstring."""
-    from .refine import centres
-    from .runs import warm
+    from ...regimes.engine.refine import centres
+    from ...regimes.engine.runs import warm
 
     say = progress or (lambda m: None)
     grid = [(d, math.radians(c)) for d in centres(-1.0, 1.0, cells, 0) for c in centres(0.0, 90.0, cells, 0)]

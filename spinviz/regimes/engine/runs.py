@@ -27,7 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..integrators import status as ST
+from ...inputs.atlas_spec import Settings
+from ...integrators import status as ST
 from . import classify as C
 
 STOPPED_RESIDUAL = ST.STOPPED_RESIDUAL   # stopped early: residual rotation about d reached where it is the exact end state
@@ -43,33 +44,6 @@ SINGULAR_MARGIN = 0.5      # truncated: refuse a start where 1 + (g x omega).J^-
 RESIDUAL_ETA = 1e-9        # rad: |d x omega|/(|d||omega|) at which a run in an exact-residual cell stops
 
 
-@dataclass(frozen=True)
-class Settings:
-    """How every run of an atlas is integrated and classified (part of the spec's identity).
-
-    tau_end : horizon, tau = t/tau0.  tau_start : first sample after 0.  per_decade : samples
-    a decade.  rtol : Taylor tolerance on the scaled omega sqrt(1 + tau/T) / |omega0|.
-    max_steps : step budget of one run (of its SIMD batch).  window : decades the classifier analyses.
-    """
-
-    tau_end: float = 1e10
-    tau_start: float = 1e-2
-    per_decade: int = 20
-    rtol: float = 1e-8
-    max_steps: int = 20_000_000
-    window: float = 2.0
-
-    def times(self) -> np.ndarray:
-        """Output times [0, tau_start, ..., tau_end], ``per_decade`` log-spaced a decade."""
-        return log_times(self.tau_start, self.tau_end, self.per_decade)
-
-
-def log_times(tau_start: float, tau_end: float, per_decade: int) -> np.ndarray:
-    """[0, tau_start, ..., tau_end] with ``per_decade`` samples a decade (shape (N,))."""
-    n = int(round(per_decade * math.log10(tau_end / tau_start))) + 1
-    return np.concatenate([[0.0], np.logspace(math.log10(tau_start), math.log10(tau_end), n)])
-
-
 def residual_is_exact(model: str, delta: float, chi: float) -> bool:
     """Where the paper proves the reduced model ends in a residual rotation about d: chi = 0
     ((5.1), (5.2)), chi = pi/2 ((5.5), (5.6)) and the spherical top delta = 0 ((5.2), (6.7))."""
@@ -80,7 +54,7 @@ def integrate_many(model: str, cells: list, omega0: list, settings: Settings, st
     """Runs of ``model`` from omega0[i] at cells[i] = (delta, chi), through ``driver.solve_many``:
     a list of ``driver.Run`` (tau, omega (N, 3), status, reached, t_stop, reason, ...); after a
     residual stop the samples are the rotation reached, held."""
-    from ..driver import solve_many
+    from ...driver import solve_many
 
     t = settings.times()
     inertia = [(1.0, 1.0, 1.0 - float(d)) for d, _ in cells]
@@ -186,6 +160,7 @@ class Batch:
 
     @property
     def runs(self) -> int:
+        """Runs in the batch: cells x members."""
         return len(self.deltas) * len(self.chis) * len(self.omega0)
 
     @property
@@ -273,7 +248,7 @@ def max_rss_mb() -> float:
 def warm(settings: Settings | None = None) -> float:
     """Load (or compile, once, into heyoka's on-disk cache) the batch integrator of both models
     at the atlas's tolerance; returns the seconds it took."""
-    from ..integrators.taylor import template, tolerance, width
+    from ...integrators.taylor import template, tolerance, width
 
     t0 = time.perf_counter()
     tol, _ = tolerance((settings or Settings()).rtol, (settings or Settings()).rtol)

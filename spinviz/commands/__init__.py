@@ -1,0 +1,168 @@
+"""The ``spinviz`` command line: a thin ``main(argv) -> int`` that parses, dispatches to one
+module per subcommand and maps errors to exit statuses (0 success, 1 a check or run failed,
+2 bad input, 128 + the signal when stopped).  No physics and no file formats here.
+
+Each subcommand is a module of this package with ``add_parser(subparsers)`` (its options,
+declared once) and ``run(args) -> int``; ``COMMANDS`` lists them in the order ``--help``
+shows.  Options are parsed here and checked by the schema (``spinviz.inputs``), so the
+command line and Python never disagree; a schema error naming an argument is shown with the
+option that set it, its name read from the parser (``--workers: ...``), or with the scene's
+key when the value came from the file (``shared.named``: the one translation).  Standard
+output and error never crash a command: a closed or full stdout gives one line on stderr and
+exit status 1 (the output file is kept), a closed or full stderr is skipped, and every echoed
+name is escaped (``errors.printable``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import errno
+import importlib
+import os
+import sys
+import warnings
+
+from .. import interrupt
+from ..errors import RenderError, SceneError, SimulationError, SpecError, SpinvizError, UsageError
+from .shared import EXIT_FAIL, EXIT_USAGE, Parser, Stream, WriteFailed, named, options_of, say
+
+COMMANDS = ("check", "info", "simulate", "render", "compare", "observe", "listen", "bench", "stress", "report",
+            "methods", "atlas")
+
+
+def command(name: str):
+    """The module of subcommand ``name``."""
+    return importlib.import_module(f".{name}", __name__)
+
+
+def parser() -> argparse.ArgumentParser:
+    """The ``spinviz`` command line: one subcommand per module of this package."""
+    p = Parser(prog="spinviz", description="Rotation of a dipolar nanocrystal braked by radiation reaction "
+                                           "(reduced (2.2)+(2.3) vs truncated (2.5) Euler equations).")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
+    sub.required = True
+    for name in COMMANDS:
+        command(name).add_parser(sub)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run one ``spinviz`` command in-process and return its exit status.
+
+    argv : the arguments after ``spinviz`` (default ``sys.argv[1:]``), e.g. ``["check", "--quick"]``.
+    Returns 0 on success, 1 when a check or run failed or an output could not be written, 2 for
+    bad input (one line on stderr), 128 + the signal number when stopped by SIGINT, SIGTERM or
+    SIGHUP.  Standard output and error are guarded for the call (a closed or full stream never
+    raises into the command); ``entry`` is the console script around it.
+    """
+    top = parser()
+    args = top.parse_args(argv)
+    args.options = options_of(_subparser(top, args.command))
+    out, err = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = Stream(out, pipe_ends=True), Stream(err, pipe_ends=False)
+    try:
+        with interrupt.handlers(), warnings.catch_warnings():
+            # NumPy's overflow warnings are not for the user: every result is checked for finite
+            # values and a run that leaves them fails with one line (driver._check_finite)
+            warnings.simplefilter("ignore", RuntimeWarning)
+            code = _run(args)
+        sys.stdout.flush()
+        if sys.stdout.error is not None:
+            # the report is lost; whatever the command wrote to files stays (it was written first)
+            e = sys.stdout.error
+            say("", f"cannot write to standard output: {getattr(e, 'strerror', None) or e}")
+            code = code or EXIT_FAIL
+        return code
+    finally:
+        sys.stdout, sys.stderr = out, err
+
+
+def _subparser(top: argparse.ArgumentParser, name: str) -> argparse.ArgumentParser:
+    sub = next(a for a in top._actions if isinstance(a, argparse._SubParsersAction))
+    return sub.choices[name]
+
+
+def _run(args) -> int:
+    mod = command(args.command)
+    try:
+        try:
+            return mod.run(args)
+        except SpecError as e:                           # the schema's, about an argument: said with its option
+            raise named(e, args, getattr(mod, "SCENE_TABLE", None)) from None
+    except WriteFailed as e:
+        say("error: ", e)
+        return EXIT_FAIL
+    except (UsageError, SceneError) as e:
+        say("error: ", e)
+        return EXIT_USAGE
+    except (SimulationError, RenderError) as e:
+        say("run failed: ", e)
+        return EXIT_FAIL
+    except interrupt.Interrupted as e:
+        say("interrupted by ", f"{e}; nothing was written")
+        return e.exit_status
+    except KeyboardInterrupt:
+        say("interrupted", "; nothing was written")
+        return 130
+    except BrokenPipeError:
+        raise                                           # the reader left: entry() ends quietly
+    except (SpinvizError, ValueError, OSError, ImportError, ArithmeticError, RuntimeError, RecursionError,
+            MemoryError) as e:
+        # the safety net: whatever input slipped past the specific checks still gets one
+        # line, not a traceback (SPINVIZ_DEBUG=1 shows the traceback)
+        if os.environ.get("SPINVIZ_DEBUG"):
+            raise
+        what = getattr(e, "filename", None) if isinstance(e, OSError) else None
+        if isinstance(e, OSError) and what is None and getattr(args, "out", None):
+            what = args.out                                 # e.g. a full disk while writing the output
+        if isinstance(e, OSError) and e.strerror:
+            say("error: ", f"{what}: {e.strerror}" if what else e.strerror)
+            return EXIT_FAIL if e.errno in (errno.ENOSPC, errno.EIO, errno.EDQUOT, errno.EFBIG) else EXIT_USAGE
+        say("error: ", str(e) or type(e).__name__)
+        return EXIT_USAGE
+
+
+def _occupy_closed_std_fds() -> None:
+    """A standard descriptor (0, 1, 2) closed by the caller (``>&-``) is opened on /dev/null,
+    as careful Unix tools do: otherwise the next file opened -- the output itself -- would
+    take its number, and anything written to "stdout" (by us or a child process) would land
+    in it.  Python has already set ``sys.stdout`` (or ``stderr``) to None for it, so the
+    command still knows the stream is gone."""
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+        except OSError:
+            nul = os.open(os.devnull, os.O_RDWR)
+            if nul != fd:
+                os.dup2(nul, fd)
+                os.close(nul)
+
+
+def _settle(stream) -> None:
+    """Text a standard stream could not take stays in its buffer and would fail again (with
+    a complaint and exit status 120) at the interpreter's last flush: send it to /dev/null."""
+    if stream is None:
+        return
+    try:
+        stream.flush()
+    except (OSError, ValueError):
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), stream.fileno())
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+
+
+def entry() -> None:
+    """Console-script entry point (``spinviz``, and ``python -m spinviz``)."""
+    _occupy_closed_std_fds()
+    try:
+        code = main()
+        if sys.stdout is not None:
+            sys.stdout.flush()
+    except BrokenPipeError:
+        # the reader went away (spinviz methods | head -1): end quietly, as a Unix tool does
+        code = 128 + 13
+    _settle(sys.stdout)
+    _settle(sys.stderr)
+    sys.exit(code)

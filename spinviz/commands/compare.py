@@ -1,0 +1,59 @@
+"""``spinviz compare SCENE [--out PREFIX] [--json]``: reduced against truncated for a two-model
+scene -- misorientation and dipole angle between the predictions, crossing times, final
+states -- and the plots ``PREFIX_compare.png``, ``PREFIX_hodograph.png``."""
+
+from __future__ import annotations
+
+import json
+
+from ..errors import SpecError, UsageError
+from .shared import EXIT_OK, cannot_write, need_matplotlib, out, p, positive, prefix_of
+
+
+def add_parser(sub) -> None:
+    """Add ``spinviz compare`` (the comparison of a two-model scene) and its options to ``sub``."""
+    c = sub.add_parser("compare", help="reduced vs truncated for a two-model scene: angles, crossing times, final states, "
+                                       "plots")
+    c.add_argument("scene")
+    c.add_argument("--out", help="prefix of the PNG plots (default renders/<scene>): "
+                                 "<prefix>_compare.png, <prefix>_hodograph.png")
+    c.add_argument("--samples", type=positive, default=800, help="evenly spaced plus as many log-spaced output times")
+    c.add_argument("--json", action="store_true", help="print the results as JSON")
+
+
+def run(args) -> int:
+    """Carry out ``spinviz compare`` with the parsed ``args``; return its exit status."""
+    from ..analysis import compare
+    from ..atomic import Outputs
+    from ..driver import simulate_request
+    from ..inputs.scene_spec import load_scene
+
+    sc = load_scene(args.scene)
+    if len(sc.models) != 2:
+        raise UsageError(f"{args.scene}: [simulation].models: compare needs two models, "
+                         f"e.g. models = [\"reduced\", \"truncated\"]")
+    need_matplotlib("compare's plots")
+    if args.samples > compare.MAX_SAMPLES:
+        raise UsageError(f"--samples: at most {compare.MAX_SAMPLES} (each model is stored at 2 x samples instants), "
+                         f"got {args.samples}")
+    prefix = prefix_of(args)
+    paths = [f"{prefix}_compare.png", f"{prefix}_hodograph.png"]
+    group = Outputs(paths, [args.scene])                # checked before the runs, landed together after
+    times = compare.compare_times(sc.t_end, max(2, args.samples))
+    try:
+        trajs = [simulate_request(sc.request(m, t_eval=times)) for m in sc.models]
+    except SpecError as e:                              # the output times are the option's
+        raise SpecError("samples", e.reason) if e.key == "t_eval" else e from None
+    c = compare.compare(trajs)
+    try:
+        with group as tmps:
+            compare.plot(c, tmps[0], sc.title)
+            compare.plot_hodograph(c, tmps[1], sc.title)
+    except OSError as e:
+        raise cannot_write(prefix, e) from None
+    if args.json:
+        print(json.dumps({**c.record(), "plots": list(paths)}, indent=2, default=float))
+    else:
+        out(compare.format_table(c, sc.title))
+        out(f"\nplots: {p(paths[0])}, {p(paths[1])}")
+    return EXIT_OK

@@ -1,0 +1,200 @@
+"""What every subcommand shares: the parser class, the argument types (parsing only: ranges are
+the schema's), the report helpers, and the one translation of a schema error into a usage
+error, with the option named from the parser itself.
+
+Nothing here loads more than argparse and ``spinviz.errors``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import errno
+import os
+import sys
+
+from ..errors import SpecError, SpinvizError, UsageError, printable
+
+EXIT_OK, EXIT_FAIL, EXIT_USAGE = 0, 1, 2
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with its errors in the house style: one escaped line, exit status 2."""
+
+    def error(self, message):
+        """Print the one-line usage error and exit with status 2."""
+        self.exit(EXIT_USAGE, f"spinviz: error: {printable(message)} (see '{printable(self.prog)} --help')\n")
+
+
+def options_of(parser: argparse.ArgumentParser) -> dict:
+    """{argument name (the option's ``dest``): its longest option string} of a parser: what a
+    schema error about an argument is called on the command line.  (argparse lists a parser's
+    actions only in ``_actions``, unchanged since Python 3.2.)"""
+    return {a.dest: max(a.option_strings, key=len) for a in parser._actions if a.option_strings}
+
+
+def named(e: SpecError, args, table: str | None = None) -> UsageError:
+    """A schema error about an argument, in the command line's terms: the option that set the
+    value (``--workers: ...``) when it was given on the command line; else, for a command that
+    reads a scene, the scene's key (``SCENE: [render].fps: ...``) when ``table`` says which
+    table the argument comes from; else the option or the argument's own name."""
+    option = getattr(args, "options", {}).get(e.key)
+    if option and getattr(args, e.key, None) is not None:
+        return UsageError(f"{option}: {e.reason}")
+    scene = getattr(args, "scene", None)
+    if table is not None and scene is not None:
+        return UsageError(f"{scene}: [{table}].{e.key}: {e.reason}")
+    return UsageError(f"{option or e.key}: {e.reason}")
+
+
+# --- argument types: parsing only; ranges are checked by the schema ------------------------
+def typed(cast, what):
+    """An argparse type that parses with ``cast`` and says ``expected WHAT`` otherwise."""
+    def parse(text: str):
+        try:
+            return cast(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}") from None
+    parse.__doc__ = f"Parse {what} (``argparse.ArgumentTypeError`` otherwise)."
+    return parse
+
+
+whole = typed(int, "a whole number")
+real = typed(float, "a number")
+
+
+def positive(text: str) -> int:
+    """A whole number of at least 1."""
+    v = whole(text)
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {v}")
+    return v
+
+
+def names(text: str) -> tuple[str, ...]:
+    """A comma-separated list of names."""
+    out = tuple(x.strip() for x in text.split(",") if x.strip())
+    if not out:
+        raise argparse.ArgumentTypeError(f"expected NAME[,NAME...], got {text!r}")
+    return out
+
+
+def vector(text: str):
+    """Three comma-separated numbers X,Y,Z."""
+    try:
+        v = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected X,Y,Z, got {text!r}") from None
+    if len(v) != 3:
+        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z, got {text!r}")
+    return v
+
+
+def size(text: str):
+    """A frame size WIDTHxHEIGHT in pixels."""
+    try:
+        w, h = (int(x) for x in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT, got {text!r}") from None
+    return (w, h)
+
+
+# --- reports ------------------------------------------------------------------------------
+def say(prefix: str, message) -> None:
+    """One line on stderr, control characters escaped and cut: nothing from a file or a key
+    name can colour, clear or split the terminal."""
+    print(f"spinviz: {prefix}{printable(message)}", file=sys.stderr)
+
+
+def p(name) -> str:
+    """A path or name for a report line: escaped (it may hold any byte a file system allows)."""
+    return printable(name, 300)
+
+
+def out(text: str) -> None:
+    """Print a report for people, each of its lines escaped (names in it are escaped by ``p``
+    where they are put in, so that a newline in a name cannot split a line)."""
+    print("\n".join(printable(line, 2000) for line in str(text).split("\n")))
+
+
+def progress(msg: str) -> None:
+    """One progress line on stderr, indented."""
+    sys.stderr.write(f"  {msg}\n")
+    sys.stderr.flush()
+
+
+def prefix_of(args, default_dir: str = "renders") -> str:
+    """The plots' prefix: ``--out``, else ``renders/<scene stem>``."""
+    return args.out or os.path.join(default_dir, os.path.splitext(os.path.basename(args.scene))[0])
+
+
+def need_matplotlib(what: str) -> None:
+    """``UsageError`` saying how to install matplotlib when it is missing (``what`` need it)."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        raise UsageError(f"{what} need matplotlib: pip install 'spinviz[render]'") from None
+
+
+class WriteFailed(SpinvizError, OSError):
+    """An output could not be written (a full disk, an I/O error): exit status 1, the path named."""
+
+
+def cannot_write(path, e: OSError) -> SpinvizError:
+    """One line naming the output that could not be written, and why."""
+    return WriteFailed(f"{path}: cannot write: {e.strerror or e}")
+
+
+# --- standard streams ---------------------------------------------------------------------
+class Stream:
+    """A standard stream that never raises into a command: the first failure (a closed or full
+    stream) is kept in ``error`` and later writes are dropped; text the stream cannot encode
+    is written escaped.  A reader that left stdout (EPIPE) still ends the command quietly."""
+
+    def __init__(self, stream, pipe_ends: bool):
+        self.stream, self.pipe_ends = stream, pipe_ends
+        self.error = None if stream is not None else OSError(errno.EBADF, os.strerror(errno.EBADF))
+
+    def _do(self, op, *a):
+        if self.error is not None:
+            return
+        try:
+            op(*a)
+        except BrokenPipeError as e:
+            if self.pipe_ends:
+                raise
+            self.error = e
+        except UnicodeEncodeError as e:
+            if not a:
+                self.error = e
+                return
+            enc = getattr(self.stream, "encoding", None) or "utf-8"
+            self._do(op, a[0].encode(enc, "backslashreplace").decode(enc))
+        except (OSError, ValueError) as e:               # ValueError: a closed file object
+            self.error = e
+
+    def write(self, text: str) -> int:
+        """Write ``text`` unless the stream has failed; never raises (but EPIPE on stdout)."""
+        self._do(lambda t: self.stream.write(t), text)
+        return len(text)
+
+    def flush(self) -> None:
+        """Flush unless the stream has failed."""
+        self._do(lambda: self.stream.flush())
+
+    def isatty(self) -> bool:
+        """Whether the stream is a working terminal."""
+        try:
+            return self.error is None and self.stream.isatty()
+        except (OSError, ValueError, AttributeError):
+            return False
+
+    def fileno(self) -> int:
+        """The descriptor of the stream (``io.UnsupportedOperation`` when it was closed)."""
+        if self.stream is None:
+            import io
+
+            raise io.UnsupportedOperation("the stream was closed before the command started")
+        return self.stream.fileno()
+
+    def __getattr__(self, name):
+        return getattr(self.stream, name)

@@ -49,7 +49,8 @@ def radiation_coupling(dipole_cgs):
 def tau0_cgs(dipole_magnitude_cgs: float, inertia1_cgs: float) -> float:
     """tau0 = 2 d^2 / (3 I1 c^3), equation (3.8); seconds.
 
-    The printed (3.3)-(3.5) have c^2 where (3.8) has c^3; c^3 is right (DESIGN.md, 2).
+    The printed (3.3)-(3.5) have c^2 where (3.8) has c^3; c^3 is right: the general reduced
+    equation (2.2)+(2.3) reproduces (3.3)-(3.5) with it (``tests/test_equations.py``).
     """
     return 2.0 * dipole_magnitude_cgs**2 / (3.0 * inertia1_cgs * C_LIGHT**3)
 

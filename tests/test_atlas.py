@@ -412,7 +412,7 @@ PHYSICAL_POINTS = [  # one point per domain of figure 2 (reduced) and per trunca
 
 @pytest.mark.parametrize("name,model,delta,chi_deg", PHYSICAL_POINTS, ids=[p[0] for p in PHYSICAL_POINTS])
 def test_dimensionless_atlas_runs_match_physical_unit_simulate(name, model, delta, chi_deg):
-    """Issue 18.4: the atlas's (4.2)-(4.4) (or the truncated analogue), dimensionless, in
+    """The atlas's (4.2)-(4.4) (or the truncated analogue), dimensionless, in
     heyoka's batch mode, against spinviz.simulate on a CGS body with the same delta, chi and
     tau0 = 1e-20 s (Omega0 ~ 1e19 rad/s), the general (2.2)+(2.3) or (2.5), mapped through
     (4.1): every sample within 1e-7 relative to tau = 1e6 (both at rtol 1e-10; measured <= 3e-9

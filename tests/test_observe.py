@@ -1,4 +1,4 @@
-"""What a detector records, when the two models part, and the sonification (issue 19)."""
+"""What a detector records, when the two models part, and the sonification."""
 
 import math
 import re

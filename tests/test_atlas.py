@@ -423,3 +423,16 @@ def test_dimensionless_atlas_runs_match_physical_unit_simulate(name, model, delt
     for r in rows:
         assert r["end_rel_diff"] < 1e-7, r
         assert r["label_atlas"] == r["label_physical"], r
+
+
+def test_the_diagrams_delta_axis_names_each_side_by_its_bodies():
+    """delta = 1 - I3/I1 > 0 is prolate (the cellulose rod, I3 < I1), delta < 0 oblate (the
+    DAST family-1 plate, I3 > I1): the axis label puts "oblate" left of 0 and "prolate" right."""
+    from spinviz.physics.presets import PRESETS
+    from spinviz.regimes.figures.style import DELTA_AXIS
+
+    rod, plate = PRESETS["cellulose_rod"](), PRESETS["dast_family1"]()
+    assert rod.inertia[2] < rod.inertia[0] and 1 - rod.inertia[2] / rod.inertia[0] > 0.9
+    assert 1 - plate.inertia[2] / plate.inertia[0] == pytest.approx(-0.6, abs=0.01)
+    left, right = DELTA_AXIS.split("\u2190 0 \u2192")
+    assert left.rstrip().endswith("oblate") and right.lstrip().startswith("prolate")

@@ -79,9 +79,11 @@ def _add_simulate(sub) -> None:
 
 
 def _add_render(sub) -> None:
-    r = sub.add_parser("render", help="render a scene off-screen to MP4 or GIF, with a PNG poster")
+    r = sub.add_parser("render", help="render a scene off-screen to MP4 or GIF, with a PNG poster; or write it as an "
+                                      "animated glTF model (.glb, .gltf) or a page where the crystal can be turned (.html)")
     r.add_argument("scene")
-    r.add_argument("--out", help="output .mp4 or .gif (default renders/<scene>.mp4)")
+    r.add_argument("--out", help="output .mp4 or .gif, .glb or .gltf (3-D model), .html (self-contained page) "
+                                 "(default renders/<scene>.mp4)")
     r.add_argument("--size", type=_size, help="WIDTHxHEIGHT in pixels, e.g. 1280x720")
     r.add_argument("--fps", type=_whole, help="frames per second (1..240)")
     r.add_argument("--duration", type=_real, help="video length in seconds")
@@ -517,6 +519,11 @@ def _cmd_render(args) -> int:
         raise                                           # says what it is about (an output, the scene)
     except ValueError as e:
         raise UsageError(f"{args.scene}: {e}") from None
+    if hasattr(res, "describe"):                        # a glTF model or a page
+        _out(res.describe())
+        for note in res.notes:
+            _out(note)
+        return EXIT_OK
     _out(f"{_p(res.path)}: {res.frames} frames {res.size[0]}x{res.size[1]}, "
           f"rendered in {res.seconds:.1f} s ({res.fps:.1f} fps, {res.workers} workers)")
     if res.poster:

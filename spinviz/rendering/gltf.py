@@ -254,7 +254,7 @@ def build(plan, kf) -> tuple[dict, bytes]:
                 body_children.append(_arrow(w, meshes, "dipole", rotation_x_to(plan.d_body), ARROWS["dipole"][3]))
             body = w.node(name=f"{panel.model} body", mesh=meshes.get("body"), rotation=xyzw(keys.q[0]).tolist(),
                           children=body_children or None,
-                          extras={"physical_scale": physical_scale(plan)})
+                          extras={"role": "body", "index": k, "physical_scale": physical_scale(plan)})
             animate(body, "rotation", xyzw(keys.q), "VEC4")
             children.append(body)
         for key, (q, length) in keys.arrows.items():
@@ -271,8 +271,8 @@ def build(plan, kf) -> tuple[dict, bytes]:
         world = w.node(name=f"{panel.model} world (spinviz z up)", rotation=list(Z_UP_TO_Y_UP), children=children)
         heading, equations = texts.headings[k]
         models.append(w.node(name=panel.model, translation=[x, 0.0, 0.0], children=[world],
-                             extras={"model": panel.model, "heading": heading, "equations": equations,
-                                     "subtitle": texts.subtitles[k]}))
+                             extras={"role": "model", "index": k, "model": panel.model, "heading": heading,
+                                     "equations": equations, "subtitle": texts.subtitles[k]}))
     camera = _camera(w, spec, len(plan.panels))
     w.doc["scenes"].append({"name": texts.footer, "nodes": models + [camera], "extras": {"spinviz": _extras(plan, kf, texts)}})
     w.doc["animations"] = [{"name": "spin", "samplers": samplers, "channels": channels,

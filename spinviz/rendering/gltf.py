@@ -221,21 +221,7 @@ def build(plan, kf) -> tuple[dict, bytes]:
     """
     spec, show = plan.spec, set(plan.spec.show)
     w = _Writer()
-    colors = COLORS[spec.background]
-    body_from_shape = np.asarray(plan.shape.R_body_from_shape if plan.shape else np.eye(3), dtype=float)
-    meshes = {}
-    if "body" in show:
-        meshes["body"] = w.mesh(body_part(plan.shape, body_color(plan.body_name), body_from_shape), "body")
-    for key in ("dipole", "L", "omega"):
-        if key in show:
-            shaft, head_len, head_r, _ = ARROWS[key]
-            color = np.asarray(ARROW_COLORS[key])
-            meshes[key + "_shaft"] = w.mesh(arrow_shaft(shaft, color), f"{key} arrow shaft")
-            meshes[key + "_head"] = w.mesh(arrow_head(head_len, head_r, color), f"{key} arrow head")
-    if "axes" in show:
-        meshes["axes"] = w.mesh(_axes_part(colors["axes"]), "axes")
-    if "sphere" in show:
-        meshes["cage"] = w.lines(list(_circle_points()), colors["sphere"], "unit sphere")
+    meshes = _meshes(w, plan)
     texts = texts_of(plan)
     times = w.accessor(kf.video_t.astype(np.float32), "SCALAR", minmax=True)
     samplers, channels = [], []
@@ -283,6 +269,27 @@ def build(plan, kf) -> tuple[dict, bytes]:
         if not w.doc[key]:
             del w.doc[key]
     return w.doc, bytes(w.blob)
+
+
+def _meshes(w: _Writer, plan) -> dict:
+    """The meshes ``plan`` shows, each once (both models use them): name -> mesh index."""
+    show = set(plan.spec.show)
+    colors = COLORS[plan.spec.background]
+    body_from_shape = np.asarray(plan.shape.R_body_from_shape if plan.shape else np.eye(3), dtype=float)
+    meshes = {}
+    if "body" in show:
+        meshes["body"] = w.mesh(body_part(plan.shape, body_color(plan.body_name), body_from_shape), "body")
+    for key in ("dipole", "L", "omega"):
+        if key in show:
+            shaft, head_len, head_r, _ = ARROWS[key]
+            color = np.asarray(ARROW_COLORS[key])
+            meshes[key + "_shaft"] = w.mesh(arrow_shaft(shaft, color), f"{key} arrow shaft")
+            meshes[key + "_head"] = w.mesh(arrow_head(head_len, head_r, color), f"{key} arrow head")
+    if "axes" in show:
+        meshes["axes"] = w.mesh(_axes_part(colors["axes"]), "axes")
+    if "sphere" in show:
+        meshes["cage"] = w.lines(list(_circle_points()), colors["sphere"], "unit sphere")
+    return meshes
 
 
 def _arrow(w: _Writer, meshes, key: str, rot3, length: float, q0=None, name: str | None = None) -> int:

@@ -13,7 +13,9 @@ block, set with textContent by the script (the <title> is HTML-escaped).
 The page exposes the pose it shows: ``window.pose(k)`` returns model k's body orientation,
 scalar first (w, x, y, z), body -> spinviz world, and each panel element carries it in its
 ``data-pose`` attribute.  ``#frame=N`` in the address opens it at the video's frame N (as if
-the slider had been set there).
+the slider had been set there); ``#frame=N&view=AZ,EL`` also turns the view to that azimuth
+and elevation (degrees, as the scene's ``azimuth_deg``, ``elevation_deg``): a link to a
+chosen moment and viewpoint.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from importlib import resources
 
 from .captions import texts_of
 from .gltf import model_offsets, view_gltf
-from .style import ARROW_COLORS, AXIS_LENGTH, COLORS, VIEW_ANGLE, palette
+from .style import ARROW_COLORS, AXIS_LENGTH, COLORS, MODEL_COLORS, VIEW_ANGLE, palette
 
 __all__ = ["page", "csp_hash"]
 
@@ -65,6 +67,7 @@ def page_data(plan, kf) -> dict:
     return {
         "title": texts.footer, "scale": texts.scale,
         "headings": [list(h) for h in texts.headings], "subtitles": list(texts.subtitles),
+        "model_colors": [_hex(MODEL_COLORS.get(p.model, pal.fg)) for p in plan.panels],
         "legend": [{"key": k, "symbol": s, "name": nm, "color": _css_rgb(ARROW_COLORS[k])} for k, s, nm in texts.legend
                    if k in ARROW_COLORS],
         "ticks": [[float(p), str(label)] for p, label in texts.bar_ticks],

@@ -18,6 +18,7 @@
   $('stage').classList.add('n' + n);
   for (let k = 0; k < n; k++) {
     $('head-' + k).textContent = D.headings[k][0] + '  ' + D.headings[k][1];
+    $('head-' + k).style.color = D.model_colors[k];
     $('sub-' + k).textContent = D.subtitles[k];
   }
   D.legend.forEach((item) => {
@@ -53,12 +54,15 @@
 
   slider.addEventListener('input', () => { stop(); setFrame(parseInt(slider.value, 10)); });
 
+  // #frame=N opens the page at the video's frame N (as if the slider had been set there);
+  // &view=AZ,EL (degrees, as the scene's azimuth_deg and elevation_deg) turns the view
+  let turnHook = null;
   function fromFragment() {
-    const m = /^#frame=(\d{1,7})$/.exec(window.location.hash);
-    if (m) {
-      slider.value = String(Math.min(parseInt(m[1], 10), D.frames - 1));
-      slider.dispatchEvent(new Event('input'));                 // as if the slider had been set
-    }
+    const m = /^#frame=(\d{1,7})(?:&view=(-?\d{1,3}(?:\.\d+)?),(-?\d{1,2}(?:\.\d+)?))?$/.exec(window.location.hash);
+    if (!m) return;
+    slider.value = String(Math.min(parseInt(m[1], 10), D.frames - 1));
+    slider.dispatchEvent(new Event('input'));
+    if (m[2] !== undefined && turnHook) turnHook(parseFloat(m[2]), Math.max(-89, Math.min(89, parseFloat(m[3]))));
   }
   window.addEventListener('hashchange', fromFragment);
 
@@ -127,13 +131,19 @@
     // one camera that the mouse turns about the origin; each view copies it to its model
     const fov = D.yfov_deg;
     const master = new THREE.PerspectiveCamera(fov, 1, 0.05, 200);
-    const dist = 1.75 / Math.tan(0.5 * fov * Math.PI / 180) * 1.1;
+    const dist = 1.75 / Math.tan(0.5 * fov * Math.PI / 180) * 1.3;
     master.position.set(D.view[0], D.view[1], D.view[2]).multiplyScalar(dist);
     const controls = new THREE.OrbitControls(master, renderer.domElement);
     controls.enablePan = false;
     controls.minDistance = 2;
     controls.maxDistance = 40;
     controls.update();
+    turnHook = (azDeg, elDeg) => {
+      const az = azDeg * Math.PI / 180, el = elDeg * Math.PI / 180, r = master.position.length();
+      // spinviz's (x, y, z) is glTF's (x, -z, y): the world node turns z up into y up
+      master.position.set(Math.cos(el) * Math.cos(az), Math.sin(el), -Math.cos(el) * Math.sin(az)).multiplyScalar(r);
+      controls.update();
+    };
     const centers = models.map((m) => m.getWorldPosition(new THREE.Vector3()));
     const cams = models.map((m, k) => {
       const c = new THREE.PerspectiveCamera(fov, 1, 0.05, 200);

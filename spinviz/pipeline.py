@@ -304,6 +304,11 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
     if os.path.splitext(os.fspath(out))[1].lower() in MODEL_FORMATS:
         # an animated glTF model or the page that shows it: the same plan, no drawing stack
         check_outputs([out], inputs)
+        import importlib.util
+
+        if importlib.util.find_spec("pygltflib") is None:
+            raise MissingRenderStack("a glTF model or page needs the optional package 'pygltflib': "
+                                     "pip install 'spinviz[render]'")
         from .rendering.export import export
 
         return export(_plan(scene, trajs, spec), out)

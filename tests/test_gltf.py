@@ -89,7 +89,7 @@ def test_keyframes_are_video_frames_within_the_stated_angle(plan):
         assert np.max(err) <= tol + 1e-12 and np.max(err) > 0.3 * tol         # used, not wasted
         for q in (keys.q, *(a[0] for a in keys.arrows.values())):
             assert np.all(np.sum(q[1:] * q[:-1], axis=1) >= 0.0)
-            assert np.max(R.misorientation(q[1:], q[:-1])) < 0.5 * math.pi
+            assert np.max(R.misorientation(q[1:], q[:-1])) < keyframes.MAX_STEP < 0.5 * math.pi
         for key, vec in (("L", panel.L_world), ("omega", panel.omega_world)):
             qa, ln = keys.arrows[key]
             assert np.max(R.angle_between(R.world_from_body(qa, x), vec[f])) < 1e-12
@@ -112,19 +112,19 @@ def _spinning_plan(deg_per_frame: float, frames: int = 7):
 
 def test_frames_a_half_turn_apart_get_slerp_midpoints():
     """An aliased spin of 120 deg a frame: midpoints (frame -1, on the slerp path between the
-    two frames, their time on the time map) keep every step under a quarter turn; the frames
-    themselves stay exact."""
+    two frames, their time on the time map) keep every step under MAX_STEP (40 deg steps); the
+    frames themselves stay exact."""
     p = _spinning_plan(120.0)
     kf = keyframes.choose(p)
     q = kf.panels[0].q
-    assert np.max(R.misorientation(q[1:], q[:-1])) < 0.5 * math.pi
+    assert np.max(R.misorientation(q[1:], q[:-1])) < keyframes.MAX_STEP
     assert np.all(np.sum(q[1:] * q[:-1], axis=1) >= 0.0)
     real = kf.frame >= 0
-    assert list(kf.frame[real]) == list(range(p.frames)) and (~real).sum() == p.frames - 1      # 60 deg steps
+    assert list(kf.frame[real]) == list(range(p.frames)) and (~real).sum() == 2 * (p.frames - 1)      # 40 deg steps
     assert np.max(R.misorientation(q[real], p.panels[0].q)) < 1e-12
     np.testing.assert_allclose(kf.sim_t, 10.0 * kf.video_t, rtol=1e-12)
-    # a steady 10 deg a frame is one slerp: the two ends suffice
-    assert keyframes.choose(_spinning_plan(10.0)).count == 2
+    # a steady 12 deg a frame is one slerp: only MAX_STEP asks for keyframes between the ends (every 48 deg)
+    assert list(keyframes.choose(_spinning_plan(12.0, 13)).frame) == [0, 4, 8, 12]
 
 
 # --- the glTF file --------------------------------------------------------------------------

@@ -30,6 +30,7 @@ import math
 import numpy as np
 
 from .. import units as U
+from . import keyframes
 from .captions import texts_of
 from .meshes import Part, arrow_head, arrow_shaft, body_part, cylinder_z
 from .stage import _circle_points, rotation_x_to
@@ -342,6 +343,7 @@ def _extras(plan, kf, texts) -> dict:
         "keyframes": {"count": kf.count, "tolerance_deg": math.degrees(kf.tolerance),
                       "max_error_deg": math.degrees(kf.max_error), "max_length_error_m": kf.max_length_error,
                       "max_step_deg": math.degrees(kf.max_step),
+                      "max_step_limit_deg": math.degrees(keyframes.MAX_STEP),
                       "what": "a subset of the video's frames: at each the exact pose the video draws; the viewer's "
                               "LINEAR interpolation stays within tolerance_deg of every frame in between"},
         "spin_mode": plan.spin_mode, "notes": list(plan.notes), "title": texts.footer,

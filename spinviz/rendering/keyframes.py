@@ -3,17 +3,19 @@ interpolation redraws the video.
 
 Pure NumPy (a planning module: no drawing library).  A glTF viewer draws a rotation between
 two keyframes by slerp at a constant rate in the animation's clock (the sampler's LINEAR
-interpolation; three.js, Blender's importer and the Khronos sample viewer do so), lengths and
-offsets by linear interpolation.  The keyframes are a subset of the video's own frames
+interpolation, as the glTF specification defines it and three.js does), lengths and offsets by
+linear interpolation.  The keyframes are a subset of the video's own frames
 (``FramePlan``): at a keyframe the file holds exactly the pose the video draws there, and the
 subset is chosen, greedily from the first frame, so that at every frame in between the
 viewer's interpolated pose -- body orientation, the direction of every moving arrow -- lies
 within ``tolerance`` (rad) of the pose the video draws at that frame, and every arrow's
 length within ``LENGTH_TOLERANCE``.  Consecutive keyframes are sign-aligned (q . q' >= 0) and
-less than a quarter turn apart, so that a viewer that interpolates the four numbers
-component by component (Blender's F-curves) follows the same short path as slerp; where two
-neighbouring video frames are further apart (an aliased spin), slerp midpoints are added --
-poses on the path every viewer draws anyway, flagged as not drawn by the video.
+less than ``MAX_STEP`` (50 deg) apart: a viewer that interpolates the four numbers component
+by component and normalizes (Blender's quaternion F-curves) then follows the same short arc
+as slerp, off slerp's timing by at most 0.16 deg (2 max_t |atan2(t sin a, 1 - t + t cos a) -
+t a| for a step of 2a = 50 deg); where two neighbouring video frames are further apart (an
+aliased spin), slerp midpoints are added -- poses on the path every viewer draws anyway,
+flagged as not drawn by the video.
 
 Quaternions here are scalar-first (w, x, y, z), body -> world for the body, and for an arrow
 the rotation taking +x along it; the glTF writer reorders them to (x, y, z, w).
@@ -31,7 +33,8 @@ from .stage import ARROW_VECTORS, arrow_length
 
 TOLERANCE_DEG = 0.25            # default: the viewer's pose within this angle of the video's at every frame
 LENGTH_TOLERANCE = 0.003        # arrow lengths, in units of the dipole arrow (1 = the glTF metre)
-MAX_STEP = 0.5 * math.pi        # rotation between consecutive keyframes stays below this (rad)
+MAX_STEP = math.radians(50.0)   # rotation between consecutive keyframes stays below this (rad): under a quarter turn,
+                                # and component-wise interpolation within 0.16 deg of slerp
 MOVING_ARROWS = ("L", "omega")  # turned in the world frame; the dipole arrow rides on the body
 
 

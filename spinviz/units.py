@@ -23,6 +23,7 @@ C_LIGHT = 2.99792458e10          # speed of light, cm/s (exact)
 DEBYE = 1.0e-18                  # 1 D in statC cm
 AMU = 1.66053906660e-24          # atomic mass unit, g (CODATA 2018)
 NM = 1.0e-7                      # 1 nm in cm
+M_PER_CM = 1.0e-2                # 1 cm in m (the glTF export states real sizes in metres)
 HBAR = 1.054571817e-27           # reduced Planck constant, erg s (CODATA 2018, exact since 2019)
 ERG_PER_S_IN_W = 1.0e-7          # 1 erg/s in W
 STATV_PER_CM_IN_V_PER_M = 2.99792458e4   # 1 statV/cm in V/m (c / 1e4 in SI digits)

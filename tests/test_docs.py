@@ -104,3 +104,17 @@ def test_physics_equations_render_offline(site, tmp_path):
     assert "<mjx-merror" not in dom and "data-mjx-error" not in dom
     assert "The paper prints c² in (3.3)–(3.5); c³ is right" in text
     assert readme_after("how spinviz treats them:") in text   # the README's typo list, included
+
+
+def test_gallery_embeds_the_turnable_page(site, tmp_path):
+    """The gallery embeds the page of the default scene (an iframe of the copy in _static);
+    that page, opened from the built site, draws both DAST crystals (orange) in Chromium."""
+    from browser import WEBGL_FLAGS
+
+    dom, text = page_text(site / "gallery.html", tmp_path)
+    assert '<iframe class="turnable" src="_static/dast_cube_turnable.html"' in dom
+    assert "Turn the crystal yourself" in text
+    img = screenshot(site / "_static" / "dast_cube_turnable.html", tmp_path, fragment="frame=200", flags=WEBGL_FLAGS)
+    view = img[175:560].astype(int)
+    orange = (view[..., 0] > 150) & (view[..., 0] - view[..., 2] > 90) & (view[..., 1] > 60)
+    assert orange[:, :640].sum() > 3000 and orange[:, 640:].sum() > 3000

@@ -106,19 +106,27 @@ def _add_compare(sub) -> None:
 
 
 def _add_observe(sub) -> None:
-    o = sub.add_parser("observe", help="what a detector records from both models of a scene, and when the two part "
-                                       "(power, frequency, polarization); plots")
+    o = sub.add_parser("observe", help="what a stated receiver records from both models of a scene: SNR, resolutions, "
+                                       "the field at the antenna, when the models part across resolutions, the P-f "
+                                       "test; plots")
     o.add_argument("scene")
     o.add_argument("--out", help="prefix of the PNG plots (default renders/<scene>): <prefix>_observe.png, "
-                                 "<prefix>_detector.png")
+                                 "<prefix>_detector.png and, for a physical body, <prefix>_receiver.png")
     o.add_argument("--los", type=_vector, help="line of sight X,Y,Z in the world frame (default: the scene's [observe], "
                                               "else across L(0))")
-    o.add_argument("--distance-cm", type=_real, help="where the field is given (default 1 cm)")
-    o.add_argument("--power-factor", type=_real, help="power resolution, a ratio (default 2)")
-    o.add_argument("--frequency-resolution", type=_real, help="relative frequency resolution (default 0.01)")
-    o.add_argument("--polarization-deg", type=_real, help="polarization-angle resolution, degrees (default 5)")
+    o.add_argument("--distance-cm", type=_real, help="the antenna's distance (default: the scene's [observe], else 10)")
+    for gone in ("--power-factor", "--frequency-resolution", "--polarization-deg"):
+        # fixed thresholds: the resolutions are the receiver's now; say so instead of "unrecognized"
+        o.add_argument(gone, type=_refused_option, help=argparse.SUPPRESS)
     o.add_argument("--samples", type=_positive, default=800, help="evenly spaced plus as many log-spaced instants")
     o.add_argument("--json", action="store_true", help="print the results as JSON")
+
+
+def _refused_option(text: str):
+    """The type of an option observe no longer takes: always an error, with the reason."""
+    from .inputs.receiver import RESOLUTION_COMPUTED
+
+    raise argparse.ArgumentTypeError(RESOLUTION_COMPUTED)
 
 
 def _add_listen(sub) -> None:
@@ -578,8 +586,7 @@ def _cmd_compare(args) -> int:
     return EXIT_OK
 
 
-OBSERVE_FLAGS = {"line_of_sight": "--los", "distance_cm": "--distance-cm", "power_factor": "--power-factor",
-                 "frequency_resolution": "--frequency-resolution", "polarization_deg": "--polarization-deg"}
+OBSERVE_FLAGS = {"line_of_sight": "--los", "distance_cm": "--distance-cm"}
 
 
 def _observe_args(args):
@@ -611,11 +618,10 @@ def _cmd_observe(args) -> int:
     if args.samples > OB_MAX_SAMPLES:
         raise UsageError(f"--samples: at most {OB_MAX_SAMPLES}, got {args.samples}")
     prefix = args.out or os.path.join("renders", os.path.splitext(os.path.basename(args.scene))[0])
-    paths = [f"{prefix}_observe.png", f"{prefix}_detector.png"]
+    paths = [f"{prefix}_observe.png", f"{prefix}_detector.png"] + ([f"{prefix}_receiver.png"] if sc.units == "cgs" else [])
     group = Outputs(paths, [args.scene])
-    res = OB.scene_resolution(sc, args.power_factor, args.frequency_resolution, args.polarization_deg)
     try:
-        obs, _ = OB.run_scene(sc, args.samples, los, dist, res)
+        obs, _ = OB.run_scene(sc, args.samples, los, dist)
     except SimulationError as e:
         raise SimulationError(f"{args.scene}: {e}") from None
     except ValueError as e:
@@ -624,13 +630,17 @@ def _cmd_observe(args) -> int:
         with group as tmps:
             OB.plot(obs, tmps[0])
             OB.plot_detector(obs, tmps[1])
+            if len(tmps) > 2:
+                from .analysis.experiment_plots import plot_receiver
+
+                plot_receiver(obs, tmps[2])
     except OSError as e:
         raise _cannot_write(prefix, e) from None
     if args.json:
         print(json.dumps({**obs.record(), "plots": list(paths)}, indent=2, default=float))
     else:
         _out(OB.format_table(obs))
-        _out(f"\nplots: {_p(paths[0])}, {_p(paths[1])}")
+        _out(f"\nplots: {', '.join(_p(x) for x in paths)}")
     return EXIT_OK
 
 

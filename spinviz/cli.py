@@ -41,7 +41,7 @@ def _parser() -> argparse.ArgumentParser:
                                             "(reduced (2.2)+(2.3) vs truncated (2.5) Euler equations).")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for add in (_add_check, _add_info, _add_simulate, _add_render, _add_compare, _add_observe, _add_listen,
+    for add in (_add_check, _add_info, _add_simulate, _add_render, _add_compare, _add_observe, _add_decide, _add_listen,
                 _add_bench, _add_stress, _add_report):
         add(sub)
     sub.add_parser("methods", help="list the integrators")
@@ -127,6 +127,35 @@ def _refused_option(text: str):
     from .inputs.receiver import RESOLUTION_COMPUTED
 
     raise argparse.ArgumentTypeError(RESOLUTION_COMPUTED)
+
+
+def _add_decide(sub) -> None:
+    d = sub.add_parser("decide", help="how long to watch: a Monte Carlo over noise and unknown starts of the time a "
+                                      "likelihood-ratio test needs to tell the models apart at 5 sigma in 95 %% of "
+                                      "trials; or the start-free P-f test of a file of measurements")
+    d.add_argument("scene")
+    d.add_argument("--measurements", help="a CSV or JSON file of line frequency and power (docs: Designing an "
+                                          "experiment): fit the P-f laws to it instead")
+    d.add_argument("--trials", type=_whole, help="Monte Carlo trials (default 200)")
+    d.add_argument("--seed", type=_whole, help="seed of the trials' random streams (default 1)")
+    d.add_argument("--spin-range", type=_pair, help="LO,HI: |Omega0| log-uniform over LO..HI x the scene's (default "
+                                                    "0.5,2)")
+    d.add_argument("--tau0", choices=("known", "fitted"), help="the body's tau0 known (default), or fitted with the start")
+    d.add_argument("--distance-cm", type=_real, help="the antenna's distance (default: the scene's [observe], else 10)")
+    d.add_argument("--workers", type=_positive, help="worker processes (default: one per core)")
+    d.add_argument("--scheduler", help="run the trials on a Dask cluster at this address (tcp://HOST:8786)")
+    d.add_argument("--out", help="prefix of the plot (default renders/<scene>): <prefix>_decide.png")
+    d.add_argument("--json", action="store_true", help="print the results as JSON")
+
+
+def _pair(text: str):
+    try:
+        v = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected LO,HI, got {text!r}") from None
+    if len(v) != 2:
+        raise argparse.ArgumentTypeError(f"expected two numbers LO,HI, got {text!r}")
+    return v
 
 
 def _add_listen(sub) -> None:
@@ -644,6 +673,98 @@ def _cmd_observe(args) -> int:
     return EXIT_OK
 
 
+DECIDE_FLAGS = {"trials": "--trials", "seed": "--seed", "spin_range": "--spin-range", "tau0": "--tau0"}
+DASK_TRIALS = 2000            # from this many trials (or with --scheduler) the Monte Carlo runs on Dask
+
+
+def _cmd_decide(args) -> int:
+    from .analysis import decide as DC
+    from .inputs.decide import DecideArguments
+    from .scene import load_scene
+
+    given = {k: getattr(args, k) for k in DECIDE_FLAGS if getattr(args, k) is not None}
+    try:
+        spec = DecideArguments(**given)
+    except SpecError as e:
+        raise UsageError(f"{DECIDE_FLAGS.get(e.key, e.key)}: {e.reason}") from None
+    sc = load_scene(args.scene)
+    receiver = sc.observe.receiver
+    if args.distance_cm is not None:
+        try:
+            receiver = dataclasses.replace(receiver, distance_cm=args.distance_cm)
+        except SpecError as e:
+            raise UsageError(f"--distance-cm: {e.reason}") from None
+    if args.measurements is not None:
+        return _decide_measurements(args, sc)
+    try:
+        setup = DC.setup_from_scene(sc, receiver, sc.observe.t_end or sc.t_end, spec.spin_range, spec.tau0)
+    except ValueError as e:
+        raise UsageError(f"{args.scene}: {e}") from None
+    prefix = args.out or os.path.join("renders", os.path.splitext(os.path.basename(args.scene))[0])
+    from .atomic import Outputs
+
+    group = Outputs([f"{prefix}_decide.png"], [args.scene])
+    out = _run_trials(DC, setup, spec, args)
+    try:
+        with group as tmps:
+            from .analysis.experiment_plots import plot_decide
+
+            plot_decide(out, sc.title, tmps[0])
+    except OSError as e:
+        raise _cannot_write(prefix, e) from None
+    if args.json:
+        print(json.dumps({**out.record(), "receiver": receiver.record(), "plots": [f"{prefix}_decide.png"]}, indent=2))
+    else:
+        _out(DC.format_outcome(out, sc.title, receiver))
+        _out(f"\nplot: {_p(prefix + '_decide.png')}")
+    return EXIT_OK
+
+
+def _run_trials(DC, setup, spec, args):
+    """The Monte Carlo where it belongs: a Dask cluster when large or asked for (the atlas's
+    ``Cluster``, imported here and nowhere else in the command), worker processes otherwise."""
+    from .inputs.render import usable_cores
+
+    if args.scheduler is not None or spec.trials >= DASK_TRIALS:
+        from .regimes.cluster import Cluster, check_workers, polled
+
+        check_workers(args.workers, args.scheduler)
+        with Cluster(args.scheduler, args.workers) as cl:
+            _progress(f"decide: {spec.trials} trials on {cl.describe}")
+
+            def mapper(fn, items):
+                return polled(cl.client.gather, cl.client.map(fn, items, pure=False))
+
+            return DC.run(setup, spec.trials, spec.seed, mapper)
+    workers = min(args.workers or usable_cores(), max(1, spec.trials // 8))
+    if workers == 1:
+        return DC.run(setup, spec.trials, spec.seed)
+    with DC.ProcessMapper(workers) as mapper:
+        return DC.run(setup, spec.trials, spec.seed, mapper)
+
+
+def _decide_measurements(args, sc) -> int:
+    """``decide --measurements FILE``: the start-free P-f test of measured data."""
+    from .analysis import pftest as PF
+    from .inputs.measurements import read_measurements
+
+    law, reason = PF.line_law(sc.body)
+    data, unit = read_measurements(args.measurements)
+    if law is None:
+        result = {"measurements": args.measurements, "law": None, "reason": reason}
+        if args.json:
+            print(json.dumps(result, indent=2))
+        else:
+            _out(f"{_p(args.measurements)}: no test: {reason}")
+        return EXIT_OK
+    test = PF.fit(PF.from_measurements(data, unit, args.measurements))
+    if args.json:
+        print(json.dumps({"measurements": args.measurements, "law": law, **test.record()}, indent=2, default=float))
+    else:
+        _out("\n".join([f"{_p(args.measurements)} ({sc.title}): line: {law}"] + [f"  {x}" for x in test.summary()]))
+    return EXIT_OK
+
+
 OB_MAX_SAMPLES = 100_000
 
 
@@ -762,7 +883,7 @@ def _cmd_atlas(args) -> int:
 
 _COMMANDS = {"check": _cmd_check, "info": _cmd_info, "simulate": _cmd_simulate, "methods": _cmd_methods,
              "render": _cmd_render, "compare": _cmd_compare, "bench": _cmd_bench, "stress": _cmd_stress,
-             "report": _cmd_report, "atlas": _cmd_atlas, "observe": _cmd_observe,
+             "report": _cmd_report, "atlas": _cmd_atlas, "observe": _cmd_observe, "decide": _cmd_decide,
              "listen": _cmd_listen}
 
 

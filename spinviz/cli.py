@@ -115,6 +115,8 @@ def _add_observe(sub) -> None:
     o.add_argument("--los", type=_vector, help="line of sight X,Y,Z in the world frame (default: the scene's [observe], "
                                               "else across L(0))")
     o.add_argument("--distance-cm", type=_real, help="the antenna's distance (default: the scene's [observe], else 10)")
+    o.add_argument("--integration-s", type=_real, help="the length of one estimate (default: the scene's [observe], "
+                                                       "else 1)")
     for gone in ("--power-factor", "--frequency-resolution", "--polarization-deg"):
         # fixed thresholds: the resolutions are the receiver's now; say so instead of "unrecognized"
         o.add_argument(gone, type=_refused_option, help=argparse.SUPPRESS)
@@ -142,6 +144,8 @@ def _add_decide(sub) -> None:
                                                     "0.5,2)")
     d.add_argument("--tau0", choices=("known", "fitted"), help="the body's tau0 known (default), or fitted with the start")
     d.add_argument("--distance-cm", type=_real, help="the antenna's distance (default: the scene's [observe], else 10)")
+    d.add_argument("--integration-s", type=_real, help="the length of one estimate (default: the scene's [observe], "
+                                                       "else 1)")
     d.add_argument("--workers", type=_positive, help="worker processes (default: one per core)")
     d.add_argument("--scheduler", help="run the trials on a Dask cluster at this address (tcp://HOST:8786)")
     d.add_argument("--out", help="prefix of the plot (default renders/<scene>): <prefix>_decide.png")
@@ -615,7 +619,7 @@ def _cmd_compare(args) -> int:
     return EXIT_OK
 
 
-OBSERVE_FLAGS = {"line_of_sight": "--los", "distance_cm": "--distance-cm"}
+OBSERVE_FLAGS = {"line_of_sight": "--los", "distance_cm": "--distance-cm", "integration_s": "--integration-s"}
 
 
 def _observe_args(args):
@@ -650,7 +654,7 @@ def _cmd_observe(args) -> int:
     paths = [f"{prefix}_observe.png", f"{prefix}_detector.png"] + ([f"{prefix}_receiver.png"] if sc.units == "cgs" else [])
     group = Outputs(paths, [args.scene])
     try:
-        obs, _ = OB.run_scene(sc, args.samples, los, dist)
+        obs, _ = OB.run_scene(sc, args.samples, los, dist, integration_s=args.integration_s)
     except SimulationError as e:
         raise SimulationError(f"{args.scene}: {e}") from None
     except ValueError as e:
@@ -689,11 +693,12 @@ def _cmd_decide(args) -> int:
         raise UsageError(f"{DECIDE_FLAGS.get(e.key, e.key)}: {e.reason}") from None
     sc = load_scene(args.scene)
     receiver = sc.observe.receiver
-    if args.distance_cm is not None:
-        try:
-            receiver = dataclasses.replace(receiver, distance_cm=args.distance_cm)
-        except SpecError as e:
-            raise UsageError(f"--distance-cm: {e.reason}") from None
+    for key, flag in (("distance_cm", "--distance-cm"), ("integration_s", "--integration-s")):
+        if getattr(args, key) is not None:
+            try:
+                receiver = dataclasses.replace(receiver, **{key: getattr(args, key)})
+            except SpecError as e:
+                raise UsageError(f"{flag}: {e.reason}") from None
     if args.measurements is not None:
         return _decide_measurements(args, sc)
     try:

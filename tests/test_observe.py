@@ -110,6 +110,15 @@ def test_receiver_parts_the_cube_at_five_sigma(cube):
     assert p.setup_time / 86400 == pytest.approx(1.75, abs=0.01)
 
 
+def test_observe_record_is_strict_json(cube):
+    """The cube's record (receiver, budgets, parting curves, P-f tests with an infinite Z) holds no
+    NaN or Infinity: None stands for them."""
+    _, obs, _ = cube
+    rec = json.loads(json.dumps(obs.record(), allow_nan=False))
+    assert rec["pf_test"]["fits"]["truncated"]["reduced_law_rejected_outright"] is True
+    assert rec["parting"]["frequency"]["setup_time"] == pytest.approx(1.0)
+
+
 def test_cube_line_as_this_receiver_measures_it_passes_the_pf_test(cube):
     """Each model's own line, one 1 s integration at each instant where it is detected in the
     radiation zone (with the receiver's noise): the reduced run goes to the reduced law (f_inf near
@@ -200,7 +209,7 @@ def test_antenna_inside_a_wavelength_gets_no_snr():
     given (1.84 times the radiation term: the closed form of test_receiver's), the radiation-zone
     SNR is not, and so no parting for this receiver."""
     obs, _ = OB.run_scene(load_scene(SCENES / "dast_cube.toml"), samples=50, distance_cm=1.0)
-    rec = json.loads(json.dumps(obs.record()))
+    rec = json.loads(json.dumps(obs.record(), allow_nan=False))          # strict JSON: no NaN, no Infinity
     start = rec["budget"]["reduced"]["start"]
     assert start["zone"] == "intermediate" and start["snr_integration"] is None and start["received_w"] is None
     assert start["field_full_rms_v_per_m"] / start["field_radiation_term_rms_v_per_m"] == pytest.approx(1.84, abs=0.01)

@@ -30,8 +30,9 @@ truncated.  One trial:
    (Z grows steadily with T; the noise moves it by about 1), interpolated in log T; infinite
    when Z < 5 at the horizon.
 
-The answer is the 95 % quantile of the trials' decision times for each truth (bootstrap
-interval over the trials: the Monte Carlo's own uncertainty), and the fraction of trials
+The answer is the 95 % quantile of the trials' decision times for each truth, with a
+distribution-free interval from the order statistics (the number of trials decided before the
+true quantile is binomial: the Monte Carlo's own uncertainty), and the fraction of trials
 decided against observation time.  Trials are independent (each has its own seed from
 ``numpy.random.SeedSequence(seed).spawn``), so the result does not depend on how they are
 batched or where they run: ``run`` takes any ``map``-like callable (in-process, a process pool,
@@ -346,7 +347,7 @@ def run_trials(setup: Setup, seed: int, indices) -> list[dict]:
 @dataclass
 class Outcome:
     """The Monte Carlo's answer: per truth the trials' decision times (s, inf = never within
-    the horizon), the 95 % quantile ``t95`` with its bootstrap interval, and the setup."""
+    the horizon), the 95 % quantile ``t95`` with its 68 % interval, and the setup."""
 
     setup: Setup
     trials: int
@@ -388,14 +389,29 @@ def quantile_time(times: np.ndarray, share: float = SHARE) -> float:
     return float(t[max(k, 0)])
 
 
-def summarize(out: Outcome, boot: int = 400) -> Outcome:
-    """Fill ``t95`` and its 68 % bootstrap interval over the trials (the Monte Carlo's own spread)."""
-    rng = np.random.default_rng(out.seed + 1)
+def quantile_interval(times: np.ndarray, share: float = SHARE, level: float = 0.68) -> tuple[float, float]:
+    """A distribution-free ``level`` interval of the ``share`` quantile of the trials' times: the
+    order statistics between which the true quantile lies with at least that probability (the
+    number of trials below it is binomial(n, share)); the upper end is inf where it lies beyond
+    the largest time (too few trials to bound it) or among the trials never decided."""
+    t = np.sort(np.asarray(times, dtype=float))
+    n = t.size
+    k = np.arange(n + 1)
+    logpmf = (np.array([math.lgamma(n + 1) - math.lgamma(j + 1) - math.lgamma(n - j + 1) for j in k])
+              + k * math.log(share) + (n - k) * math.log1p(-share))
+    cdf = np.cumsum(np.exp(logpmf - logpmf.max()))
+    cdf /= cdf[-1]
+    lo = int(np.searchsorted(cdf, 0.5 * (1.0 - level)))            # trials below the quantile, low end
+    hi = int(np.searchsorted(cdf, 0.5 * (1.0 + level)))
+    return float(t[max(lo - 1, 0)]), (float(t[hi]) if hi < n else math.inf)
+
+
+def summarize(out: Outcome) -> Outcome:
+    """Fill ``t95`` and its 68 % interval (``quantile_interval``: the Monte Carlo's own spread)."""
     for m in MODELS:
         t = out.times(m)
         out.t95[m] = quantile_time(t)
-        b = np.array([quantile_time(rng.choice(t, t.size)) for _ in range(boot)])
-        out.interval[m] = (float(np.quantile(b, 0.16)), float(np.quantile(b, 0.84)))
+        out.interval[m] = quantile_interval(t)
     return out
 
 

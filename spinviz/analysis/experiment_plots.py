@@ -36,21 +36,23 @@ def _nothing(ax, obs, what: str) -> bool:
         ax.annotate("the antenna is inside a wavelength throughout (R < λ):\nno radiation-zone SNR" if near else
                     "the line is not detected at any instant", (0.5, 0.5), xycoords="axes fraction", ha="center",
                     va="center", fontsize=9, color="0.3")
+        ax.set_axis_off()
     return not has
 
 
 def _snr_panel(ax, obs, pos, scale) -> None:
-    """SNR of one integration of every line above 1e-4 of the strongest (both models), and the
-    coherent interval's detection threshold scaled to one integration."""
+    """SNR of one integration of every line above 1e-6 of the strongest in power (both models),
+    and the coherent interval's detection threshold scaled to one integration."""
     ax.set_title("signal-to-noise ratio of each line (below the dotted line: not detected)")
     if _nothing(ax, obs, "rho"):
         return
-    for bg in obs.budgets:
+    for j, bg in enumerate(obs.budgets):
         t = bg.t[pos] / scale
-        top = np.nanmax(np.nan_to_num(bg.rho[pos], nan=0.0), axis=1)
+        top = np.max(bg.power_sr[pos], axis=1, keepdims=True)
+        strong = bg.power_sr[pos] >= 1e-6 * top           # the rest is the line spectrum's round-off
         for k in range(bg.rho.shape[1]):
-            y = bg.rho[pos, k]
-            if np.any(np.nan_to_num(y, nan=0.0) > 1e-4 * top):
+            y = np.where(strong[:, k], bg.rho[pos, k], np.nan)
+            if np.any(np.nan_to_num(y, nan=0.0) > 0):
                 dom = k == np.bincount(bg.dominant[pos]).argmax()
                 ax.plot(t, np.where(y > 0, y, np.nan), **_style(bg.model, lw=1.8 if dom else 0.7,
                                                                 label=f"{bg.model}: strongest line" if dom else None))
@@ -58,9 +60,16 @@ def _snr_panel(ax, obs, pos, scale) -> None:
         need = bg.threshold[rows, bg.dominant[pos]] * obs.receiver.integration_s / bg.t_coh[rows, bg.dominant[pos]]
         ax.plot(t, need, color=model_color(bg.model), lw=0.8, ls=":",
                 label=f"{bg.model}: detection threshold (per coherent interval, scaled)")
+        inside = ~bg.radiation_zone[rows, bg.dominant[pos]]
+        if np.any(inside) and not np.all(inside):
+            i = int(np.argmax(inside))
+            ax.axvline(t[i], color=model_color(bg.model), lw=0.8, ls="-.")
+            ax.annotate(f"{bg.model}: λ > R from here,\nno radiation-zone SNR", (t[i], 0.5 - 0.12 * j),
+                        xycoords=("data", "axes fraction"), xytext=(-4, 0), textcoords="offset points", ha="right",
+                        fontsize=7, color=model_color(bg.model))
     ax.set_yscale("log")
     ax.set_ylabel(f"SNR of one {obs.receiver.integration_s:g} s integration")
-    ax.legend(fontsize=7, loc="lower left")
+    ax.legend(fontsize=7, loc="best")
 
 
 def _resolution_panel(ax, obs, pos, scale) -> None:
@@ -104,7 +113,9 @@ def _field_panel(ax, obs, pos, scale) -> None:
     tw.annotate("R = λ: radiation zone above", (0.99, 1.0), xycoords=("axes fraction", "data"), ha="right",
                 va="bottom", fontsize=7, color="tab:red")
     tw.set_yscale("log")
-    tw.set_ylabel("R / λ (dash-dot)")
+    tw.tick_params(axis="y", labelsize=8, colors="0.35")
+    tw.annotate("dash-dot: R/λ (right axis)", (0.99, 0.97), xycoords="axes fraction", ha="right", va="top",
+                fontsize=7, color="0.35")
 
 
 def _pf_panel(ax, obs) -> None:
@@ -134,6 +145,8 @@ def _pf_panel(ax, obs) -> None:
     ax.plot([], [], color=model_color("reduced"), ls="-", label="fitted P = A f²(f² − f∞²) (reduced law)")
     ax.set_xscale("log")
     ax.set_yscale("log")
+    ax.xaxis.set_major_formatter(lambda v, _: f"{v:g}")
+    ax.xaxis.set_minor_formatter(lambda v, _: f"{v:g}" if round(v, 6) in (2, 3, 4, 5, 6, 7, 8) else "")
     ax.set_xlabel("line frequency (GHz), log scale")
     ax.set_ylabel("power toward the antenna (W/sr)")
     ax.set_title("the start-free test: power against frequency")
@@ -166,7 +179,7 @@ def plot_receiver(obs, path: str) -> None:
         _time_axis(ax, tl)
     _pf_panel(axes[1, 1], obs)
     fig.suptitle(f"{obs.title}\nthe receiver: {obs.receiver.describe()}", fontsize=11)
-    fig.tight_layout()
+    fig.tight_layout(w_pad=2.5)
     save(fig, path)
 
 
@@ -185,20 +198,21 @@ def plot_decide(out, title: str, path: str) -> None:
     scale, tl = time_unit(max(float(finite.max()) if finite.size else s.horizon, lo * 10), "cgs")
     fig, axes = plt.subplots(1, 2, figsize=(15, 5.8))
     ax = axes[0]
-    for m in MODELS:
-        ax.plot(T / scale, out.fraction(m, T), **_style(m, label=f"truth: {m}"))
+    for j, m in enumerate(MODELS):
+        never = 100.0 * float(np.mean(~np.isfinite(out.times(m))))
+        ax.plot(T / scale, out.fraction(m, T), **_style(m, label=f"truth: {m} ({never:.3g} % never decided)"))
         t95 = out.t95[m]
         if math.isfinite(t95):
-            lo95, hi95 = out.interval[m]
+            lo95, hi95 = (min(x, s.horizon) for x in out.interval[m])      # an interval may reach "never"
             ax.axvspan(lo95 / scale, hi95 / scale, color=model_color(m), alpha=0.15)
-            ax.annotate(f"{m}: {U.human_time(t95)}", (t95 / scale, SHARE), xytext=(4, -14 if m == MODELS[0] else 6),
-                        textcoords="offset points", fontsize=8, color=model_color(m))
+            ax.annotate(f"{m}: {U.human_time(t95)} (band: Monte Carlo 68 %)", (hi95 / scale, SHARE),
+                        xytext=(6, -14 - 12 * j), textcoords="offset points", fontsize=8, color=model_color(m))
     ax.axhline(SHARE, color="tab:red", lw=0.9, ls="--")
     ax.set_ylim(0, 1.02)
     ax.set_ylabel(f"share of trials decided (Z ≥ {DECISION_Z:g})")
     ax.set_title(f"{out.trials} trials: when does the likelihood ratio reach {DECISION_Z:g}σ?")
     _time_axis(ax, tl.replace("time t", "observation time"))
-    ax.legend(fontsize=8, loc="upper left")
+    ax.legend(fontsize=8, loc="center right")
     ax = axes[1]
     for m in MODELS:
         share = np.array([r["b0"] / (r["u0"] + r["b0"]) for r in out.rows])
@@ -207,15 +221,16 @@ def plot_decide(out, title: str, path: str) -> None:
         ax.plot(np.sqrt(share[~never]), t[~never] / scale, "o", ms=3, color=model_color(m), alpha=0.6,
                 label=f"truth: {m}")
         if np.any(never):
-            ax.plot(np.sqrt(share[never]), np.full(int(never.sum()), s.horizon / scale), "x", ms=4,
-                    color=model_color(m), label=f"truth: {m}, not within the horizon")
+            ax.plot(np.sqrt(share[never]), np.full(int(never.sum()), s.horizon / scale), "x", ms=5,
+                    color=model_color(m), label=f"truth: {m}, not within the horizon (drawn at it)")
+    ax.axhline(s.horizon / scale, color="0.6", lw=0.8, ls=":")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("start's f∞/f0 = ε|Ω∥|/ω_L0 (0: spun across the dipole), log scale")
     ax.set_ylabel(tl.replace("time t", "decision time") + ", log scale")
     ax.set_title("each trial's decision time against its start")
     ax.grid(True, which="major", color="0.9", lw=0.6)
-    ax.legend(fontsize=8, loc="upper right")
+    ax.legend(fontsize=8, loc="upper center")
     fig.suptitle(f"{title}\nhow long to watch: tau0 {s.tau0_mode}, |Ω0| log-uniform over "
                  f"{s.spin_range[0]:g}–{s.spin_range[1]:g} × the scene's, directions isotropic", fontsize=11)
     fig.tight_layout()

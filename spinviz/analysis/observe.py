@@ -355,8 +355,8 @@ def _observable_panel(ax, obs: Observation, key: str, series, t, scale: float) -
                     xycoords=("data", "axes fraction"), xytext=(4, 0), textcoords="offset points", fontsize=8,
                     color="tab:red", va="top")
     elif tp is not None:
-        ax.annotate(f"apart for this receiver at {U.format_time(tp, obs.units)} (before the first plotted instant)",
-                    (0.02, 0.96), xycoords="axes fraction", fontsize=8, color="tab:red", va="top")
+        ax.annotate(f"apart for this receiver at {U.format_time(tp, obs.units)}\n(before the first plotted instant)",
+                    (0.02, 0.22), xycoords="axes fraction", fontsize=8, color="tab:red", va="bottom")
     elif obs.receiver is not None:
         ax.annotate("never apart for this receiver within the run", (0.98, 0.96), xycoords="axes fraction",
                     fontsize=8, color="0.35", va="top", ha="right")
@@ -371,7 +371,7 @@ def _parting_panel(ax, obs: Observation, key: str, scale: float, tl: str) -> Non
     ax.set_yscale("log")
     if c.resolutions.size == 0:
         ax.annotate("the models never differ in this observable" + (" beyond the runs' accuracy" if c.floor > 0
-                                                                    else ""), (0.5, 0.5), xycoords="axes fraction",
+                                                                    else ""), (0.6, 0.3), xycoords="axes fraction",
                     ha="center", fontsize=9, color="0.35")
     else:
         ok = np.isfinite(c.times)
@@ -387,10 +387,12 @@ def _parting_panel(ax, obs: Observation, key: str, scale: float, tl: str) -> Non
             ax.plot([x], [y], "o", color="tab:red", ms=7, zorder=5)
             ax.annotate(f"  {U.format_time(c.setup_time, obs.units)}", (x, y), fontsize=8, color="tab:red",
                         va="center")
-    t_lo = (obs.receiver.integration_s / 100.0 if obs.receiver is not None else obs.horizon * 1e-8) / scale
+    first = [float(np.nanmin(x.times)) for x in obs.parting.values() if np.any(np.isfinite(x.times))]
+    t_lo = 0.5 * max(obs.receiver.integration_s / 100.0 if obs.receiver is not None else obs.horizon * 1e-8,
+                     min(first, default=0.0)) / scale
     ax.set_ylim(t_lo, 2.0 * obs.horizon / scale)
     _few_log_ticks(ax)
-    ax.set_xlabel(PT.LABELS[key].replace("resolution", "resolution, log scale"))
+    ax.set_xlabel(PT.LABELS[key] + ", log scale")
     ax.set_ylabel(tl + ", log scale")
     ax.set_title(f"{key}: when do they part, across resolutions?")
     ax.grid(True, which="major", color="0.9", lw=0.6)
@@ -399,11 +401,14 @@ def _parting_panel(ax, obs: Observation, key: str, scale: float, tl: str) -> Non
 
 
 def _few_log_ticks(ax) -> None:
-    """At most ~8 labelled decades a log axis (a parting curve spans 20): fast to lay out, legible."""
-    from matplotlib.ticker import LogLocator, NullLocator
+    """At most ~8 labelled decades on a log axis (a parting curve spans 20): fast to lay out,
+    legible; an axis under two decades gets 1, 2, 5 in each."""
+    from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullLocator
 
-    for axis in (ax.xaxis, ax.yaxis):
-        axis.set_major_locator(LogLocator(numticks=8))
+    for axis, lim in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+        narrow = lim[0] > 0 and lim[1] / lim[0] < 100.0
+        axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0) if narrow else (1.0,), numticks=8 if not narrow else 12))
+        axis.set_major_formatter(LogFormatterSciNotation(labelOnlyBase=not narrow))
         axis.set_minor_locator(NullLocator())
 
 
@@ -600,10 +605,12 @@ def _log_ticks(ax, x) -> None:
 MIN_LINE = 1e-6
 
 
-def run_scene(sc, samples: int = 800, line_of_sight=None, distance_cm=None, receive: bool = True):
+def run_scene(sc, samples: int = 800, line_of_sight=None, distance_cm=None, receive: bool = True,
+              integration_s=None):
     """Simulate both models of scene ``sc`` over its ``[observe]`` horizon (or its own) at
-    ``observe_times`` and observe them with its receiver (its distance overridden by
-    ``distance_cm``; none with ``receive`` False): (Observation, trajectories)."""
+    ``observe_times`` and observe them with its receiver (its distance and integration time
+    overridden by ``distance_cm``, ``integration_s``; none with ``receive`` False):
+    (Observation, trajectories)."""
     from dataclasses import replace
 
     from ..driver import simulate_request
@@ -619,5 +626,7 @@ def run_scene(sc, samples: int = 800, line_of_sight=None, distance_cm=None, rece
     receiver = sc.observe.receiver
     if distance_cm is not None:
         receiver = replace(receiver, distance_cm=float(distance_cm))
+    if integration_s is not None:
+        receiver = replace(receiver, integration_s=float(integration_s))
     obs = observe(trajs, sc.title, los, receiver, omega0=sc.omega0, rtol=sc.rtol, receive=receive)
     return obs, trajs

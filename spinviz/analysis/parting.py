@@ -14,8 +14,9 @@ agree to first order in the rotation, not in the power -- so the fine resolution
 reaches part them early, where the integrated runs are not accurate enough: their relative
 errors are ~1e-11 (measured against (5.2), (5.4)).  For a top with the closed forms of
 ``physics.longitudinal`` (chi = 0 or delta = 0) the power and frequency differences are taken
-from them on a dense log grid (exact to round-off); otherwise from the runs, and resolutions
-below ten times the integrator's relative tolerance are left out (``floor``).
+from them on a dense log grid (exact to round-off: resolutions below 1e-14, fifty ulps of the
+frequency ratio, are left out); otherwise from the runs, and resolutions below ten times the
+integrator's relative tolerance are left out (``floor``).
 
 ``parting_time(t, D, r)`` is the first time the running maximum of D reaches r (linear
 interpolation), so it never decreases with r.
@@ -34,6 +35,7 @@ from .detector import Detection
 OBSERVABLES = ("power", "frequency", "polarization")
 MIN_LINEAR = 0.1
 DECISION_SIGMA = 5.0
+CLOSED_FLOOR = 1e-14          # fifty ulps of a ratio of two frequencies: below it the closed forms' difference is round-off
 LABELS = {"power": "relative power resolution σ_P/P", "frequency": "relative frequency resolution σ_f/f",
           "polarization": "polarization-angle resolution (°)"}
 # the resolutions the table lists (the polarization's in degrees at the boundary, radians inside)
@@ -159,7 +161,7 @@ def curves(a: Detection, b: Detection, start=None, tau0: float = 1.0, rtol: floa
         t = np.unique(np.concatenate([np.geomspace(horizon * 1e-12, horizon, 4000), a.t[a.t > 0]]))
         exact = exact_differences(t, start[0], start[1], tau0)
         for key in ("power", "frequency"):
-            out[key] = curve(key, t, exact[key], "closed forms (5.2), (5.4)", 0.0)
+            out[key] = curve(key, t, exact[key], "closed forms (5.2), (5.4)", CLOSED_FLOOR)
     else:
         for key in ("power", "frequency"):
             out[key] = curve(key, a.t, d[key], runs, floor)

@@ -99,16 +99,22 @@ class PfTest:
     notes: list = field(default_factory=list)
 
     def record(self) -> dict:
-        """The test as plain numbers (JSON)."""
+        """The test as plain numbers (JSON; None for an infinite or undefined number)."""
+        def num(x):
+            return float(x) if x is not None and math.isfinite(x) else None
+
         def law(x):
-            return {"params": x.params, "chi2": x.chi2, "dof": x.dof, "z_fit": x.z_fit}
+            return {"params": {k: num(v) for k, v in x.params.items()}, "chi2": num(x.chi2), "dof": x.dof,
+                    "z_fit": num(x.z_fit)}
 
         return {"measurements": self.n, "f_range_hz": list(self.f_range), "verdict": self.verdict,
-                "z_against_truncated": self.z, "exponent": self.exponent, "exponent_sigma": self.exponent_sigma,
-                "f_inf_hz": self.f_inf, "f_inf_interval_hz": list(self.f_inf_interval),
-                "f_inf_upper95_hz": self.f_inf_upper95, "f_inf_expected_hz": self.f_inf_expected,
-                "z_against_expected_reduced": self.z_expected, "truncated": law(self.truncated),
-                "reduced": law(self.reduced), "general": law(self.general), "notes": self.notes}
+                "z_against_truncated": num(self.z), "exponent": num(self.exponent),
+                "exponent_sigma": num(self.exponent_sigma), "f_inf_hz": num(self.f_inf),
+                "f_inf_interval_hz": [num(x) for x in self.f_inf_interval], "f_inf_upper95_hz": num(self.f_inf_upper95),
+                "f_inf_expected_hz": num(self.f_inf_expected), "z_against_expected_reduced": num(self.z_expected),
+                "reduced_law_rejected_outright": self.z_expected is not None and not math.isfinite(self.z_expected),
+                "truncated": law(self.truncated), "reduced": law(self.reduced), "general": law(self.general),
+                "notes": self.notes}
 
     def summary(self) -> list[str]:
         """The result in words, a few lines."""

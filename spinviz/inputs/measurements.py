@@ -39,7 +39,7 @@ MAX_ROWS = 1_000_000
 @request
 class MeasurementRow:
     """One measurement: the line's frequency f_hz and power (any unit), their 1-sigma errors,
-    and optionally the time t_s it was taken at."""
+    and optionally the time t_s of the measurement."""
 
     f_hz: Positive
     power: Positive

@@ -1,4 +1,4 @@
-"""A detector far away along a line of sight n: what it records from a run (issue 19).
+"""A detector far away along a line of sight n: what it records from a run.
 
 The far field is E = (d_ddot x n) x n / (c^2 R) at the retarded time t + R/c (a constant shift,
 left out: times are the source's).  Near each stored state the symmetric top's motion is its

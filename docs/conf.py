@@ -165,6 +165,7 @@ html_theme_options = {
 }
 # The section navigation only where there is a section to navigate: the API reference.
 html_sidebars = {page: [] for page in
-                 ("index", "getting_started", "scenes", "gallery", "physics", "integrators", "accuracy", "atlas")}
+                 ("index", "getting_started", "scenes", "gallery", "physics", "integrators", "accuracy", "atlas",
+                  "experiment")}
 html_show_sourcelink = False
 html_copy_source = False

@@ -9,16 +9,84 @@ path is checked before any work starts (``check_outputs``: not a directory, not 
 command's inputs, in a writable place), all are written to temporary files, and they are
 renamed into place together -- with stop signals held back for those few renames -- or all
 discarded.
+
+Reading is guarded the same way: ``open_regular`` opens a file only if it is a regular file
+(a FIFO would block the reader forever, a device never end, a directory or a socket fail
+deep inside a parser), and says at once what the path is instead.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import stat
 import tempfile
 
 from .errors import UsageError, shortened
 from .interrupt import deferred
+
+
+class NotRegularFile(OSError):
+    """A path a reader refuses at once: a directory, FIFO, device or socket where a regular
+    file is expected.  ``kind`` says which ("a named pipe (FIFO)", ...); ``strerror`` is the
+    one-line reason ("is a named pipe (FIFO), not a regular file")."""
+
+    def __init__(self, path, kind: str):
+        self.kind = kind
+        code = errno.EISDIR if kind == "a directory" else errno.EINVAL
+        super().__init__(code, f"is {kind}, not a regular file", os.fspath(path))
+
+
+def special_kind(mode: int) -> str | None:
+    """None for a regular file's ``st_mode``; otherwise what the path is, in words."""
+    if stat.S_ISREG(mode):
+        return None
+    for test, kind in ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a named pipe (FIFO)"),
+                       (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                       (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return kind
+    return "not a regular file"
+
+
+def open_regular(path, mode: str = "rb"):
+    """``path`` opened for reading (a file object, binary unless ``mode`` says "r") if it is a
+    regular file; ``NotRegularFile`` at once for a directory, FIFO, device or socket.
+
+    The open itself never blocks (O_NONBLOCK: a FIFO without a writer would hold ``open``
+    forever) and follows symbolic links as any reader does; the check is on the opened
+    descriptor (``fstat``), so the file read is the file checked.  ``FileNotFoundError``,
+    ``PermissionError`` and the rest are raised as ``open`` raises them."""
+    if mode not in ("rb", "r"):
+        raise ValueError(f"open_regular reads only ('rb' or 'r'), got {mode!r}")
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError as e:
+        if e.errno == errno.ENXIO:                  # a socket (or a device without its driver)
+            try:
+                kind = special_kind(os.stat(path).st_mode) or "not a regular file"
+            except OSError:
+                kind = "not a regular file"
+            raise NotRegularFile(path, kind) from None
+        raise
+    try:
+        kind = special_kind(os.fstat(fd).st_mode)
+        if kind is not None:
+            raise NotRegularFile(path, kind)
+        os.set_blocking(fd, True)
+        return os.fdopen(fd, mode, **({"encoding": "utf-8"} if mode == "r" else {}))
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def read_regular(path, limit: int | None = None) -> bytes:
+    """The bytes of the regular file ``path`` (``open_regular``); with ``limit``, at most
+    ``limit + 1`` bytes are read, so a caller can tell a file over its limit without reading
+    all of it."""
+    with open_regular(path) as fh:
+        return fh.read() if limit is None else fh.read(limit + 1)
 
 
 def _umask() -> int:

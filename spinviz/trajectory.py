@@ -17,7 +17,7 @@ import numpy as np
 
 from . import rotations as R
 from . import units as U
-from .atomic import atomic_path, plain
+from .atomic import atomic_path, open_regular, plain
 from .errors import SpecTypeError, TrajectoryFileError
 from .physics.bodies import Body
 from .physics.equations import angular_momentum_world, kinetic_energy
@@ -378,12 +378,14 @@ class Trajectory:
         stats and slow geometry as they were.
 
         Raises ``TrajectoryFileError`` (a ValueError naming the file) for a file that is missing,
-        unreadable, damaged or not a spinviz trajectory, never a zip, JSON or NumPy error."""
+        unreadable, damaged or not a spinviz trajectory, and at once for a path that is not a
+        regular file (a directory, FIFO, device or socket); never a zip, JSON or NumPy error."""
         if not isinstance(path, (str, bytes, os.PathLike)):
             raise SpecTypeError("path", f"must be the path of a .npz trajectory, got {type(path).__name__}")
         path = os.fsdecode(path)
         try:
-            with np.load(path, allow_pickle=False) as z:
+            # a regular file only: a FIFO or a device is refused at once, never waited on
+            with open_regular(path) as fh, np.load(fh, allow_pickle=False) as z:
                 if not hasattr(z, "files"):
                     raise TrajectoryFileError(path, "a single NumPy array, not a spinviz trajectory (.npz)")
                 if "metadata" not in z.files:

@@ -233,7 +233,9 @@ def wav_bytes(samples: np.ndarray, rate: int, title: str, mapping: Mapping) -> b
 def read_info(path) -> dict:
     """The LIST/INFO items of a WAV (INAM, ICMT, ...) and, from ICMT, the mapping as a dict
     under "mapping"."""
-    raw = open(path, "rb").read()
+    from ..atomic import read_regular
+
+    raw = read_regular(path)                  # a FIFO or device is refused at once, never waited on
     if raw[:4] != b"RIFF" or raw[8:12] != b"WAVE":
         raise ValueError(f"{path}: not a WAV file")
     out, pos = {}, 12

@@ -163,7 +163,13 @@ class Trajectory:
         field's two polarizations and dP/dOmega toward it.  See ``physics.radiation``.
 
         Where ``phase_resolved`` is False the world-frame directions of the fast vectors are not
-        physical (the invariants, L and the power per solid angle averaged over a turn are)."""
+        physical (the invariants, L and the power per solid angle averaged over a turn are).
+
+        ``line_of_sight`` is checked by the schema (``inputs.base.Direction``: three finite
+        numbers, not all zero; ``SpecError("line_of_sight", ...)``) before anything is computed."""
+        from .inputs.simulation import RadiationRequest
+
+        line_of_sight = RadiationRequest(line_of_sight=line_of_sight).line_of_sight
         try:
             import xarray as xr
         except ImportError:
@@ -206,7 +212,8 @@ class Trajectory:
         Parameters
         ----------
         times : array_like, shape (M,)
-            Instants within [t[0], t[-1]], in the run's time unit (s or tau0).
+            Finite instants within [t[0], t[-1]], in the run's time unit (s or tau0);
+            ``SpecError("times", ...)`` otherwise (``SpecTypeError`` for what is not numbers).
 
         Returns
         -------
@@ -221,13 +228,13 @@ class Trajectory:
         for a run whose spin phase is unresolved (``phase_resolved`` False) only the nodes
         and the slow geometry are meaningful.
         """
-        times = np.atleast_1d(np.asarray(times, dtype=float))
+        from .inputs.simulation import SampleRequest
+
         t = self.t
+        lo, hi = t[0], t[-1]
+        times = SampleRequest(times=times, start=float(lo), end=float(hi)).times   # SpecError("times", ...)
         if times.shape == t.shape and np.array_equal(times, t):
             return self                     # already stored at these instants (the renderer's case)
-        lo, hi = t[0], t[-1]
-        if np.any(times < lo - 1e-12 * abs(hi - lo)) or np.any(times > hi + 1e-12 * abs(hi - lo)):
-            raise ValueError(f"sample times must lie in [{lo:g}, {hi:g}]")
         times = np.clip(times, lo, hi)
         if t.size == 1:
             omega = np.repeat(self.omega, times.size, axis=0)

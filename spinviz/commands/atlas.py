@@ -15,7 +15,7 @@ import sys
 
 from ..errors import UsageError, printable
 from ..interrupt import Interrupted, check
-from .shared import positive, real
+from .shared import positive, real, reals
 
 EVIDENCE = ("validate", "crosscheck", "physical", "convergence", "tolerance")
 
@@ -56,7 +56,7 @@ def add_parser(sub) -> None:
     ev.add_argument("--members", type=positive, help="starts per point (default: validate 32, crosscheck 3, physical 4, "
                                                      "convergence 32, tolerance 8)")
     ev.add_argument("--tau-end", type=real, help="physical: the horizon (default 1e10)")
-    ev.add_argument("--horizons", metavar="LIST", help="convergence: the horizons (default 1e10,1e12,1e14)")
+    ev.add_argument("--horizons", metavar="LIST", type=reals, help="convergence: the horizons (default 1e10,1e12,1e14)")
 
 
 def run(args) -> int:

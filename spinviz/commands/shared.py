@@ -70,6 +70,17 @@ def positive(text: str) -> int:
     return v
 
 
+def reals(text: str) -> tuple[float, ...]:
+    """A comma-separated list of numbers (their ranges are the schema's)."""
+    try:
+        out = tuple(float(x) for x in text.split(",") if x.strip())
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected numbers separated by commas, got {text!r}") from None
+    if not out:
+        raise argparse.ArgumentTypeError(f"expected numbers separated by commas, got {text!r}")
+    return out
+
+
 def names(text: str) -> tuple[str, ...]:
     """A comma-separated list of names."""
     out = tuple(x.strip() for x in text.split(",") if x.strip())

@@ -112,6 +112,10 @@ def _run(args) -> int:
         # line, not a traceback (SPINVIZ_DEBUG=1 shows the traceback)
         if os.environ.get("SPINVIZ_DEBUG"):
             raise
+        status = getattr(e, "exit_status", None)
+        if isinstance(status, int):                     # a failure with its own status (a busy store: 75)
+            say("error: ", e)
+            return status
         what = getattr(e, "filename", None) if isinstance(e, OSError) else None
         if isinstance(e, OSError) and what is None and getattr(args, "out", None):
             what = args.out                                 # e.g. a full disk while writing the output

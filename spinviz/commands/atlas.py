@@ -3,9 +3,11 @@
 ``spinviz atlas --evidence KIND``.
 
 Exit statuses of its own: 75 when the cluster failed and runs were not computed (sysexits'
-EX_TEMPFAIL: the same command resumes), 1 when tasks failed as a whole, 128 + the signal
-after a stop; for ``--verify``, 0 (every chunk matches its checksums) or 1 (damaged), 2 (not
-an atlas store).
+EX_TEMPFAIL: the same command resumes) or when another command holds the store's lock (the
+same command works once that one has finished), 1 when tasks failed as a whole, 128 + the
+signal after a stop; for ``--verify``, 0 (the whole atlas its spec implies, every chunk
+matching its checksums) or 1 (damaged, incomplete, a level missing or foreign), 2 (not an
+atlas store).
 """
 
 from __future__ import annotations
@@ -136,15 +138,18 @@ def _bench(spec, args) -> int:
 
 def verify(path: str, as_json: bool = False) -> int:
     """``--verify STORE``: one line per variable (chunks intact, or the damaged ones named),
-    the metadata, and a verdict, for the store and each refinement level; 0 if everything
-    matches its checksums, 1 if not."""
+    the metadata and the spec, and a verdict, for the store and each refinement level its spec
+    implies; 0 if every level the spec implies is present, whole (every file matches its
+    checksum, every run computed) and of this spec, 1 if not (what is missing, damaged or
+    foreign named)."""
     from ..regimes.store.verify import report
 
     r = report(path)
     if as_json:
         first = r["reports"][0]
         print(json.dumps({"path": path, "ok": r["ok"], "lines": first["lines"], "runs_verified": r["runs_verified"],
-                          "damaged_chunks": r["damaged_chunks"], "levels": r["reports"][1:]}, indent=2))
+                          "damaged_chunks": r["damaged_chunks"], "problems": r["problems"], "levels": r["reports"][1:]},
+                         indent=2))
     else:
         many = len(r["reports"]) > 1
         for level in r["reports"]:

@@ -13,10 +13,11 @@ atlas store).
 from __future__ import annotations
 
 import json
+import os
 import sys
 
 from ..errors import UsageError, printable
-from ..interrupt import Interrupted, check
+from ..interrupt import check
 from .shared import positive, real, reals
 
 EVIDENCE = ("validate", "crosscheck", "physical", "convergence", "tolerance")
@@ -63,7 +64,7 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     """Carry out ``spinviz atlas`` with the parsed ``args``; return its exit status."""
-    from ..regimes.api import RUNS_PER_TASK, atlas, default_out
+    from ..regimes.api import RUNS_PER_TASK, atlas
     from ..regimes.faults import AtlasIncomplete
 
     if args.verify is not None:
@@ -96,13 +97,6 @@ def run(args) -> int:
                     progress=not args.quiet, runs_per_task=args.runs_per_task or RUNS_PER_TASK,
                     retry_failed=args.retry_failed)
         check()                                       # a signal that reached a library that swallowed it
-    except Interrupted as e:
-        # said here, not by the command line's generic "nothing was written": the finished
-        # chunks are on disk, and that is the point
-        out = args.out or default_out(spec)
-        print(f"spinviz: atlas stopped by {e}; every finished chunk is in {printable(out, 200)} and the same command "
-              f"computes only what is missing", file=sys.stderr)
-        return e.exit_status
     except AtlasIncomplete as e:
         print(f"spinviz: {printable(e.cli_message())}", file=sys.stderr)
         return e.exit_status
@@ -119,6 +113,20 @@ def run(args) -> int:
         for path in res.plots:
             print(printable(path, 2000))
     return 0
+
+
+def stopped(args, signal_name) -> str:
+    """The one line of an atlas command stopped by a signal (wherever it landed): the finished
+    chunks are on disk and the same command completes the store -- that is the point."""
+    from ..regimes.api import default_out
+
+    if args.verify is not None or args.evidence is not None or args.bench or args.spec is None:
+        return f"interrupted by {signal_name}; nothing was written"
+    out = args.out or default_out(args.spec)
+    if not os.path.isdir(out):
+        return f"atlas stopped by {signal_name} before its store was made; nothing was written"
+    return (f"atlas stopped by {signal_name}; every finished chunk is in {printable(out, 200)} and the same command "
+            f"computes only what is missing")
 
 
 def _bench(spec, args) -> int:

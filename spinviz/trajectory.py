@@ -167,7 +167,7 @@ class Trajectory:
 
         ``line_of_sight`` is checked by the schema (``inputs.base.Direction``: three finite
         numbers, not all zero; ``SpecError("line_of_sight", ...)``) before anything is computed."""
-        from .inputs.simulation import RadiationRequest
+        from .inputs.trajectory import RadiationRequest
 
         line_of_sight = RadiationRequest(line_of_sight=line_of_sight).line_of_sight
         try:
@@ -228,7 +228,7 @@ class Trajectory:
         for a run whose spin phase is unresolved (``phase_resolved`` False) only the nodes
         and the slow geometry are meaningful.
         """
-        from .inputs.simulation import SampleRequest
+        from .inputs.trajectory import SampleRequest
 
         t = self.t
         lo, hi = t[0], t[-1]

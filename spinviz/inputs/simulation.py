@@ -18,7 +18,7 @@ from pydantic import Field, PlainValidator, model_validator
 
 from ..errors import SpecError, brief
 from ..physics.bodies import Body
-from .base import Direction, Int, Positive, Real, at_most, between, request, vector, wrong_type
+from .base import Int, Positive, Real, at_most, between, request, vector, wrong_type
 
 MODELS = ("reduced", "truncated", "free")
 KINEMATICS = ("quaternion", "euler_zxz", "none")
@@ -185,46 +185,3 @@ class SimulationRequest:
         """atol, or rtol / 100 when not given (in spin units the state is O(1): atol >= rtol would rule)."""
         return self.rtol * 1e-2 if self.atol is None else self.atol
 
-
-# --- the arguments of a Trajectory's methods ----------------------------------------------------
-def _sample_times(v):
-    """Instants to sample at: a number or a 1-D list or array of finite numbers (any order)."""
-    if isinstance(v, str | bytes | bool) or v is None:
-        raise wrong_type(f"must be a time or a list of times, got {brief(v)}")
-    if hasattr(v, "__len__") and len(v) > MAX_SAMPLES:
-        raise ValueError(f"must hold at most {MAX_SAMPLES} instants (memory), got {len(v)}")
-    try:
-        a = np.atleast_1d(np.array(v, dtype=float))
-    except (TypeError, ValueError):
-        raise wrong_type(f"must be a time or a list of times, got {brief(v)}") from None
-    if a.ndim != 1 or a.size < 1:
-        raise ValueError(f"must be a time or a 1-D list of at least one, got shape {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"must be finite, got {brief(v)}")
-    return a
-
-
-@request(eq=False)
-class SampleRequest:
-    """``Trajectory.sample(times)``: finite instants within the run, [start, end] (the stored
-    first and last instants; a relative 1e-12 of the span beyond an end is the end itself)."""
-
-    times: Annotated[np.ndarray, PlainValidator(_sample_times)]
-    start: Real
-    end: Real
-
-    @model_validator(mode="after")
-    def _inside(self):
-        slack = 1e-12 * abs(self.end - self.start)
-        outside = self.times[(self.times < self.start - slack) | (self.times > self.end + slack)]
-        if outside.size:
-            raise SpecError("times", f"must lie in [{self.start:g}, {self.end:g}] (the run's stored span: sampling "
-                                     f"interpolates, it never integrates), got {outside[0]:g}")
-        return self
-
-
-@request
-class RadiationRequest:
-    """``Trajectory.radiation(line_of_sight)``: a world-frame direction (``base.Direction``) or None."""
-
-    line_of_sight: Direction | None = None

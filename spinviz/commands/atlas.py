@@ -135,6 +135,10 @@ def _bench(spec, args) -> int:
     if args.out or args.scheduler or args.plot:
         raise UsageError("--bench: measures on temporary stores and the embedded cluster; drop --out, --scheduler "
                          "and --plot")
+    unused = [o for o, v in (("--runs-per-task", args.runs_per_task), ("--retry-failed", args.retry_failed),
+                             ("--workers", args.workers if args.write_path else None)) if v]
+    if unused:                                        # never ignored in silence
+        raise UsageError(f"{unused[0]}: not used by --bench{' --write-path' if args.write_path else ''}")
     if args.write_path:
         rows = bench.store_cost(spec)
         print(bench.format_store_cost(rows) if not args.json else json.dumps(rows, indent=2, default=float))

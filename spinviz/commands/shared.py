@@ -112,7 +112,10 @@ def size(text: str):
 # --- reports ------------------------------------------------------------------------------
 def say(prefix: str, message) -> None:
     """One line on stderr, control characters escaped and cut: nothing from a file or a key
-    name can colour, clear or split the terminal."""
+    name can colour, clear or split the terminal.  Nothing when stderr was closed before the
+    command started (``print`` would otherwise write the line to stdout)."""
+    if sys.stderr is None:
+        return
     print(f"spinviz: {prefix}{printable(message)}", file=sys.stderr)
 
 

@@ -92,6 +92,35 @@ def test_a_level_without_its_zgroup_is_computed_again(refined_atlas, copy, capsy
     same_atlas(copy, refined_atlas.store)
 
 
+def test_a_level_carrying_another_atlas_identity_is_foreign(refined_atlas, copy, capsys, tmp_path):
+    """Fast: level 1 relabelled, checksums and all, as the level of the same grid from seed 4
+    (the identity a copied level of that atlas carries): --verify says FOREIGN, exit 1."""
+    import tomllib
+
+    from atlasdata import refined_spec
+
+    from spinviz.inputs.atlas_spec import parse_spec
+    from spinviz.regimes.store import integrity as IN
+
+    other = parse_spec(tomllib.loads(refined_spec(4)), str(tmp_path / "other.toml"))
+    level = copy / "level1"
+
+    def write():
+        g = zarr.open_group(str(level), mode="r+", zarr_format=2)
+        g.attrs["spec"] = LV.level_spec(other, 1).canonical_json()
+        g.attrs["spec_sha256"] = LV.level_identity(other, 1)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")           # zarr on the store's .checksums: not one of its arrays
+            zarr.consolidate_metadata(str(level), zarr_format=2)
+
+    IN.rewrite_metadata(str(level), [".zattrs", ".zmetadata"], write)
+    code, lines = verify(copy, capsys)
+    assert code == 1 and any(x.startswith("level 1: FOREIGN: holds a level of another atlas") for x in lines), lines
+    with pytest.raises(ForeignLevel, match=r"level1: holds a refinement level of another atlas"):
+        resume(refined_atlas, copy)
+
+
+@pytest.mark.slow
 def test_a_level_of_another_atlas_is_foreign_refused_and_named(refined_atlas, copy, capsys):
     """A level copied from an atlas of another seed verified "ok: 104 runs verified over 2
     refinement levels"; only the resume noticed.  Now --verify names it, and the resume refuses

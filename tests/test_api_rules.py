@@ -45,7 +45,8 @@ def refused(call, kind, key):
     ([], SpecError, "must be a time or a 1-D list of at least one, got shape (0,)"),
 ])
 def test_sample_refuses_times_it_cannot_honour(run, times, kind, reason):
-    """``sample([nan])`` returned a trajectory of NaN, ``sample([1e300])`` raised a plain ValueError."""
+    """NaN, infinite or out-of-span times, and what is not times: a ``SpecError`` naming
+    ``times``, never a trajectory of NaN or a plain ValueError."""
     assert reason in refused(lambda: run.sample(times), kind, "times")
 
 
@@ -62,7 +63,7 @@ def test_sample_inside_the_span_still_interpolates(run):
     ((math.nan, 0.0, 1.0), SpecError, "must be finite"),
 ])
 def test_radiation_line_of_sight_through_the_schema(run, los, kind, reason):
-    """``radiation(line_of_sight=(0, 0, 0))`` or ``'abc'`` raised a plain ValueError."""
+    """A zero, non-finite or malformed line of sight: the schema's typed error naming it."""
     assert reason in refused(lambda: run.radiation(line_of_sight=los), kind, "line_of_sight")
 
 
@@ -136,8 +137,9 @@ def test_one_rule_for_a_line_of_sight(v):
     (lambda: P.dast_family1(c_nm=None), SpecTypeError, "c_nm"),
 ])
 def test_body_constructors_raise_the_schemas_errors(call, kind, key):
-    """``symmetric_top(nan, 0)`` and a two-value ``Body`` inertia raised ``BodyError``, outside
-    ``SpecError``; strings raised Python's own ValueError."""
+    """``symmetric_top(nan, 0)``, a two-value ``Body`` inertia, strings where numbers go: a
+    ``SpecError`` (``SpecTypeError`` for the wrong kind) naming the argument -- ``BodyError``
+    is one."""
     refused(call, kind, key)
 
 

@@ -66,10 +66,10 @@ def lines_for(name: str, out) -> set:
 def test_a_stop_signal_at_any_instant_of_an_atlas(refined_atlas, tmp_path):
     """Half the instants on a new store (spec, cluster start, level 0, level 1's creation and
     runs, the pictures, shutdown), half on a store holding level 0 only (the cluster started
-    for the refinement level).  (Before: a SIGINT during a refinement level could end the
-    command by the signal itself with nothing on stderr, a signal during the shutdown killed it
-    unreported, asyncio printed "Future exception was never retrieved" tracebacks, and a worker
-    being started when the stop came kept the command waiting in multiprocessing's exit hook.)"""
+    for the refinement level).  What can go wrong at such instants: the process ended by the
+    signal itself with nothing on stderr (its default action, in the interpreter's shutdown),
+    library tracebacks (asyncio's "Future exception was never retrieved"), a worker being
+    started when the stop came keeping the command waiting in multiprocessing's exit hook."""
     rng = random.Random(25)
     level0 = tmp_path / "level0.zarr"                         # the reference without its refinement level
     shutil.copytree(refined_atlas.store, level0)

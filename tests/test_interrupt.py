@@ -95,9 +95,9 @@ def methods_run(monkeypatch):
 
 
 def test_a_signal_as_the_command_ends_is_its_exit_status_and_its_one_line(methods_run, capsys):
-    """A signal after the work (the report being printed, the interpreter shutting down) ended
-    the process by the signal itself, unreported: it is held from the end of the work on and
-    reported with the status it would have had."""
+    """A signal after the work (the report being printed, the interpreter shutting down) is
+    held from the end of the work on and reported, with 128 + the signal and the status the
+    command would have had -- never left to its default action, which kills unreported."""
     from spinviz.commands import main
 
     def late():

@@ -35,7 +35,8 @@ def no_work(monkeypatch):
 
 
 REFUSED = [
-    # the cases: unbounded work, raw Python/NumPy messages, a silent default, an internal key
+    # unbounded work, values a raw Python/NumPy message would meet, a zero that is not the default,
+    # a count the kind's own atlas would refuse under its key
     (["atlas", "--evidence", "physical", "--tau-end", "1e300"], "--tau-end: must lie in [100000, 1e+16]"),
     (["atlas", "--evidence", "convergence", "--horizons", "1e10,1e300"], "--horizons: each must lie in [100000, 1e+16]"),
     (["atlas", "--evidence", "physical", "--tau-end", "nan"], "--tau-end: must be finite, got nan"),

@@ -158,7 +158,7 @@ def test_any_options_get_acceptance_or_one_line(world, capsys, command, data):
         assert code == 2, (argv, code, err)                            # refused, the work never reached
 
 
-FOUND = [   # what the long hunt (HYPOTHESIS_PROFILE=fuzz) found reaching the work: kept as cases
+FOUND = [   # combinations a long hunt (HYPOTHESIS_PROFILE=fuzz) turns up, checked in every run
     (["atlas", "SPEC", "--workers", "1" + "0" * 40, "--bench"], "--workers: must be at most"),
     (["render", SCENE, "--duration", "nan", "--bench"], "--duration: must be finite, got nan"),
     (["render", SCENE, "--bench", "--frames", "1" + "0" * 40], "--frames: must lie in [2, "),

@@ -5,9 +5,8 @@ Outside values: the ``#open=`` part of the page's own address (anyone's to write
 and what the store holds -- its title, model names, the labels and places of the series.
 Each payload, if it ever ran, would set ``document.title`` to ``PWNED``; Chromium opens the
 page and its DOM is read afterwards (``--dump-dom``): no payload ran, none of it became an
-element, and it shows as text where the page shows it.  (Before: ``#open=<img src=x
-onerror=...>`` ran the attacker's script -- the fragment went into ``innerHTML`` -- and model
-names went into the markup unescaped.)"""
+element, and it shows as text where the page shows it.  (A fragment put into
+``innerHTML`` runs ``#open=<img src=x onerror=...>``'s script for whoever opens the link.)"""
 
 import base64
 import hashlib
@@ -24,7 +23,7 @@ from spinviz.regimes.figures import page as PG
 
 PAYLOAD = "document.title='PWNED'"
 HOSTILE = [
-    f"<img src=x onerror={PAYLOAD}>",                                        # the form that ran before
+    f"<img src=x onerror={PAYLOAD}>",                                        # runs if put into innerHTML
     f"<img src=x onerror=\"{PAYLOAD}\">",
     f"<svg onload={PAYLOAD}>",
     f"</title><script>{PAYLOAD}</script>",

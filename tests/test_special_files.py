@@ -78,7 +78,8 @@ def test_the_shared_reader_refuses_what_is_not_a_regular_file(tmp_path, kind):
 
 @pytest.mark.parametrize("kind", KINDS)
 def test_trajectory_load_refuses_a_special_file_at_once(tmp_path, kind):
-    """``Trajectory.load`` of a FIFO blocked forever (the scene loader refused it at once)."""
+    """``Trajectory.load`` refuses a FIFO at once, as the scene loader does (a reader of a FIFO
+    without a writer would wait forever)."""
     p = special(tmp_path, kind)
     e = at_once(lambda: spinviz.Trajectory.load(p), p)
     assert isinstance(e, TrajectoryFileError) and str(e) == f"{p}: {WORDS[kind]}"

@@ -67,7 +67,8 @@ def test_the_reference_verifies_ok_over_both_levels(refined_atlas, capsys):
 
 
 def test_a_deleted_level_is_missing_not_ok_and_the_resume_computes_it(refined_atlas, copy, capsys):
-    """``rm -r STORE/level1`` gave "ok: 24 runs verified", exit 0, with 80 of 104 runs gone."""
+    """``rm -r STORE/level1``: 80 of the 104 runs gone is not "ok" -- the spec implies level 1,
+    so it is named missing, exit 1; the resume computes it, and only it."""
     shutil.rmtree(copy / "level1")
     code, lines = verify(copy, capsys)
     assert code == 1, lines
@@ -80,8 +81,9 @@ def test_a_deleted_level_is_missing_not_ok_and_the_resume_computes_it(refined_at
 
 
 def test_a_level_without_its_zgroup_is_computed_again(refined_atlas, copy, capsys):
-    """Deleting only ``level1/.zgroup`` gave "ok"; the resume then refused with a false "level1:
-    appeared while the atlas was being created" and no way forward."""
+    """Only ``level1/.zgroup`` deleted: the level is not a whole store, named so by --verify;
+    the resume removes it and computes it again, in one line (a level can always be
+    recomputed from the spec and the levels below)."""
     (copy / "level1" / ".zgroup").unlink()
     code, lines = verify(copy, capsys)
     assert code == 1 and "level 1: DAMAGED: no .zgroup: not a whole Zarr store" in lines, lines
@@ -122,9 +124,9 @@ def test_a_level_carrying_another_atlas_identity_is_foreign(refined_atlas, copy,
 
 @pytest.mark.slow
 def test_a_level_of_another_atlas_is_foreign_refused_and_named(refined_atlas, copy, capsys):
-    """A level copied from an atlas of another seed verified "ok: 104 runs verified over 2
-    refinement levels"; only the resume noticed.  Now --verify names it, and the resume refuses
-    it -- touching nothing -- with the one command that removes it; after which it computes."""
+    """A level copied from an atlas of another seed is whole and checksummed, but of another
+    atlas: --verify names it FOREIGN (both identities), and the resume refuses it -- touching
+    nothing -- with the one command that removes it; after which it computes this atlas's."""
     shutil.rmtree(copy / "level1")
     shutil.copytree(refined_atlas.foreign / "level1", copy / "level1")
     code, lines = verify(copy, capsys)

@@ -87,6 +87,7 @@ def test_a_level_without_its_zgroup_is_computed_again(refined_atlas, copy, capsy
     (copy / "level1" / ".zgroup").unlink()
     code, lines = verify(copy, capsys)
     assert code == 1 and "level 1: DAMAGED: no .zgroup: not a whole Zarr store" in lines, lines
+    assert lines[-1] == f"{copy}: DAMAGED LEVEL: level1 not a whole store (the same atlas command computes it again)"
     res = resume(refined_atlas, copy)
     assert res.computed == 80
     assert capsys.readouterr().err.strip() == (f"spinviz: {copy / 'level1'}: no .zgroup: not a whole Zarr store; the "

@@ -111,7 +111,7 @@ def _judge_level(spec, lpath: str, k: int, cells, problems: list) -> dict:
         return _entry(lpath, k, [f"MISSING: the labels of level {k - 1} call for {int(cells.sum())} of its cells "
                                  f"([refine] levels = {spec.refine_levels})"], None, ok=False)
     if st.kind == "damaged":
-        problems.append(("missing", f"level{k} not a whole store (the same atlas command computes it again)"))
+        problems.append(("damaged level", f"level{k} not a whole store (the same atlas command computes it again)"))
         return _entry(lpath, k, [f"DAMAGED: {st.why}"], None, ok=False)
     if st.kind == "foreign":
         problems.append(("foreign", f"level{k} is of another atlas (rm -r {lpath}, then the same atlas command)"))
@@ -150,9 +150,9 @@ def _complete(entry: dict, path: str, cells, problems: list) -> None:
         entry["lines"].append(f"runs: all {want} computed")
 
 
-ORDER = ("metadata", "foreign", "damaged", "missing", "incomplete", "extra")
-WORD = {"metadata": "DAMAGED", "foreign": "FOREIGN LEVEL", "damaged": "DAMAGED", "missing": "MISSING LEVEL",
-        "incomplete": "INCOMPLETE", "extra": "NOT OK"}
+ORDER = ("metadata", "foreign", "damaged", "damaged level", "missing", "incomplete", "extra")
+WORD = {"metadata": "DAMAGED", "foreign": "FOREIGN LEVEL", "damaged": "DAMAGED", "damaged level": "DAMAGED LEVEL",
+        "missing": "MISSING LEVEL", "incomplete": "INCOMPLETE", "extra": "NOT OK"}
 
 
 def _verdict(path: str, reports: list, problems: list) -> dict:

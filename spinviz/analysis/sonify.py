@@ -333,9 +333,13 @@ def listen_scene(sc, out_wav: str, out_png: str | None, duration: float = 20.0, 
                  dynamic_range_db: float = 60.0, pitch: str = "auto"):
     """Simulate and detect both models of scene ``sc`` (``observe.run_scene``), synthesize and
     write the WAV (and its spectrogram PNG); returns the Mapping.  The caller makes the paths
-    atomic as a group (these write in place)."""
+    atomic as a group (these write in place).  The sound's arguments are checked first
+    (``inputs.options.ListenRequest``: ``SpecError`` naming the argument), before the runs."""
+    from ..inputs.options import ListenRequest
     from .observe import run_scene
 
+    ListenRequest(duration=duration, f0=f0, time_map=time_map, pitch=pitch, dynamic_range_db=dynamic_range_db,
+                  samples=samples)
     obs, _ = run_scene(sc, samples, line_of_sight, distance_cm)
     # the log map's knee: a tenth of the braking time 1/(tau0 |Omega0|^2), where the motion starts to
     # change, unless t_end/1000 comes first (a geological horizon must not spend its first second on nothing)

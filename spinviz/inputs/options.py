@@ -249,3 +249,21 @@ class EvidenceRequest:
         horizons = self.horizons or (1e10, 1e12, 1e14)
         units = sum(math.sqrt(h / horizons[0]) for h in horizons) + 4
         return 14 * n * units * CONVERGENCE_S_PER_RUN * math.sqrt(horizons[0] / 1e10)
+
+
+# --- listen ------------------------------------------------------------------------------------
+SOUND_SECONDS = (0.5, 600.0, "seconds of sound")
+LISTEN_SAMPLES = 100_000         # instants of each model's run (the detector's memory per instant)
+
+
+@request
+class ListenRequest:
+    """``spinviz listen``'s sound (``analysis.sonify.listen_scene``): how long, at which pitch,
+    how sound time and pitch follow the run's, how much dynamic range, from how many instants."""
+
+    duration: Annotated[Real, between(*SOUND_SECONDS)] = 20.0
+    f0: Annotated[Real, between(20.0, 5000.0, "Hz: audible, well under the Nyquist frequency")] = 440.0
+    time_map: Literal["log", "linear"] = "log"
+    pitch: Literal["auto", "linear"] = "auto"
+    dynamic_range_db: Annotated[Real, between(1.0, 120.0, "dB of sound")] = 60.0
+    samples: Annotated[Int, between(2, LISTEN_SAMPLES, "instants of each model's run")] = 800

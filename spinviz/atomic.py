@@ -120,7 +120,9 @@ class AtomicPath:
 
     def commit(self):
         """Rename the finished temporary file over ``path`` (one atomic ``os.replace``), with the
-        permissions a new file would get."""
+        permissions a new file would get.  Never over a FIFO, device or socket (a rename would
+        replace the node itself: /dev/null, for one): ``UsageError``."""
+        refuse_special_output(self.path)
         os.chmod(self.tmp, 0o666 & ~_umask())
         os.replace(self.tmp, self.path)
 
@@ -228,6 +230,27 @@ def check_parent_writable(p: str) -> None:
         raise UsageError(f"{p}: cannot write in {d} (permission denied)")
 
 
+def refuse_special_output(p) -> None:
+    """``UsageError`` for an output path that names a FIFO, device or socket: an output is a
+    new regular file renamed into place, and renaming over such a node would replace the node
+    (as root, /dev/null itself)."""
+    try:
+        kind = special_kind(os.lstat(p).st_mode)
+    except OSError:
+        return                                         # nothing there (or not reachable: said when written)
+    if kind is not None and kind != "a directory" and not os.path.islink(p):
+        raise UsageError(f"{shortened(p)}: {kind}, not a regular file; an output is a file written whole and renamed "
+                         f"into place: choose a file path")
+    if os.path.islink(p):
+        try:
+            kind = special_kind(os.stat(p).st_mode)
+        except OSError:
+            return
+        if kind is not None and kind != "a directory":
+            raise UsageError(f"{shortened(p)}: links to {kind}, not a regular file; an output is a file written whole and "
+                             f"renamed into place: choose a file path")
+
+
 def check_outputs(paths, inputs=()) -> list[str]:
     """Refuse, before any work, an output that cannot be written or must not be: a
     directory, one of the command's own inputs, a path named twice, a place without write
@@ -242,6 +265,7 @@ def check_outputs(paths, inputs=()) -> list[str]:
         seen.add(real)
         if os.path.isdir(p):
             raise UsageError(f"{p}: is a directory; an output must be a file path")
+        refuse_special_output(p)
         for i in inputs:
             i = os.fspath(i)
             if os.path.exists(p) and os.path.exists(i) and os.path.samefile(p, i):

@@ -163,3 +163,32 @@ def test_resume_recomputes_a_chunk_a_fifo_replaced(store, small_atlas_spec, tmp_
     assert box["res"].repaired == 9 and box["res"].computed == 9
     assert np.array_equal(ST.regime_codes(str(s)), ST.regime_codes(str(store)))
     assert "regime/0.1.0.0 (is a named pipe (FIFO), not a regular file)" in capsys.readouterr().err
+
+
+# --- outputs ------------------------------------------------------------------------------------
+@pytest.mark.parametrize("kind", ["fifo", "device", "socket"])
+def test_an_output_is_never_renamed_over_a_special_file(tmp_path, kind):
+    """An output lands by renaming a finished file over its path: over a FIFO, a device or a
+    socket that would replace the node itself (as root, /dev/null), so it is refused -- before
+    any work by the commands' output checks, and by the atomic write itself."""
+    from spinviz.atomic import check_outputs, write_text
+    from spinviz.errors import UsageError
+
+    p = special(tmp_path, kind)
+    before = os.lstat(p)
+    for call in (lambda: check_outputs([p]), lambda: write_text(p, "x")):
+        with pytest.raises(UsageError, match="not a regular file; an output is a file written whole"):
+            call()
+    after = os.lstat(p)
+    assert (after.st_ino, after.st_mode) == (before.st_ino, before.st_mode)
+    assert [x.name for x in tmp_path.iterdir() if "partial" in x.name] == []
+
+
+@pytest.mark.parametrize("argv", [["bench", "--json", "{p}"], ["report", "--out", "{p}"],
+                                  ["atlas", "{spec}", "--out", "{p}"]])
+def test_commands_refuse_a_special_output_before_any_work(tmp_path, capsys, small_atlas_spec, argv):
+    p = special(tmp_path, "fifo")
+    argv = [a.replace("{p}", str(p)).replace("{spec}", str(small_atlas_spec)) for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(p) in err and "named pipe (FIFO)" in err, err

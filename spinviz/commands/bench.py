@@ -24,8 +24,10 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     """Carry out ``spinviz bench`` with the parsed ``args``; return its exit status."""
-    from ..atomic import write_json
+    from ..atomic import check_outputs, write_json
     from ..validation import bench
+
+    check_outputs([x for x in (args.json, args.plot) if x])      # before the minutes of work, not after
 
     if args.process:
         from ..validation import process_bench as PB

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..atomic import check_parent_writable
+from ..atomic import check_parent_writable, special_kind
 from ..errors import SpecTypeError, UsageError, printable
 from ..inputs.atlas import AtlasArguments
 from ..inputs.atlas_spec import AtlasSpec, check_feasible, load_spec
@@ -148,7 +148,8 @@ def _runs_of(mask: np.ndarray) -> list[tuple[int, int]]:
 def check_out(path: str, spec_path: str | None = None) -> None:
     """The store path: a directory to be created, or an existing atlas store (checked later)."""
     if os.path.exists(path) and not os.path.isdir(path):
-        raise UsageError(f"{path}: exists and is a file; an atlas store is a directory (e.g. atlas.zarr)")
+        kind = special_kind(os.stat(path).st_mode) or "a file"
+        raise UsageError(f"{path}: exists and is {kind}; an atlas store is a directory (e.g. atlas.zarr)")
     if spec_path and os.path.exists(path) and os.path.exists(spec_path) and os.path.samefile(path, spec_path):
         raise UsageError(f"{path}: is the spec itself")
     check_parent_writable(path)

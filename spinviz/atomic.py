@@ -9,16 +9,84 @@ path is checked before any work starts (``check_outputs``: not a directory, not 
 command's inputs, in a writable place), all are written to temporary files, and they are
 renamed into place together -- with stop signals held back for those few renames -- or all
 discarded.
+
+Reading is guarded the same way: ``open_regular`` opens a file only if it is a regular file
+(a FIFO would block the reader forever, a device never end, a directory or a socket fail
+deep inside a parser), and says at once what the path is instead.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import stat
 import tempfile
 
 from .errors import UsageError, shortened
 from .interrupt import deferred
+
+
+class NotRegularFile(OSError):
+    """A path a reader refuses at once: a directory, FIFO, device or socket where a regular
+    file is expected.  ``kind`` says which ("a named pipe (FIFO)", ...); ``strerror`` is the
+    one-line reason ("is a named pipe (FIFO), not a regular file")."""
+
+    def __init__(self, path, kind: str):
+        self.kind = kind
+        code = errno.EISDIR if kind == "a directory" else errno.EINVAL
+        super().__init__(code, f"is {kind}, not a regular file", os.fspath(path))
+
+
+def special_kind(mode: int) -> str | None:
+    """None for a regular file's ``st_mode``; otherwise what the path is, in words."""
+    if stat.S_ISREG(mode):
+        return None
+    for test, kind in ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a named pipe (FIFO)"),
+                       (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                       (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return kind
+    return "not a regular file"
+
+
+def open_regular(path, mode: str = "rb"):
+    """``path`` opened for reading (a file object, binary unless ``mode`` says "r") if it is a
+    regular file; ``NotRegularFile`` at once for a directory, FIFO, device or socket.
+
+    The open itself never blocks (O_NONBLOCK: a FIFO without a writer would hold ``open``
+    forever) and follows symbolic links as any reader does; the check is on the opened
+    descriptor (``fstat``), so the file read is the file checked.  ``FileNotFoundError``,
+    ``PermissionError`` and the rest are raised as ``open`` raises them."""
+    if mode not in ("rb", "r"):
+        raise ValueError(f"open_regular reads only ('rb' or 'r'), got {mode!r}")
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError as e:
+        if e.errno == errno.ENXIO:                  # a socket (or a device without its driver)
+            try:
+                kind = special_kind(os.stat(path).st_mode) or "not a regular file"
+            except OSError:
+                kind = "not a regular file"
+            raise NotRegularFile(path, kind) from None
+        raise
+    try:
+        kind = special_kind(os.fstat(fd).st_mode)
+        if kind is not None:
+            raise NotRegularFile(path, kind)
+        os.set_blocking(fd, True)
+        return os.fdopen(fd, mode, **({"encoding": "utf-8"} if mode == "r" else {}))
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def read_regular(path, limit: int | None = None) -> bytes:
+    """The bytes of the regular file ``path`` (``open_regular``); with ``limit``, at most
+    ``limit + 1`` bytes are read, so a caller can tell a file over its limit without reading
+    all of it."""
+    with open_regular(path) as fh:
+        return fh.read() if limit is None else fh.read(limit + 1)
 
 
 def _umask() -> int:
@@ -52,7 +120,9 @@ class AtomicPath:
 
     def commit(self):
         """Rename the finished temporary file over ``path`` (one atomic ``os.replace``), with the
-        permissions a new file would get."""
+        permissions a new file would get.  Never over a FIFO, device or socket (a rename would
+        replace the node itself: /dev/null, for one): ``UsageError``."""
+        refuse_special_output(self.path)
         os.chmod(self.tmp, 0o666 & ~_umask())
         os.replace(self.tmp, self.path)
 
@@ -160,6 +230,27 @@ def check_parent_writable(p: str) -> None:
         raise UsageError(f"{p}: cannot write in {d} (permission denied)")
 
 
+def refuse_special_output(p) -> None:
+    """``UsageError`` for an output path that names a FIFO, device or socket: an output is a
+    new regular file renamed into place, and renaming over such a node would replace the node
+    (as root, /dev/null itself)."""
+    try:
+        kind = special_kind(os.lstat(p).st_mode)
+    except OSError:
+        return                                         # nothing there (or not reachable: said when written)
+    if kind is not None and kind != "a directory" and not os.path.islink(p):
+        raise UsageError(f"{shortened(p)}: {kind}, not a regular file; an output is a file written whole and renamed "
+                         f"into place: choose a file path")
+    if os.path.islink(p):
+        try:
+            kind = special_kind(os.stat(p).st_mode)
+        except OSError:
+            return
+        if kind is not None and kind != "a directory":
+            raise UsageError(f"{shortened(p)}: links to {kind}, not a regular file; an output is a file written whole and "
+                             f"renamed into place: choose a file path")
+
+
 def check_outputs(paths, inputs=()) -> list[str]:
     """Refuse, before any work, an output that cannot be written or must not be: a
     directory, one of the command's own inputs, a path named twice, a place without write
@@ -174,6 +265,7 @@ def check_outputs(paths, inputs=()) -> list[str]:
         seen.add(real)
         if os.path.isdir(p):
             raise UsageError(f"{p}: is a directory; an output must be a file path")
+        refuse_special_output(p)
         for i in inputs:
             i = os.fspath(i)
             if os.path.exists(p) and os.path.exists(i) and os.path.samefile(p, i):

@@ -14,6 +14,13 @@ Two places need more than a Python handler:
   in a thread without the GIL and hands them a ``stop`` flag they poll; the main thread
   waits in short slices, takes the signal, sets the flag and re-raises once the kernel
   has returned.
+
+A stop can arrive at any instant, also before a command starts its work or after it has
+finished.  ``hold()`` marks the end of the work: from then on a signal is only recorded, and
+``pending()`` tells the command line that one arrived which was never acted on, so that it
+still ends with 128 + the signal and its one line (``spinviz.commands.entry`` keeps the
+handlers installed until the process exits, so there is no instant at which a signal kills
+the process unreported).
 """
 
 from __future__ import annotations
@@ -22,11 +29,11 @@ import contextlib
 import signal
 import threading
 
-import numpy as np
-
 SIGNALS = tuple(s for s in (getattr(signal, n, None) for n in ("SIGINT", "SIGTERM", "SIGHUP")) if s is not None)
 
 _received: int | None = None
+_raised = False           # the first signal was raised as ``Interrupted`` (so it was acted on)
+_held = False             # the command's work is over: signals are only recorded (``hold``)
 
 
 class Interrupted(KeyboardInterrupt):
@@ -64,37 +71,66 @@ def _inside_swallowing_library(frame) -> bool:
 
 
 def _handler(signum, frame):
-    global _received
+    global _received, _raised
     first = _received is None
-    _received = signum
-    if first and not _deferring and not _inside_swallowing_library(frame):
+    if first:
+        _received = signum                         # the first signal is the one the exit status tells
+    if first and not _deferring and not _held and not _inside_swallowing_library(frame):
+        _raised = True
         raise Interrupted(signum)
 
 
 def install() -> None:
     """Turn SIGINT, SIGTERM and SIGHUP into ``Interrupted`` (main thread only)."""
-    global _received
-    _received = None
+    global _received, _raised, _held
+    _received, _raised, _held = None, False, False
     for s in SIGNALS:
         signal.signal(s, _handler)
+
+
+def installed() -> bool:
+    """Whether this module's handler is the one in place for every stop signal."""
+    return all(signal.getsignal(s) is _handler for s in SIGNALS)
 
 
 @contextlib.contextmanager
 def handlers():
     """``install()`` for the duration of a block, then the previous handlers again (a command
-    run in-process from Python leaves the caller's signal handling as it found it)."""
-    if threading.current_thread() is not threading.main_thread():
+    run in-process from Python leaves the caller's signal handling as it found it).  Inside a
+    block that already has them (the command line's ``entry`` installs them for the life of
+    the process), nothing changes: a signal held meanwhile stays pending for the outer one."""
+    if threading.current_thread() is not threading.main_thread() or installed():
         yield
         return
-    global _received
+    global _received, _raised, _held, _deferring
     old = {s: signal.getsignal(s) for s in SIGNALS}
+    depth = _deferring
     install()
     try:
         yield
     finally:
         for s, h in old.items():
             signal.signal(s, h)
-        _received = None                           # a later run in this process starts clean
+        _received, _raised, _held, _deferring = None, False, False, depth   # a later run here starts clean
+
+
+def hold() -> None:
+    """The command's work is over: from now on a stop signal is only recorded (``pending``),
+    never raised -- not inside the report, an ``atexit`` hook or the interpreter's shutdown."""
+    global _held
+    _held = True
+
+
+def pending() -> int | None:
+    """The signal that arrived and was never acted on (it came while held or deferred and no
+    ``check()`` raised it), or None."""
+    return None if _raised else _received
+
+
+def acknowledge() -> None:
+    """The pending signal has been reported: do not report it again."""
+    global _raised
+    _raised = True
 
 
 def received() -> int | None:
@@ -104,7 +140,9 @@ def received() -> int | None:
 
 def check() -> None:
     """Raise ``Interrupted`` if a stop signal arrived (even if its exception was swallowed)."""
+    global _raised
     if _received is not None:
+        _raised = True
         raise Interrupted(_received)
 
 
@@ -121,7 +159,7 @@ def deferred():
         yield
     finally:
         _deferring -= 1
-    if not _deferring:
+    if not _deferring and not _held:
         check()
 
 
@@ -137,6 +175,8 @@ def call_stoppable(kernel, *args):
     bpo-45274 clean-up releases the thread's state lock), so a second ``join`` returns at
     once and the interpreter could exit under a kernel still in C++ (heyoka then aborts:
     "terminate called without an active exception")."""
+    import numpy as np
+
     stop = np.zeros(1, dtype=np.int64)
     if threading.current_thread() is not threading.main_thread():
         return kernel(*args, stop)                 # signals only reach the main thread anyway

@@ -73,6 +73,22 @@ def normalize(q) -> np.ndarray:
     return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
+def unit_vector(v) -> np.ndarray:
+    """The direction of a 3-vector, v / |v|, shape (3,).  Scaled by its largest component
+    first, so |v| can neither overflow (1e308 components) nor underflow (1e-320): every
+    finite non-zero vector has its direction.  ``ValueError`` for one that has none (zero,
+    non-finite, not three numbers) -- the one rule for a line of sight, the schema's and the
+    detector's."""
+    a = np.asarray(v, dtype=float)
+    if a.shape != (3,) or not np.all(np.isfinite(a)):
+        raise ValueError(f"must be three finite numbers, got {np.array2string(a, threshold=6)}")
+    m = float(np.max(np.abs(a)))
+    if m == 0.0:
+        raise ValueError("must not be zero: a direction needs a length")
+    a = a / m
+    return a / np.linalg.norm(a)
+
+
 def multiply(a, b) -> np.ndarray:
     """Hamilton product a (x) b of float quaternions, shapes (..., 4) broadcast, (w, x, y, z)."""
     a = np.asarray(a, dtype=float)

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import rotations as R
 from . import units as U
-from .atomic import atomic_path, plain
+from .atomic import atomic_path, open_regular, plain
 from .errors import SpecTypeError, TrajectoryFileError
 from .physics.bodies import Body
 from .physics.equations import angular_momentum_world, kinetic_energy
@@ -163,7 +163,13 @@ class Trajectory:
         field's two polarizations and dP/dOmega toward it.  See ``physics.radiation``.
 
         Where ``phase_resolved`` is False the world-frame directions of the fast vectors are not
-        physical (the invariants, L and the power per solid angle averaged over a turn are)."""
+        physical (the invariants, L and the power per solid angle averaged over a turn are).
+
+        ``line_of_sight`` is checked by the schema (``inputs.base.Direction``: three finite
+        numbers, not all zero; ``SpecError("line_of_sight", ...)``) before anything is computed."""
+        from .inputs.trajectory import RadiationRequest
+
+        line_of_sight = RadiationRequest(line_of_sight=line_of_sight).line_of_sight
         try:
             import xarray as xr
         except ImportError:
@@ -206,7 +212,8 @@ class Trajectory:
         Parameters
         ----------
         times : array_like, shape (M,)
-            Instants within [t[0], t[-1]], in the run's time unit (s or tau0).
+            Finite instants within [t[0], t[-1]], in the run's time unit (s or tau0);
+            ``SpecError("times", ...)`` otherwise (``SpecTypeError`` for what is not numbers).
 
         Returns
         -------
@@ -221,13 +228,13 @@ class Trajectory:
         for a run whose spin phase is unresolved (``phase_resolved`` False) only the nodes
         and the slow geometry are meaningful.
         """
-        times = np.atleast_1d(np.asarray(times, dtype=float))
+        from .inputs.trajectory import SampleRequest
+
         t = self.t
+        lo, hi = t[0], t[-1]
+        times = SampleRequest(times=times, start=float(lo), end=float(hi)).times   # SpecError("times", ...)
         if times.shape == t.shape and np.array_equal(times, t):
             return self                     # already stored at these instants (the renderer's case)
-        lo, hi = t[0], t[-1]
-        if np.any(times < lo - 1e-12 * abs(hi - lo)) or np.any(times > hi + 1e-12 * abs(hi - lo)):
-            raise ValueError(f"sample times must lie in [{lo:g}, {hi:g}]")
         times = np.clip(times, lo, hi)
         if t.size == 1:
             omega = np.repeat(self.omega, times.size, axis=0)
@@ -378,12 +385,14 @@ class Trajectory:
         stats and slow geometry as they were.
 
         Raises ``TrajectoryFileError`` (a ValueError naming the file) for a file that is missing,
-        unreadable, damaged or not a spinviz trajectory, never a zip, JSON or NumPy error."""
+        unreadable, damaged or not a spinviz trajectory, and at once for a path that is not a
+        regular file (a directory, FIFO, device or socket); never a zip, JSON or NumPy error."""
         if not isinstance(path, (str, bytes, os.PathLike)):
             raise SpecTypeError("path", f"must be the path of a .npz trajectory, got {type(path).__name__}")
         path = os.fsdecode(path)
         try:
-            with np.load(path, allow_pickle=False) as z:
+            # a regular file only: a FIFO or a device is refused at once, never waited on
+            with open_regular(path) as fh, np.load(fh, allow_pickle=False) as z:
                 if not hasattr(z, "files"):
                     raise TrajectoryFileError(path, "a single NumPy array, not a spinviz trajectory (.npz)")
                 if "metadata" not in z.files:

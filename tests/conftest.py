@@ -59,6 +59,38 @@ def small_atlas_reference(small_atlas_spec, tmp_path_factory):
     return out
 
 
+def _refined(tmp_path_factory, name: str, seed: int):
+    from atlasdata import refined_spec
+
+    from spinviz.regimes import api
+
+    d = tmp_path_factory.mktemp(name)
+    spec = d / f"{name}.toml"
+    spec.write_text(refined_spec(seed))
+    store = d / f"{name}.zarr"
+    res = api.atlas(spec, store, workers=1, processes=False, progress=False, runs_per_task=4)
+    assert res.levels == 1 and res.computed == res.total
+    return spec, store
+
+
+@pytest.fixture(scope="session")
+def refined_atlas(tmp_path_factory):
+    """The small refined atlas of tests/atlasdata.py (levels 0 and 1), computed once (~3 s):
+    ``spec`` its file, ``store`` the reference store; ``foreign`` (computed when first asked
+    for) the same grid from another seed -- another atlas, whose level 1 is "foreign" in the
+    first."""
+    spec, store = _refined(tmp_path_factory, "ref", 3)
+
+    class Refined(SimpleNamespace):
+        @property
+        def foreign(self):
+            if "foreign" not in self.made:
+                self.made["foreign"] = _refined(tmp_path_factory, "foreign", 4)[1]
+            return self.made["foreign"]
+
+    return Refined(spec=spec, store=store, made={})
+
+
 # Hypothesis: deterministic and bounded in CI; HYPOTHESIS_PROFILE=fuzz for a long random hunt.
 from hypothesis import HealthCheck, settings  # noqa: E402
 

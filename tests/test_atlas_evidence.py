@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from spinviz.errors import UsageError
+from spinviz.errors import SpecError, SpecTypeError, UsageError
 from spinviz.regimes import api
 from spinviz.regimes.store import dataset as ST
 from spinviz.validation.atlas import convergence as CV
@@ -26,17 +26,23 @@ tau_end = 1e6
 """
 
 
-@pytest.mark.parametrize("kind, options, message", [
-    ("crosscheck", {"tau_end": 1e8}, "--evidence crosscheck: does not use --tau-end"),
-    ("tolerance", {"out": "x.zarr"}, "--evidence tolerance: does not use --out"),
-    ("validate", {"horizons": "1e10,1e12"}, "--evidence validate: does not use --horizons"),
-    ("convergence", {"horizons": "1e12,1e10"}, "--horizons: give at least two increasing positive horizons"),
-    ("convergence", {"horizons": "1e10,x"}, "--horizons: expected numbers separated by commas"),
-    ("convergence", {"out": "/nonexistent/a.zarr"}, "--out /nonexistent/a.zarr: not an atlas store"),
-    ("nonsense", {}, "--evidence: nonsense is not one of validate, crosscheck, physical, convergence, tolerance"),
+@pytest.mark.parametrize("kind, options, error, message", [
+    ("crosscheck", {"tau_end": 1e8}, SpecError, "tau_end: not used by --evidence crosscheck (it takes members)"),
+    ("tolerance", {"out": "x.zarr"}, SpecError, "out: not used by --evidence tolerance"),
+    ("validate", {"horizons": (1e10, 1e12)}, SpecError, "horizons: not used by --evidence validate"),
+    ("convergence", {"horizons": (1e12, 1e10)}, SpecError, "horizons: must increase"),
+    ("convergence", {"horizons": "1e10,x"}, SpecTypeError, "horizons: must be a list of horizons tau"),
+    ("convergence", {"horizons": (1e10, 1e300)}, SpecError, "horizons: each must lie in [100000, 1e+16]"),
+    ("physical", {"tau_end": 0.0}, SpecError, "tau_end: must lie in [100000, 1e+16]"),
+    ("physical", {"tau_end": float("nan")}, SpecError, "tau_end: must be finite"),
+    ("convergence", {"out": "/nonexistent/a.zarr"}, UsageError, "--out /nonexistent/a.zarr: not an atlas store"),
+    ("nonsense", {}, UsageError, "--evidence: nonsense is not one of validate, crosscheck, physical, convergence, "
+                                 "tolerance"),
 ])
-def test_options_a_kind_does_not_take_are_refused_before_work(kind, options, message):
-    with pytest.raises(UsageError) as e:
+def test_options_a_kind_does_not_take_are_refused_before_work(kind, options, error, message, monkeypatch):
+    """Each refused before any work: the computation itself raises if reached."""
+    monkeypatch.setattr(evidence, "_compute", lambda req: pytest.fail("reached the work"))
+    with pytest.raises(error) as e:
         evidence.run(kind, 1, **options)
     assert message in str(e.value)
 

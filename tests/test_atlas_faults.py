@@ -31,7 +31,7 @@ from spinviz.regimes import api, cluster
 from spinviz.regimes.engine import runs as RN
 from spinviz.regimes.faults import AtlasIncomplete, OptionError, StoreDamaged
 from spinviz.regimes.store import dataset as store
-from spinviz.regimes.store import integrity
+from spinviz.regimes.store import integrity, levels
 
 ROOT = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""), "PYTHONUNBUFFERED": "1"}
@@ -157,11 +157,14 @@ def test_damaged_chunk_is_named_and_recomputed(spec_path, reference, tmp_path, c
 
 
 def test_verify_a_clean_store(reference, capsys):
-    """One line per variable with its chunks, the metadata, the verdict; exit 0."""
+    """The metadata, the spec the store records (its hash), one line per variable with its
+    chunks, the runs the spec implies, the verdict; exit 0."""
     rc, lines = verify(reference, capsys)
     assert rc == 0
-    assert lines == ["metadata: ok"] + [f"{v}: ok (4 chunks)" for v in store.run_variables(str(reference))] + [
-        f"{reference}: ok: 36 runs verified"]
+    sha = store.identity(levels.recorded_spec(str(reference)))
+    assert lines == ["metadata: ok", f"spec: ok (sha256 {sha[:12]}, [refine] levels = 0)"] + [
+        f"{v}: ok (4 chunks)" for v in store.run_variables(str(reference))] + [
+        "runs: all 36 computed", f"{reference}: ok: 36 runs verified"]
 
 
 def test_verify_refuses_what_is_not_a_store(tmp_path, capsys):

@@ -336,7 +336,7 @@ def _npz(path, **arrays):
     ("nan in omega", "damaged: the array 'omega' is not finite numbers"),
     ("body missing", "damaged metadata: KeyError 'body_description'"),
     ("missing", "no such file"),
-    ("directory", "Is a directory"),
+    ("directory", "is a directory, not a regular file"),
 ])
 def test_a_damaged_trajectory_file_is_one_typed_error(tmp_path, damage, reason):
     """``Trajectory.load`` of a damaged file raised BadZipFile, EOFError, KeyError or

@@ -7,6 +7,7 @@ import pytest
 
 from spinviz import rotations as R
 from spinviz.driver import SimulationError, simulate
+from spinviz.errors import SpecError
 from spinviz.integrators import names
 from spinviz.physics import bodies as B
 from spinviz.physics import cases
@@ -232,7 +233,7 @@ def test_sample_interpolation_orders():
         eq.append(R.misorientation(s.q, fine.q[1:]).max())
     assert np.polyfit(np.log(hs), np.log(ew), 1)[0] == pytest.approx(4.0, abs=0.3), ew
     assert np.polyfit(np.log(hs), np.log(eq), 1)[0] == pytest.approx(2.0, abs=0.2), eq
-    with pytest.raises(ValueError, match="sample times must lie in"):
+    with pytest.raises(SpecError, match=r"times: must lie in \[0, 20\]"):
         coarse.sample([21.0])
 
 

@@ -75,3 +75,85 @@ def test_a_stopped_kernel_has_returned_before_the_signal_is_reraised():
         with pytest.raises(interrupt.Interrupted):
             interrupt.call_stoppable(kernel)
         assert returned == [True]
+
+
+@pytest.fixture
+def methods_run(monkeypatch):
+    """``spinviz methods`` whose run does ``act()`` at its very end (the work done, outputs written)."""
+    from spinviz.commands import methods
+
+    real = methods.run
+    box = {}
+
+    def run(args):
+        code = real(args)
+        box["act"]()
+        return code
+
+    monkeypatch.setattr(methods, "run", run)
+    return box
+
+
+def test_a_signal_as_the_command_ends_is_its_exit_status_and_its_one_line(methods_run, capsys):
+    """A signal after the work (the report being printed, the interpreter shutting down) is
+    held from the end of the work on and reported, with 128 + the signal and the status the
+    command would have had -- never left to its default action, which kills unreported."""
+    from spinviz.commands import main
+
+    def late():
+        interrupt.hold()                          # as the dispatcher does when the run returns
+        send(signal.SIGHUP)
+        for _ in range(1000):
+            np.sqrt(2.0)
+
+    methods_run["act"] = late
+    assert main(["methods"]) == 129
+    err = capsys.readouterr().err
+    assert err == "spinviz: interrupted by SIGHUP as the command ended; it had finished (exit status 0)\n"
+    assert interrupt.pending() is None
+
+
+def test_a_signal_while_an_error_is_reported_still_gives_its_status(monkeypatch, capsys):
+    """The first signal, landing while the dispatcher reports a usage error, is said once with
+    the command's stop line, never as a traceback out of the report."""
+    from spinviz.commands import main, shared
+
+    real_say = shared.say
+    calls = []
+
+    def say(prefix, message):
+        calls.append(prefix)
+        if len(calls) == 1:
+            send(signal.SIGTERM)
+            for _ in range(1000):
+                np.sqrt(2.0)
+        real_say(prefix, message)
+
+    monkeypatch.setattr("spinviz.commands.say", say)
+    assert main(["info", "no-such-target"]) == 143
+    assert capsys.readouterr().err == "spinviz: interrupted by SIGTERM; nothing was written\n"
+
+
+def test_entry_answers_signals_from_its_first_line_to_its_last(tmp_path):
+    """The console script installs the handlers before anything else and never gives them back:
+    a SIGTERM during the interpreter's shutdown (sent by an exit hook the command left) is
+    held and reported by the last hook, with 143; the process is not killed by the signal."""
+    import subprocess
+    import sys
+
+    probe = ("import os, signal, sys\n"
+             "from spinviz import commands\n"
+             "from spinviz.commands import methods\n"
+             "real = methods.run\n"
+             "import atexit\n"
+             "def run(args):\n"
+             "    atexit.register(lambda: os.kill(os.getpid(), signal.SIGTERM))\n"   # during the interpreter's shutdown
+             "    return real(args)\n"
+             "methods.run = run\n"
+             "sys.argv = ['spinviz', 'methods']\n"
+             "commands.entry()\n")
+    r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=60,
+                       env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+    assert r.returncode == 143, (r.returncode, r.stderr)
+    assert r.stderr == "spinviz: interrupted by SIGTERM as the command ended; it had finished (exit status 0)\n"
+    assert "taylor" in r.stdout

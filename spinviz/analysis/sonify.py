@@ -233,7 +233,9 @@ def wav_bytes(samples: np.ndarray, rate: int, title: str, mapping: Mapping) -> b
 def read_info(path) -> dict:
     """The LIST/INFO items of a WAV (INAM, ICMT, ...) and, from ICMT, the mapping as a dict
     under "mapping"."""
-    raw = open(path, "rb").read()
+    from ..atomic import read_regular
+
+    raw = read_regular(path)                  # a FIFO or device is refused at once, never waited on
     if raw[:4] != b"RIFF" or raw[8:12] != b"WAVE":
         raise ValueError(f"{path}: not a WAV file")
     out, pos = {}, 12
@@ -331,9 +333,13 @@ def listen_scene(sc, out_wav: str, out_png: str | None, duration: float = 20.0, 
                  dynamic_range_db: float = 60.0, pitch: str = "auto"):
     """Simulate and detect both models of scene ``sc`` (``observe.run_scene``), synthesize and
     write the WAV (and its spectrogram PNG); returns the Mapping.  The caller makes the paths
-    atomic as a group (these write in place)."""
+    atomic as a group (these write in place).  The sound's arguments are checked first
+    (``inputs.options.ListenRequest``: ``SpecError`` naming the argument), before the runs."""
+    from ..inputs.options import ListenRequest
     from .observe import run_scene
 
+    ListenRequest(duration=duration, f0=f0, time_map=time_map, pitch=pitch, dynamic_range_db=dynamic_range_db,
+                  samples=samples)
     obs, _ = run_scene(sc, samples, line_of_sight, distance_cm, receive=False)     # the sound needs no receiver
     # the log map's knee: a tenth of the braking time 1/(tau0 |Omega0|^2), where the motion starts to
     # change, unless t_end/1000 comes first (a geological horizon must not spend its first second on nothing)

@@ -52,8 +52,9 @@ def main(argv: list[str] | None = None) -> int:
     argv : the arguments after ``spinviz`` (default ``sys.argv[1:]``), e.g. ``["check", "--quick"]``.
     Returns 0 on success, 1 when a check or run failed or an output could not be written, 2 for
     bad input (one line on stderr), 128 + the signal number when stopped by SIGINT, SIGTERM or
-    SIGHUP.  Standard output and error are guarded for the call (a closed or full stream never
-    raises into the command); ``entry`` is the console script around it.
+    SIGHUP -- whenever the signal arrives, before the work, during it, or as the command ends.
+    Standard output and error are guarded for the call (a closed or full stream never raises
+    into the command); ``entry`` is the console script around it.
     """
     top = parser()
     args = top.parse_args(argv)
@@ -65,7 +66,8 @@ def main(argv: list[str] | None = None) -> int:
             # NumPy's overflow warnings are not for the user: every result is checked for finite
             # values and a run that leaves them fails with one line (driver._check_finite)
             warnings.simplefilter("ignore", RuntimeWarning)
-            code = _run(args)
+            code = _run(args)                          # from its end on, a signal is only recorded
+            code = ended(code)
         sys.stdout.flush()
         if sys.stdout.error is not None:
             # the report is lost; whatever the command wrote to files stays (it was written first)
@@ -77,13 +79,49 @@ def main(argv: list[str] | None = None) -> int:
         sys.stdout, sys.stderr = out, err
 
 
+def ended(code: int) -> int:
+    """A stop signal that arrived after the command's work (held, never acted on): its one line,
+    and 128 + the signal instead of ``code``."""
+    late = interrupt.pending()
+    if late is None:
+        return code
+    interrupt.acknowledge()
+    import signal
+
+    say("interrupted by ", f"{signal.Signals(late).name} as the command ended; it had finished (exit status {code})")
+    return 128 + late
+
+
 def _subparser(top: argparse.ArgumentParser, name: str) -> argparse.ArgumentParser:
     sub = next(a for a in top._actions if isinstance(a, argparse._SubParsersAction))
     return sub.choices[name]
 
 
 def _run(args) -> int:
+    """The command's exit status; a stop signal at any point of it -- its error reports
+    included -- ends it with 128 + the signal and the command's own line (``stopped``)."""
     mod = command(args.command)
+    code = None
+    try:
+        code = _dispatch(mod, args)
+        interrupt.hold()                               # the work is over: a signal now is only recorded
+        return code
+    except interrupt.Interrupted as e:
+        interrupt.hold()
+        if code is not None:                           # it came between the end of the work and the hold
+            interrupt.acknowledge()
+            say("interrupted by ", f"{e} as the command ended; it had finished (exit status {code})")
+        else:
+            line = getattr(mod, "stopped", None)
+            say("", line(args, e) if line is not None else f"interrupted by {e}; nothing was written")
+        return e.exit_status
+    except KeyboardInterrupt:                          # a library's own Ctrl-C handling
+        interrupt.hold()
+        say("interrupted", "; nothing was written")
+        return 130
+
+
+def _dispatch(mod, args) -> int:
     try:
         try:
             return mod.run(args)
@@ -98,12 +136,10 @@ def _run(args) -> int:
     except (SimulationError, RenderError) as e:
         say("run failed: ", e)
         return EXIT_FAIL
-    except interrupt.Interrupted as e:
-        say("interrupted by ", f"{e}; nothing was written")
-        return e.exit_status
+    except interrupt.Interrupted:
+        raise                                           # said by _run, with the command's own line
     except KeyboardInterrupt:
-        say("interrupted", "; nothing was written")
-        return 130
+        raise
     except BrokenPipeError:
         raise                                           # the reader left: entry() ends quietly
     except (SpinvizError, ValueError, OSError, ImportError, ArithmeticError, RuntimeError, RecursionError,
@@ -112,6 +148,10 @@ def _run(args) -> int:
         # line, not a traceback (SPINVIZ_DEBUG=1 shows the traceback)
         if os.environ.get("SPINVIZ_DEBUG"):
             raise
+        status = getattr(e, "exit_status", None)
+        if isinstance(status, int):                     # a failure with its own status (a busy store: 75)
+            say("error: ", e)
+            return status
         what = getattr(e, "filename", None) if isinstance(e, OSError) else None
         if isinstance(e, OSError) and what is None and getattr(args, "out", None):
             what = args.out                                 # e.g. a full disk while writing the output
@@ -153,16 +193,61 @@ def _settle(stream) -> None:
             pass
 
 
+_EXIT = {"code": 0}
+
+
+def _last_words() -> None:
+    """The process's last act (the first ``atexit`` hook registered, so the last to run): a stop
+    signal that arrived during the interpreter's shutdown (held: the handlers stay installed)
+    gets its line and 128 + the signal; then the process exits at once, before the interpreter
+    would give the signals back their default action (which kills unreported)."""
+    code = _EXIT["code"]
+    late = interrupt.pending()
+    if late is not None:
+        import signal
+
+        interrupt.acknowledge()
+        say("interrupted by ", f"{signal.Signals(late).name} as the command ended; it had finished (exit status {code})")
+        code = 128 + late
+    for stream in (sys.stdout, sys.stderr):
+        _settle(stream)
+    os._exit(code)
+
+
 def entry() -> None:
-    """Console-script entry point (``spinviz``, and ``python -m spinviz``)."""
+    """Console-script entry point (``spinviz``, and ``python -m spinviz``).
+
+    The stop signals are answered from the first instant to the last: the handlers are
+    installed before anything else and never given back, a signal after the command's work
+    is held and reported (``ended``, ``_last_words``), and library logging (Dask's reconnect
+    attempts, asyncio's complaints about futures a stopped cluster left) is silenced: one
+    line on stderr per outcome (SPINVIZ_DEBUG=1 keeps the logs)."""
+    import atexit
+    import logging
+
+    interrupt.install()
+    _EXIT["code"] = 1                                # until the command says otherwise (an uncaught bug: 1)
+    atexit.register(_last_words)
+    if not os.environ.get("SPINVIZ_DEBUG"):
+        logging.disable(logging.CRITICAL)
     _occupy_closed_std_fds()
     try:
         code = main()
         if sys.stdout is not None:
             sys.stdout.flush()
+    except interrupt.Interrupted as e:              # before the command ran (its arguments being read)
+        interrupt.hold()
+        say("interrupted by ", f"{e}; nothing was written")
+        code = e.exit_status
+    except SystemExit as e:                         # argparse: --help (0) or a usage error (2)
+        interrupt.hold()
+        code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
     except BrokenPipeError:
         # the reader went away (spinviz methods | head -1): end quietly, as a Unix tool does
+        interrupt.hold()
         code = 128 + 13
+    interrupt.hold()
     _settle(sys.stdout)
     _settle(sys.stderr)
+    _EXIT["code"] = code
     sys.exit(code)

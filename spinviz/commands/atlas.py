@@ -3,19 +3,22 @@
 ``spinviz atlas --evidence KIND``.
 
 Exit statuses of its own: 75 when the cluster failed and runs were not computed (sysexits'
-EX_TEMPFAIL: the same command resumes), 1 when tasks failed as a whole, 128 + the signal
-after a stop; for ``--verify``, 0 (every chunk matches its checksums) or 1 (damaged), 2 (not
-an atlas store).
+EX_TEMPFAIL: the same command resumes) or when another command holds the store's lock (the
+same command works once that one has finished), 1 when tasks failed as a whole, 128 + the
+signal after a stop; for ``--verify``, 0 (the whole atlas its spec implies, every chunk
+matching its checksums) or 1 (damaged, incomplete, a level missing or foreign), 2 (not an
+atlas store).
 """
 
 from __future__ import annotations
 
 import json
+import os
 import sys
 
 from ..errors import UsageError, printable
-from ..interrupt import Interrupted, check
-from .shared import positive, real
+from ..interrupt import check
+from .shared import positive, real, reals
 
 EVIDENCE = ("validate", "crosscheck", "physical", "convergence", "tolerance")
 
@@ -56,12 +59,12 @@ def add_parser(sub) -> None:
     ev.add_argument("--members", type=positive, help="starts per point (default: validate 32, crosscheck 3, physical 4, "
                                                      "convergence 32, tolerance 8)")
     ev.add_argument("--tau-end", type=real, help="physical: the horizon (default 1e10)")
-    ev.add_argument("--horizons", metavar="LIST", help="convergence: the horizons (default 1e10,1e12,1e14)")
+    ev.add_argument("--horizons", metavar="LIST", type=reals, help="convergence: the horizons (default 1e10,1e12,1e14)")
 
 
 def run(args) -> int:
     """Carry out ``spinviz atlas`` with the parsed ``args``; return its exit status."""
-    from ..regimes.api import RUNS_PER_TASK, atlas, default_out
+    from ..regimes.api import RUNS_PER_TASK, atlas
     from ..regimes.faults import AtlasIncomplete
 
     if args.verify is not None:
@@ -94,13 +97,6 @@ def run(args) -> int:
                     progress=not args.quiet, runs_per_task=args.runs_per_task or RUNS_PER_TASK,
                     retry_failed=args.retry_failed)
         check()                                       # a signal that reached a library that swallowed it
-    except Interrupted as e:
-        # said here, not by the command line's generic "nothing was written": the finished
-        # chunks are on disk, and that is the point
-        out = args.out or default_out(spec)
-        print(f"spinviz: atlas stopped by {e}; every finished chunk is in {printable(out, 200)} and the same command "
-              f"computes only what is missing", file=sys.stderr)
-        return e.exit_status
     except AtlasIncomplete as e:
         print(f"spinviz: {printable(e.cli_message())}", file=sys.stderr)
         return e.exit_status
@@ -119,12 +115,30 @@ def run(args) -> int:
     return 0
 
 
+def stopped(args, signal_name) -> str:
+    """The one line of an atlas command stopped by a signal (wherever it landed): the finished
+    chunks are on disk and the same command completes the store -- that is the point."""
+    from ..regimes.api import default_out
+
+    if args.verify is not None or args.evidence is not None or args.bench or args.spec is None:
+        return f"interrupted by {signal_name}; nothing was written"
+    out = args.out or default_out(args.spec)
+    if not os.path.isdir(out):
+        return f"atlas stopped by {signal_name} before its store was made; nothing was written"
+    return (f"atlas stopped by {signal_name}; every finished chunk is in {printable(out, 200)} and the same command "
+            f"computes only what is missing")
+
+
 def _bench(spec, args) -> int:
     from ..regimes import bench
 
     if args.out or args.scheduler or args.plot:
         raise UsageError("--bench: measures on temporary stores and the embedded cluster; drop --out, --scheduler "
                          "and --plot")
+    unused = [o for o, v in (("--runs-per-task", args.runs_per_task), ("--retry-failed", args.retry_failed),
+                             ("--workers", args.workers if args.write_path else None)) if v]
+    if unused:                                        # never ignored in silence
+        raise UsageError(f"{unused[0]}: not used by --bench{' --write-path' if args.write_path else ''}")
     if args.write_path:
         rows = bench.store_cost(spec)
         print(bench.format_store_cost(rows) if not args.json else json.dumps(rows, indent=2, default=float))
@@ -136,15 +150,18 @@ def _bench(spec, args) -> int:
 
 def verify(path: str, as_json: bool = False) -> int:
     """``--verify STORE``: one line per variable (chunks intact, or the damaged ones named),
-    the metadata, and a verdict, for the store and each refinement level; 0 if everything
-    matches its checksums, 1 if not."""
+    the metadata and the spec, and a verdict, for the store and each refinement level its spec
+    implies; 0 if every level the spec implies is present, whole (every file matches its
+    checksum, every run computed) and of this spec, 1 if not (what is missing, damaged or
+    foreign named)."""
     from ..regimes.store.verify import report
 
     r = report(path)
     if as_json:
         first = r["reports"][0]
         print(json.dumps({"path": path, "ok": r["ok"], "lines": first["lines"], "runs_verified": r["runs_verified"],
-                          "damaged_chunks": r["damaged_chunks"], "levels": r["reports"][1:]}, indent=2))
+                          "damaged_chunks": r["damaged_chunks"], "problems": r["problems"], "levels": r["reports"][1:]},
+                         indent=2))
     else:
         many = len(r["reports"]) > 1
         for level in r["reports"]:

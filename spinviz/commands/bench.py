@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from ..errors import UsageError
-from .shared import EXIT_OK, names, p, positive, progress
+from .shared import EXIT_OK, names, positive, progress
 
 
 def add_parser(sub) -> None:
@@ -25,13 +24,14 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     """Carry out ``spinviz bench`` with the parsed ``args``; return its exit status."""
-    from ..atomic import write_json
+    from ..atomic import check_outputs, write_json
     from ..validation import bench
+
+    check_outputs([x for x in (args.json, args.plot) if x])      # before the minutes of work, not after
 
     if args.process:
         from ..validation import process_bench as PB
 
-        _known(args.problems, PB.PROBLEMS)
         pts = PB.run(args.problems or PB.PROBLEMS, repeats=args.repeats or 3, quick=args.quick, progress=progress)
         print(PB.format_table(pts))
         if args.json:
@@ -40,7 +40,6 @@ def run(args) -> int:
             PB.plot(pts, args.plot)
         return EXIT_OK
     plan = bench.quick_plan() if args.quick else bench.Plan()
-    _known(args.problems, bench.PROBLEMS)
     plan = dataclasses.replace(plan, **{k: v for k, v in (("problems", args.problems), ("repeats", args.repeats))
                                         if v is not None})
     rows = bench.run(plan, progress=progress)
@@ -52,8 +51,3 @@ def run(args) -> int:
         bench.plot(rows, args.plot)
     return EXIT_OK
 
-
-def _known(given, valid) -> None:
-    unknown = [n for n in given or () if n not in valid]
-    if unknown:
-        raise UsageError(f"--problems: unknown {', '.join(map(p, unknown))}; valid: {', '.join(valid)}")

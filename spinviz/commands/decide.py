@@ -53,8 +53,8 @@ def run(args) -> int:
     from ..inputs.decide import DecideArguments
     from ..inputs.scene_spec import load_scene
 
-    spec = DecideArguments(**{k: getattr(args, k) for k in ("trials", "seed", "spin_range", "tau0")
-                              if getattr(args, k) is not None})
+    spec = DecideArguments(**{k: getattr(args, k) for k in ("trials", "seed", "spin_range", "tau0", "workers",
+                                                            "scheduler") if getattr(args, k) is not None})
     sc = load_scene(args.scene)
     receiver = sc.observe.receiver
     given = {k: getattr(args, k) for k in KEYS if getattr(args, k) is not None}

@@ -34,6 +34,7 @@ def run(args) -> int:
     """Carry out ``spinviz listen`` with the parsed ``args``; return its exit status."""
     from ..analysis import sonify
     from ..atomic import Outputs
+    from ..inputs.options import ListenRequest
     from ..inputs.scene_spec import load_scene
 
     detector_overrides(args)
@@ -42,14 +43,8 @@ def run(args) -> int:
     png = args.png or os.path.splitext(args.out)[0] + ".png"
     if os.path.splitext(png)[1].lower() != ".png":
         raise UsageError(f"--png: {png}: give a path ending in .png")
-    if not 0.5 <= args.duration <= sonify.MAX_SECONDS:
-        raise UsageError(f"--duration: must lie in [0.5, {sonify.MAX_SECONDS:g}] s, got {args.duration:g}")
-    if not 20.0 <= args.f0 <= 5000.0:
-        raise UsageError(f"--f0: must lie in [20, 5000] Hz (audible, well under the Nyquist frequency), got {args.f0:g}")
-    if not 1.0 <= args.dynamic_range_db <= 120.0:
-        raise UsageError(f"--dynamic-range-db: must lie in [1, 120], got {args.dynamic_range_db:g}")
-    if args.samples > MAX_SAMPLES:
-        raise UsageError(f"--samples: at most {MAX_SAMPLES}, got {args.samples}")
+    ListenRequest(duration=args.duration, f0=args.f0, time_map=args.time_map, pitch=args.pitch,   # named by option
+                  dynamic_range_db=args.dynamic_range_db, samples=args.samples)
     sc = load_scene(args.scene)
     need_matplotlib("listen's spectrogram")
     group = Outputs([args.out, png], [args.scene])

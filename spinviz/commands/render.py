@@ -65,7 +65,10 @@ def run(args) -> int:
 
 
 def _bench(sc, args) -> int:
+    from ..atomic import check_outputs
     from ..validation import render_bench
+
+    check_outputs([x for x in (args.json, args.plot) if x], [args.scene])   # before the work, not after
 
     rows = render_bench.run(sc, fps=args.fps, duration=args.duration, frames=args.frames, workers=args.workers)
     out(render_bench.format_table(rows, args.scene))

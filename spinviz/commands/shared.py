@@ -70,6 +70,17 @@ def positive(text: str) -> int:
     return v
 
 
+def reals(text: str) -> tuple[float, ...]:
+    """A comma-separated list of numbers (their ranges are the schema's)."""
+    try:
+        out = tuple(float(x) for x in text.split(",") if x.strip())
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected numbers separated by commas, got {text!r}") from None
+    if not out:
+        raise argparse.ArgumentTypeError(f"expected numbers separated by commas, got {text!r}")
+    return out
+
+
 def names(text: str) -> tuple[str, ...]:
     """A comma-separated list of names."""
     out = tuple(x.strip() for x in text.split(",") if x.strip())
@@ -127,7 +138,10 @@ def detector_overrides(args, keys=("line_of_sight", "distance_cm")) -> dict:
 # --- reports ------------------------------------------------------------------------------
 def say(prefix: str, message) -> None:
     """One line on stderr, control characters escaped and cut: nothing from a file or a key
-    name can colour, clear or split the terminal."""
+    name can colour, clear or split the terminal.  Nothing when stderr was closed before the
+    command started (``print`` would otherwise write the line to stdout)."""
+    if sys.stderr is None:
+        return
     print(f"spinviz: {prefix}{printable(message)}", file=sys.stderr)
 
 

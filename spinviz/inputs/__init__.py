@@ -11,7 +11,10 @@ keys or the keyword arguments):
                               ``RenderArguments`` (``t``, ``t_end``, ``workers``, ``out`` ...)
 ``inputs.simulation``         ``SimulationRequest``: ``spinviz.simulate``'s arguments, which a
                               scene also becomes (``Scene.request(model)``)
+``inputs.trajectory``         ``Trajectory.sample``'s times, ``Trajectory.radiation``'s line of sight
 ``inputs.atlas``              the atlas spec's tables; ``AtlasArguments`` (``spinviz.atlas``)
+``inputs.options``            the study commands' counts and horizons (``check --sweep``,
+                              ``bench``, ``atlas --evidence``) and the cap on their work
 ``inputs.base``               the field types and the translation of errors
 ``inputs.toml``               reading a TOML file; a table checked with file and key in errors
 ============================  ===============================================================
@@ -35,8 +38,9 @@ To add a key: one annotated field in the request class of its table (type, range
 reason, default, a line in the class docstring).  The TOML key, the keyword argument, the
 error messages and -- for an atlas spec -- the spec's identity follow from it
 (``inputs.atlas`` says how ``[run]`` keys reach ``regimes.runs.Settings``).  A command-line
-option for it is one ``add_argument`` in its ``spinviz.commands`` module, whose ``dest`` is the
-argument's name (the command line names a refused value by the option, read from the parser).
+option for it is one ``add_argument`` in its command's module (``spinviz.commands.<name>``)
+whose ``dest`` is the argument's name: the dispatcher names a schema error by that option,
+and ``tests/test_options_fuzz.py`` fuzzes it from the parser.
 
 Importing this package loads nothing; its modules load pydantic when a scene, a spec or a
 call is first validated (~65 ms once per process with the schema's classes, measured on this

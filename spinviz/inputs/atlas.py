@@ -255,13 +255,19 @@ class AtlasArguments:
 
     @model_validator(mode="after")
     def _cluster(self):
-        if self.scheduler is not None and self.workers is not None:
-            raise SpecError("workers", "applies to the embedded cluster only; an existing cluster (scheduler) has the "
-                                       "workers it was started with")
-        from .render import usable_cores
-
-        cores = usable_cores()
-        if self.workers is not None and self.workers > cores:
-            raise SpecError("workers", f"must be at most {cores}, the cores this process may use (more workers than "
-                                       f"cores only share them), got {self.workers}")
+        check_cluster(self.workers, self.scheduler)
         return self
+
+
+def check_cluster(workers: int | None, scheduler: str | None) -> None:
+    """Workers of an embedded cluster: at most the cores this process may use, and none asked of
+    an existing cluster (``SpecError`` naming ``workers``)."""
+    if scheduler is not None and workers is not None:
+        raise SpecError("workers", "applies to the embedded cluster only; an existing cluster (scheduler) has the "
+                                   "workers it was started with")
+    from .render import usable_cores
+
+    cores = usable_cores()
+    if workers is not None and workers > cores:
+        raise SpecError("workers", f"must be at most {cores}, the cores this process may use (more workers than "
+                                   f"cores only share them), got {workers}")

@@ -61,6 +61,7 @@ from ..errors import SceneError, SpecTypeError
 from ..physics.bodies import MIN_INERTIA_RATIO
 from . import atlas as IA
 from .base import fields_of
+from .options import MAX_DAYS_ENV, max_days
 from .render import usable_cores
 from .toml import document, read_toml, table
 
@@ -193,6 +194,50 @@ def settings_from_canonical(canonical: dict) -> Settings:
     return settings_from(run, classify)
 
 
+def spec_from_record(attrs: dict, where: str) -> AtlasSpec:
+    """The ``AtlasSpec`` an atlas store records (its attributes ``spec``, ``grid_axes``,
+    ``title``), read back through the same schema as a spec file, so that ``--verify`` judges
+    a store by what its own spec implies.  ``where`` names the record in errors
+    (``SceneError(where, key, reason)``); the caller compares the result's identity with the
+    recorded ``spec_sha256``."""
+    import dataclasses
+
+    try:
+        canonical = json.loads(attrs["spec"])
+        if not isinstance(canonical, dict):
+            raise ValueError
+    except (KeyError, TypeError, ValueError):
+        raise SceneError(where, "spec", "missing or not a JSON table") from None
+    members = canonical.get("members") if isinstance(canonical.get("members"), dict) else {}
+    doc = {"models": canonical.get("models"), "grid": {"delta": canonical.get("delta"), "chi": canonical.get("chi")},
+           "members": {"list": members.get("omega0")}, "run": canonical.get("run", {}),
+           "classify": canonical.get("classify", {}), "output": canonical.get("output", {}),
+           "title": attrs.get("title", "") if isinstance(attrs.get("title", ""), str) else ""}
+    spec = parse_spec(doc, where)
+    refine = table(IA.RefineTable, canonical.get("refine", {}), "refine", where)
+    seed, omega = members.get("seed"), members.get("omega")
+    if seed is not None or omega is not None:
+        table(IA.MembersTable, {"count": spec.members, "seed": seed, "omega": omega}, "members", where)
+    axes = None
+    if "grid_axes" in attrs:
+        try:
+            raw = json.loads(attrs["grid_axes"])
+            axes = {k: (float(raw[k][0]), float(raw[k][1]), int(raw[k][2])) for k in ("delta", "chi")}
+        except (KeyError, TypeError, ValueError, IndexError):
+            raise SceneError(where, "grid_axes", "not {delta: [min, max, cells], chi: [...]}") from None
+        for k, values in (("delta", spec.deltas), ("chi", spec.chis)):
+            lo, hi, n = axes[k]
+            r = table(IA.AxisRange, {"min": lo, "max": hi, "cells": n}, f"grid_axes.{k}", where)
+            centres = r.min + (np.arange(r.cells) + 0.5) * (r.max - r.min) / r.cells
+            centres[np.abs(centres) < 1e-12 * (r.max - r.min)] = 0.0
+            if centres.shape != values.shape or not np.allclose(centres, values, rtol=0.0, atol=1e-12 * (r.max - r.min)):
+                raise SceneError(where, f"grid_axes.{k}", "does not give the recorded grid")
+    if refine.levels and axes is None:
+        raise SceneError(where, "refine", "refinement levels are recorded but not the grid's ranges (grid_axes)")
+    return dataclasses.replace(spec, seed=seed, omega_magnitude=omega, axes=axes, refine_levels=refine.levels,
+                               refine_agree=refine.agree)
+
+
 def load_spec(path) -> AtlasSpec:
     """Read and validate an atlas spec; ``SceneError`` (file, key, reason) on any problem."""
     if not isinstance(path, str | os.PathLike):
@@ -305,7 +350,7 @@ BYTES_PER_CELL = 1200            # the paper's predictions at each (delta, chi),
 BYTES_PER_TASK = 1000            # a batch (its chi tuple, omega0 view, region), its key and counters
 BYTES_PER_RUN = 16               # done mask, label codes and their copies
 CPU_S_PER_RUN = 0.096            # a run to tau_end = 1e10 at rtol 1e-8, one core
-MAX_DAYS = 30.0                  # an embedded atlas expected to take longer is refused: it would not finish here
+MAX_DAYS = 30.0                  # an embedded atlas expected to take longer is refused (options.max_days: SPINVIZ_MAX_DAYS)
 MEMORY_SHARE = 0.5               # of physical memory, for this process (the workers need the rest)
 
 
@@ -353,9 +398,11 @@ def check_feasible(spec: AtlasSpec, arguments: IA.AtlasArguments) -> Cost:
                                               f"process (~{BYTES_PER_CELL} B a cell, {BYTES_PER_TASK} B a task); this "
                                               f"machine has {mem / 1e9:.3g} GB (limit {MEMORY_SHARE:g} of it): use fewer "
                                               f"cells or members, or more runs per task")
-    if c.wall_s is not None and c.wall_s > MAX_DAYS * 86400.0:
+    days = max_days()
+    if c.wall_s is not None and c.wall_s > days * 86400.0:
         raise SceneError(spec.path, "[grid]", f"{c.runs} runs to tau_end = {spec.settings.tau_end:g} would take "
                                               f"~{c.wall_s / 86400.0:.3g} days on {workers} workers (~{CPU_S_PER_RUN:g} s a "
-                                              f"run at tau_end 1e10, growing as sqrt(tau_end)); at most {MAX_DAYS:g} days: "
-                                              f"use fewer cells or members, a shorter [run].tau_end, or a cluster (scheduler)")
+                                              f"run at tau_end 1e10, growing as sqrt(tau_end)); at most {days:g} days: "
+                                              f"use fewer cells or members, a shorter [run].tau_end, or a cluster "
+                                              f"(scheduler); someone who means it raises the cap with {MAX_DAYS_ENV}=DAYS")
     return c

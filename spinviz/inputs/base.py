@@ -36,7 +36,8 @@ from pydantic_core import PydanticCustomError
 
 from ..errors import SpecError, SpecTypeError, brief
 
-__all__ = ["request", "Real", "Positive", "NonNegative", "Int", "Text", "Line", "vector", "check_vector", "between",
+__all__ = ["request", "Real", "Positive", "NonNegative", "Int", "Text", "Line", "vector", "Direction", "check_vector",
+           "between",
            "at_most", "refused", "wrong_type", "one_line", "fields_of", "terms", "SpecError", "SpecTypeError"]
 
 CONFIG = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False, arbitrary_types_allowed=True)
@@ -157,6 +158,20 @@ def check_vector(v, n: int, what: str = "numbers") -> tuple[float, ...]:
 def vector(n: int, what: str = "numbers"):
     """A list (tuple, 1-D array) of ``n`` finite numbers, as a tuple of floats."""
     return Annotated[tuple[float, ...], PlainValidator(lambda v: check_vector(v, n, what))]
+
+
+def _direction(v) -> tuple[float, ...]:
+    v = check_vector(v, 3)
+    from ..rotations import unit_vector
+
+    unit_vector(v)                      # the detector's own rule: every finite non-zero vector has a direction
+    return v
+
+
+# A direction X, Y, Z (a line of sight): three finite numbers, not all zero -- exactly what
+# ``rotations.unit_vector`` (and so the detector) can normalise, 1e308 and 1e-320 components
+# included; kept as given
+Direction = Annotated[tuple[float, ...], PlainValidator(_direction)]
 
 
 def _path(v):

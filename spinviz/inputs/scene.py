@@ -23,17 +23,19 @@ from ..errors import SpecError, brief
 from ..physics import bodies as B
 from ..physics import presets as P
 from . import receiver as RX
-from .base import Line, Positive, Real, Text, between, check_vector, one_line, refused, request, wrong_type
+from .base import Direction, Line, Positive, Real, Text, between, check_vector, one_line, refused, request, wrong_type
 from .render import MAX_TITLE
 from .simulation import MODELS, Atol, Method, Quaternion, Rtol, Samples, Vector3
 from .toml import Table
 
-# Physical ranges of the CGS inputs: wide enough for any nanoparticle and for a metre-sized
-# crystal, narrow enough that every derived quantity (I ~ rho L^5, tau0 ~ d^2/I) is a float64.
-LENGTH_NM = (0.1, 1e9, "from an atom to a metre")
-DENSITY = (1e-3, 1e3, "g/cm^3")
-DIPOLE_DEBYE = (1e-6, 1e30, "D")
+# Physical ranges of the CGS inputs, the body constructors' own (physics.bodies): the same
+# value gets the same reason from a scene and from Python.
+LENGTH_NM, DENSITY, DIPOLE_DEBYE = B.LENGTH_NM, B.DENSITY, B.DIPOLE_DEBYE
 ASPECT = (1e-3, 1e3, "L/D")
+
+# the arguments of physics.bodies.rod / box, as [body]'s keys (a rod's diameter may come from aspect)
+_SHAPE_KEYS = {"length": "length_nm", "diameter": "diameter_nm", "length, diameter": "length_nm, diameter_nm",
+               "a": "a_nm", "b": "b_nm", "c": "c_nm", "a, b, c": "a_nm, b_nm, c_nm", "dipole": "dipole_debye"}
 
 Length = Annotated[Real, between(*LENGTH_NM)]
 Density = Annotated[Real, between(*DENSITY)]
@@ -150,8 +152,9 @@ class BodyTable:
         """The body (``SpecError`` naming the key when it is not physical)."""
         try:
             return self._build(units_hint)
-        except B.BodyError as e:
-            raise SpecError(e.key, e.reason) from None
+        except B.BodyError as e:                          # the constructor's argument, as this table's key
+            key = _SHAPE_KEYS.get(e.key, e.key) if self.form == "shape" else e.key
+            raise SpecError(key, e.reason) from None
 
     def _build(self, units_hint):
         form = self.form
@@ -294,7 +297,7 @@ class ObserveTable:
     t_end: Positive | None = None
     t_end_T: Positive | None = None
     t_end_Theta: Positive | None = None
-    line_of_sight: Vector3 | None = None
+    line_of_sight: Direction | None = None
     distance_cm: RX.Distance = RX.DEFAULT_DISTANCE_CM
     bandwidth_hz: RX.Bandwidth = RX.DEFAULT_BANDWIDTH_HZ
     integration_s: RX.Integration = RX.DEFAULT_INTEGRATION_S
@@ -309,8 +312,6 @@ class ObserveTable:
     @model_validator(mode="after")
     def _check(self):
         one_of(self, *HORIZON_KEYS)
-        if self.line_of_sight is not None and not math.hypot(*self.line_of_sight) > 0.0:
-            raise SpecError("line_of_sight", "must not be zero")
         self.receiver()                                      # one of each noise and antenna key
         return self
 

@@ -184,3 +184,4 @@ class SimulationRequest:
     def atol_or_default(self) -> float:
         """atol, or rtol / 100 when not given (in spin units the state is O(1): atol >= rtol would rule)."""
         return self.rtol * 1e-2 if self.atol is None else self.atol
+

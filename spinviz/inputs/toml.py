@@ -4,12 +4,12 @@ class, with errors naming the file, the table and the key."""
 from __future__ import annotations
 
 import os
-import stat
 import tomllib
 from typing import Annotated
 
 from pydantic import PlainValidator
 
+from ..atomic import NotRegularFile, open_regular
 from ..errors import SceneError, SpecError
 from .base import terms, wrong_type
 
@@ -57,24 +57,22 @@ def read_toml(path, kind: str = "scene") -> dict:
     block or never end; nesting thousands deep would exhaust the parser's recursion)."""
     path = os.fspath(path)
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)         # never blocks on a FIFO
+        with open_regular(path) as fh:                           # never blocks on a FIFO
+            size = os.fstat(fh.fileno()).st_size
+            if size > MAX_FILE_BYTES:
+                raise SceneError(path, "(file)", f"{size} bytes is too large for a {kind} file (limit {MAX_FILE_BYTES})")
+            raw = fh.read(MAX_FILE_BYTES + 1)
+    except SceneError:
+        raise
+    except NotRegularFile as e:
+        what = f"not a {kind} file" if e.kind == "a directory" else f"a {kind} is a TOML file"
+        raise SceneError(path, "(file)", f"{e.strerror}; {what}") from None
     except FileNotFoundError:
         raise SceneError(path, "(file)", "no such file") from None
     except (OSError, ValueError) as e:                           # ValueError: an embedded NUL
         raise SceneError(path, "(file)", getattr(e, "strerror", None) or str(e)) from None
-    try:
-        st = os.fstat(fd)
-        if stat.S_ISDIR(st.st_mode):
-            raise SceneError(path, "(file)", f"is a directory, not a {kind} file")
-        if not stat.S_ISREG(st.st_mode):
-            raise SceneError(path, "(file)", f"not a regular file (a pipe, device or socket); a {kind} is a TOML file")
-        if st.st_size > MAX_FILE_BYTES:
-            raise SceneError(path, "(file)", f"{st.st_size} bytes is too large for a {kind} file (limit {MAX_FILE_BYTES})")
-        raw = os.read(fd, MAX_FILE_BYTES + 1)
-    except OSError as e:
-        raise SceneError(path, "(file)", e.strerror or str(e)) from None
-    finally:
-        os.close(fd)
+    if len(raw) > MAX_FILE_BYTES:                                # it grew while being read
+        raise SceneError(path, "(file)", f"more than {MAX_FILE_BYTES} bytes is too large for a {kind} file")
     try:
         return tomllib.loads(raw.decode("utf-8"))
     except UnicodeDecodeError:

@@ -17,6 +17,8 @@ import os
 import pickle
 import tempfile
 
+from ..atomic import open_regular
+
 
 def cache_dir() -> str:
     """Where built integrators are kept: $SPINVIZ_CACHE_DIR, else $XDG_CACHE_HOME/spinviz or
@@ -49,7 +51,7 @@ def load(key: str):
     """The object stored under ``key``, or None (absent; damaged or unreadable: removed)."""
     path = os.path.join(cache_dir(), key + ".pickle")
     try:
-        with open(path, "rb") as f:
+        with open_regular(path) as f:            # a FIFO or device planted in the cache is refused, never waited on
             return pickle.load(f)
     except FileNotFoundError:
         return None

@@ -18,18 +18,32 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import units as U
-from ..errors import brief
+from ..errors import SpecError, SpecTypeError, brief
 from ..rotations import world_from_body
 from .equations import System, is_symmetric
 
 
-class BodyError(ValueError):
-    """A body that is not physical; ``key`` names the offending parameter."""
+class BodyError(SpecError):
+    """A body that is not physical: a ``SpecError`` (so one rule for every public callable)
+    whose ``key`` names the offending argument of the body's constructor."""
 
-    def __init__(self, key: str, reason: str):
-        super().__init__(f"{key}: {reason}")
-        self.key = key
-        self.reason = reason
+
+class BodyTypeError(BodyError, SpecTypeError):
+    """A body argument of the wrong kind (a string where a number is expected)."""
+
+
+def _number(key: str, x) -> float:
+    """``x`` as a float, or ``BodyTypeError`` naming ``key`` (a string, None, a list)."""
+    if isinstance(x, bool) or not isinstance(x, int | float | np.integer | np.floating):
+        raise BodyTypeError(key, f"must be a number, got {brief(x)}")
+    return float(x)
+
+
+def _numbers(key: str, v, n: int = 3) -> tuple[float, ...]:
+    """``v`` as ``n`` floats, or ``BodyTypeError`` naming ``key``."""
+    if isinstance(v, str | bytes) or not hasattr(v, "__len__") or len(v) != n:
+        raise BodyTypeError(key, f"must be {n} numbers, got {brief(v)}")
+    return tuple(_number(key, x) for x in (v.tolist() if isinstance(v, np.ndarray) else v))
 
 
 @dataclass(frozen=True)
@@ -100,9 +114,13 @@ class Body:
     extra: dict = field(default_factory=dict, compare=False)
 
     def __post_init__(self):
+        if not isinstance(self.name, str):
+            raise BodyTypeError("name", f"must be a string, got {brief(self.name)}")
+        if not isinstance(self.units, str):
+            raise BodyTypeError("units", f"must be a string, got {brief(self.units)}")
         validate_inertia(self.inertia)
-        d = np.asarray(self.dipole, dtype=float)
-        if d.shape != (3,) or not np.all(np.isfinite(d)):
+        d = np.asarray(_numbers("dipole", self.dipole), dtype=float)
+        if not np.all(np.isfinite(d)):
             raise BodyError("dipole", f"must be three finite numbers, got {brief(self.dipole)}")
         if not np.any(d != 0.0):
             raise BodyError("dipole", "is zero: tau0 (3.8) is undefined; give a dipole and use model = \"free\" "
@@ -239,9 +257,9 @@ MIN_INERTIA_RATIO = 1e-6
 
 def validate_inertia(inertia) -> None:
     """Raise BodyError unless inertia is three finite positive moments obeying I_i <= I_j + I_k."""
-    a = np.asarray(inertia, dtype=float)
-    if a.shape != (3,):
-        raise BodyError("inertia", f"must be three principal moments, got {brief(inertia)}")
+    if isinstance(inertia, str | bytes) or not hasattr(inertia, "__len__") or len(inertia) != 3:
+        raise BodyTypeError("inertia", f"must be three principal moments, got {brief(inertia)}")
+    a = np.asarray(_numbers("inertia", inertia), dtype=float)
     if not np.all(np.isfinite(a)):
         raise BodyError("inertia", f"must be finite, got {list(a)}")
     if np.any(a <= 0.0):
@@ -258,11 +276,36 @@ def validate_inertia(inertia) -> None:
             )
 
 
+# Physical ranges of the CGS inputs (the scene's schema reads them from here): wide enough for
+# any nanoparticle and for a metre-sized crystal, narrow enough that every derived quantity
+# (I ~ rho L^5, tau0 ~ d^2/I) is a float64.
+LENGTH_NM = (0.1, 1e9, "from an atom to a metre")
+DENSITY = (1e-3, 1e3, "g/cm^3")
+DIPOLE_DEBYE = (1e-6, 1e30, "D")
+
+
 def _positive(key: str, x: float) -> float:
-    x = float(x)
+    x = _number(key, x)
     if not math.isfinite(x) or x <= 0.0:
         raise BodyError(key, f"must be a positive finite number, got {brief(x)}")
     return x
+
+
+def _within(key: str, x, lo: float, hi: float, why: str, unit: float = 1.0) -> float:
+    """``x`` (in the caller's unit) with ``x / unit`` in [lo, hi], or ``BodyError`` naming ``key``
+    with the whole range -- before anything derived from it can overflow."""
+    x = _number(key, x)
+    if not (math.isfinite(x) and lo <= x / unit <= hi):
+        raise BodyError(key, f"must lie in [{lo * unit:g}, {hi * unit:g}] ({why}), got {brief(x)}")
+    return x
+
+
+def _length_cm(key: str, x) -> float:
+    return _within(key, x, *LENGTH_NM, U.NM)
+
+
+def _density(key: str, x) -> float:
+    return _within(key, x, *DENSITY)
 
 
 # --- shapes ------------------------------------------------------------------------------
@@ -294,15 +337,27 @@ def box_from_inertia(inertia) -> tuple[float, float, float]:
     return tuple(float(x) for x in np.maximum(e, 1e-3))
 
 
+def _shape_inertia(inertia, keys: str, whose: str):
+    """The moments a shape gives, checked (``validate_inertia``); a rule they break is blamed on
+    the shape's dimensions ``keys`` (a needle too thin to integrate comes from its edges)."""
+    try:
+        validate_inertia(inertia)
+    except BodyError as e:
+        raise BodyError(keys, f"{whose} principal moments: {e.reason}") from None
+    return inertia
+
+
 def rod(length, diameter, density, dipole, dipole_angle=0.0, name="rod", **kw) -> Body:
     """Solid cylinder (CGS: cm, g/cm^3, statC cm); axis e3, dipole in the e1-e3 plane at
     ``dipole_angle`` (rad) from the axis (the paper's chi)."""
-    length = _positive("length", length)
-    diameter = _positive("diameter", diameter)
-    density = _positive("density", density)
-    dipole = _positive("dipole", dipole)
-    chi = float(dipole_angle)
-    inertia = cylinder_inertia(length, diameter, density)
+    length = _length_cm("length", length)
+    diameter = _length_cm("diameter", diameter)
+    density = _density("density", density)
+    dipole = _within("dipole", dipole, *DIPOLE_DEBYE, U.DEBYE)
+    chi = _number("dipole_angle", dipole_angle)
+    if not math.isfinite(chi):
+        raise BodyError("dipole_angle", f"must be finite, got {brief(chi)}")
+    inertia = _shape_inertia(cylinder_inertia(length, diameter, density), "length, diameter", "the rod's")
     mass = density * math.pi * 0.25 * diameter**2 * length
     return Body(
         name=name,
@@ -318,14 +373,14 @@ def rod(length, diameter, density, dipole, dipole_angle=0.0, name="rod", **kw) -
 def box(a, b, c, density, dipole, name="box", q_body_from_shape=(1.0, 0.0, 0.0, 0.0), **kw) -> Body:
     """Solid a x b x c parallelepiped (CGS: cm, g/cm^3), edges along e1, e2, e3; ``dipole``
     the body-frame dipole vector (statC cm)."""
-    a, b, c = (_positive(k, v) for k, v in (("a", a), ("b", b), ("c", c)))
-    density = _positive("density", density)
+    a, b, c = (_length_cm(k, v) for k, v in (("a", a), ("b", b), ("c", c)))
+    density = _density("density", density)
     return Body(
         name=name,
         units="cgs",
-        inertia=box_inertia(a, b, c, density),
-        dipole=tuple(float(x) for x in dipole),
-        shape=Shape("box", (a, b, c), tuple(q_body_from_shape), label="parallelepiped"),
+        inertia=_shape_inertia(box_inertia(a, b, c, density), "a, b, c", "the box's"),
+        dipole=_numbers("dipole", dipole),
+        shape=Shape("box", (a, b, c), _numbers("q_body_from_shape", q_body_from_shape, 4), label="parallelepiped"),
         extra={"density": density, "mass": density * a * b * c},
         **kw,
     )
@@ -350,10 +405,10 @@ def custom(inertia, dipole, units="cgs", name="custom", **kw) -> Body:
     Body
         Drawn as the uniform box with the same principal moments.
     """
-    inertia = tuple(float(x) for x in inertia)
     validate_inertia(inertia)
+    inertia = _numbers("inertia", inertia)
     shape = Shape("box", box_from_inertia(inertia), label="inertia-equivalent box")
-    return Body(name=name, units=units, inertia=inertia, dipole=tuple(float(x) for x in dipole), shape=shape, **kw)
+    return Body(name=name, units=units, inertia=inertia, dipole=_numbers("dipole", dipole), shape=shape, **kw)
 
 
 def symmetric_top(delta: float, chi: float, name="symmetric top", **kw) -> Body:
@@ -374,13 +429,13 @@ def symmetric_top(delta: float, chi: float, name="symmetric top", **kw) -> Body:
     Body
         units "dimensionless": tau0 = 1 (3.8), so times are in tau0 and rates in 1/tau0 (4.1).
     """
-    delta = float(delta)
+    delta = _number("delta", delta)
     if not math.isfinite(delta) or not (-1.0 <= delta < 1.0):
         raise BodyError("delta", f"must satisfy -1 <= delta < 1 (3.6), got {brief(delta)}")
     if 1.0 - delta < MIN_INERTIA_RATIO:
         raise BodyError("delta", f"1 - delta = I3/I1 = {1.0 - delta:.2g} is below {MIN_INERTIA_RATIO:g}: a needle this thin "
                                  f"makes (4.4) too stiff to integrate")
-    chi = float(chi)
+    chi = _number("chi", chi)
     if not math.isfinite(chi):
         raise BodyError("chi", f"must be finite, got {brief(chi)}")
     return custom((1.0, 1.0, 1.0 - delta), (math.sin(chi), 0.0, math.cos(chi)), units="dimensionless", name=name, **kw)

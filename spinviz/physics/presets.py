@@ -13,7 +13,7 @@ import numpy as np
 
 from .. import units as U
 from ..rotations import quat_from_axis_angle
-from .bodies import Body, PrintedFigure, Shape, _positive, box, rod
+from .bodies import DENSITY, LENGTH_NM, Body, BodyError, PrintedFigure, Shape, _within, box, rod
 
 
 # --- materials ---------------------------------------------------------------------------
@@ -71,12 +71,15 @@ def dast_box(a_nm: float, b_nm: float, c_nm: float, density: float | None = None
     density : g/cm^3, default from the crystal data (1.30); pass 1.37 for the paper's value.
     The dipole is the dipole density times the volume, along the crystal direction.
     """
-    a, b, c = (_positive(k, v) * U.NM for k, v in (("a_nm", a_nm), ("b_nm", b_nm), ("c_nm", c_nm)))
-    rho = crystal.density if density is None else _positive("density", density)
+    a, b, c = (_within(k, v, *LENGTH_NM) * U.NM for k, v in (("a_nm", a_nm), ("b_nm", b_nm), ("c_nm", c_nm)))
+    rho = crystal.density if density is None else _within("density", density, *DENSITY)
     d = crystal.dipole_density * a * b * c * crystal.dipole_direction_crystal
     kw.setdefault("source", _DAST_SOURCE)
     kw.setdefault("reference_omega", OMEGA_PAPER)
-    return box(a, b, c, rho, d, name=name or f"DAST {a_nm:g} x {b_nm:g} x {c_nm:g} nm", **kw)
+    try:
+        return box(a, b, c, rho, d, name=name or f"DAST {a_nm:g} x {b_nm:g} x {c_nm:g} nm", **kw)
+    except BodyError as e:                                   # box's edges are these, in nm
+        raise BodyError("a_nm, b_nm, c_nm" if e.key == "a, b, c" else e.key, e.reason) from None
 
 
 # --- presets of section 6 ------------------------------------------------------------------
@@ -107,6 +110,7 @@ def dast_cube(a_nm: float = 100.0, density: float | None = None) -> Body:
     (chi = 0), reached from the crystal axes by a rotation about b.  The drawn cube keeps
     its crystal faces through ``Shape.q_body_from_shape``.
     """
+    a_nm = _within("a_nm", a_nm, *LENGTH_NM)                # named before it is used in a name
     base = dast_box(a_nm, a_nm, a_nm, density)
     n_c = DAST.dipole_direction_crystal
     beta = -math.atan2(n_c[0], n_c[2])                     # rotation about b taking d to e3
@@ -133,6 +137,7 @@ def dast_cube(a_nm: float = 100.0, density: float | None = None) -> Body:
 
 def dast_family1(a_nm: float = 100.0, c_nm: float = 50.0, density: float | None = None) -> Body:
     """DAST family-1 box a = b = 100 nm, c = 50 nm (section 6.2): delta = -0.6, chi = 55 deg."""
+    a_nm, c_nm = _within("a_nm", a_nm, *LENGTH_NM), _within("c_nm", c_nm, *LENGTH_NM)
     body = dast_box(a_nm, a_nm, c_nm, density, name=f"DAST family-1 box {a_nm:g} x {a_nm:g} x {c_nm:g} nm")
     if (a_nm, c_nm) != (100.0, 50.0):
         return body

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import units as U
-from ..rotations import world_from_body
+from ..rotations import unit_vector, world_from_body
 from .equations import free_rate, radiation_function, rate_function
 
 
@@ -222,11 +222,10 @@ def polarization_basis(line_of_sight) -> tuple[np.ndarray, np.ndarray, np.ndarra
     """(n, u1, u2): the unit line of sight (world) and two unit polarization axes across it,
     u1 = z x n / |z x n| (horizontal; x x n when n is along z), u2 = n x u1; a right-handed
     triad (u1, u2, n).  Polarization angles are measured from u1 towards u2."""
-    n = np.asarray(line_of_sight, dtype=float)
-    size = float(np.linalg.norm(n))
-    if n.shape != (3,) or not math.isfinite(size) or size == 0.0:
-        raise ValueError(f"a line of sight is a non-zero 3-vector, got {n!r}")
-    n = n / size
+    try:
+        n = unit_vector(line_of_sight)     # the schema's rule (inputs.base.Direction): any finite non-zero vector
+    except ValueError as e:
+        raise ValueError(f"line of sight: {e}") from None
     ref = np.array([0.0, 0.0, 1.0]) if abs(n[2]) < 0.99 else np.array([1.0, 0.0, 0.0])
     u1 = np.cross(ref, n)
     u1 /= np.linalg.norm(u1)

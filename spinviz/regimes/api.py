@@ -24,15 +24,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..atomic import check_parent_writable
+from ..atomic import check_parent_writable, special_kind
 from ..errors import SpecTypeError, UsageError, printable
 from ..inputs.atlas import AtlasArguments
 from ..inputs.atlas_spec import AtlasSpec, check_feasible, load_spec
 from ..interrupt import check, deferred
 from .engine import runs as RN
-from .faults import AtlasIncomplete, StoreDamaged
+from .faults import AtlasIncomplete, ForeignLevel, StoreDamaged
 from .store import dataset as ST
 from .store import integrity as IN
+from .store import levels as LV
+from .store.lock import StoreLock
 
 RUNS_PER_TASK = 32          # a task of ~32 runs lasts ~0.2-10 s: scheduling (~ms) stays below 1 %
 
@@ -84,9 +86,10 @@ class AtlasResult:
         return s
 
 
-def default_out(spec: AtlasSpec) -> str:
-    """``<spec stem>.zarr`` in the current directory."""
-    stem = os.path.splitext(os.path.basename(spec.path))[0] or "atlas"
+def default_out(spec) -> str:
+    """``<spec stem>.zarr`` in the current directory (``spec``: an ``AtlasSpec`` or its path)."""
+    path = spec if isinstance(spec, str | os.PathLike) else spec.path
+    stem = os.path.splitext(os.path.basename(os.fspath(path)))[0] or "atlas"
     return f"{stem}.zarr"
 
 
@@ -145,7 +148,8 @@ def _runs_of(mask: np.ndarray) -> list[tuple[int, int]]:
 def check_out(path: str, spec_path: str | None = None) -> None:
     """The store path: a directory to be created, or an existing atlas store (checked later)."""
     if os.path.exists(path) and not os.path.isdir(path):
-        raise UsageError(f"{path}: exists and is a file; an atlas store is a directory (e.g. atlas.zarr)")
+        kind = special_kind(os.stat(path).st_mode) or "a file"
+        raise UsageError(f"{path}: exists and is {kind}; an atlas store is a directory (e.g. atlas.zarr)")
     if spec_path and os.path.exists(path) and os.path.exists(spec_path) and os.path.samefile(path, spec_path):
         raise UsageError(f"{path}: is the spec itself")
     check_parent_writable(path)
@@ -200,10 +204,28 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
         from .figures.draw import check_plot_paths
 
         plots = check_plot_paths(plot, out, spec)
+    # one writer at a time (an advisory lock beside the store), taken before anything reads or
+    # writes it; a second atlas command on this store is refused here, at once
+    with StoreLock(out, exclusive=True, what="this atlas command"):
+        res = _compute(spec, out, scheduler, workers, processes, runs_per_task, flush_s, retry_failed, on_result,
+                       progress, say)
+        if plot is not None:
+            from .figures.draw import draw
+
+            res.plots = draw(out, plots)
+    return res
+
+
+def _compute(spec, out, scheduler, workers, processes, runs_per_task, flush_s, retry_failed, on_result, progress,
+             say) -> AtlasResult:
+    """The atlas's levels, computed or completed in order under the store's lock."""
     t0 = time.perf_counter()
-    levels = [Level(spec, out, None)]
-    totals = {"todo": 0, "reused": 0, "repaired": 0, "failed": 0, "runs": 0}
     notices: list = []
+    _clear_creation_leftovers(out, say, notices)
+    if os.path.exists(out):
+        _check_store(spec, out)
+    levels: list[Level] = []
+    totals = {"todo": 0, "reused": 0, "repaired": 0, "failed": 0, "runs": 0}
     stats = None
     where = "nothing to compute"
     # stop signals are recorded, and acted on where this code looks (check()), never raised
@@ -211,12 +233,15 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
     with deferred(), contextlib.ExitStack() as stack:
         cluster = _LazyCluster(stack, scheduler, workers, processes)
         for k in range(spec.refine_levels + 1):
-            if k:
-                levels.append(refined_level(spec, out, levels, k))
-                if not levels[-1].wanted.any():
-                    levels.pop()
+            if k == 0:
+                lv = Level(spec, out, None)
+            else:
+                cells = LV.wanted(spec, [x.out for x in levels], k)
+                if not cells.any():
                     break
-            lv = levels[-1]
+                lv = Level(LV.level_spec(spec, k), ST.level_path(out, k), cells)
+                _prepare_level(lv, k, say, notices)
+            levels.append(lv)
             s = _run_level(lv, cluster, runs_per_task, flush_s, retry_failed, on_result, progress, say, notices, totals)
             stats = s if stats is None else stats.merged(s)
             if s is not None:
@@ -228,14 +253,79 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
                     done = ST.done_mask(lv.out)
                     done = int((done if lv.wanted is None else done & lv.wanted[..., None]).sum())
                     raise AtlasIncomplete(lv.out, inc.cause, lv.runs - done, lv.runs, done, inc.cluster_lost)
+        for k in LV.found(out):
+            if k >= len(levels):
+                line = (f"{ST.level_path(out, k)}: not a level this atlas implies (the labels of level {len(levels) - 1} "
+                        f"flag no cell for it); left as it is: rm -r {ST.level_path(out, k)} removes it")
+                notices.append(line)
+                say(line)
     seconds = time.perf_counter() - t0
-    res = AtlasResult(out, totals["runs"], totals["todo"], totals["reused"], totals["failed"], seconds, where, [], stats,
-                      totals["repaired"], notices, levels=len(levels) - 1)
-    if plot is not None:
-        from .figures.draw import draw
+    return AtlasResult(out, totals["runs"], totals["todo"], totals["reused"], totals["failed"], seconds, where, [], stats,
+                       totals["repaired"], notices, levels=len(levels) - 1)
 
-        res.plots = draw(out, plots)
-    return res
+
+def _check_store(spec: AtlasSpec, out: str) -> None:
+    """Before any work: an existing store must be an atlas of this very spec (its metadata
+    whole: ``StoreDamaged`` otherwise), and every ``levelK`` inside it a level of this spec --
+    one of another atlas, or beyond the spec's ``[refine] levels``, is refused with the one
+    command that removes it (``ForeignLevel``), never mixed in and never deleted.  (A level
+    that is damaged or missing is recomputed when its turn comes, ``_prepare_level``.)"""
+    if not os.path.isdir(out):
+        return                                       # check_out has said what it is
+    skeleton = IN.verify_skeleton(out)
+    if skeleton is None:
+        if not os.path.exists(os.path.join(out, ".zgroup")):
+            raise UsageError(f"{out}: exists and is not an atlas store (no .zgroup); choose another store path")
+        ST.check_identity(spec, out)                 # another Zarr store, or another spec: said as such
+        raise StoreDamaged(f"{out}: carries no checksums (made by an earlier spinviz, or its {IN.DIR} was deleted), "
+                           f"so its runs cannot be trusted; move it away and compute the atlas again")
+    if skeleton:
+        raise StoreDamaged(f"{out}: its metadata are damaged ({IN.summary(skeleton, 4)}); they cannot be "
+                           f"recomputed from the runs: move it away and compute the atlas again")
+    ST.check_identity(spec, out)
+    for k in LV.found(out):
+        path = ST.level_path(out, k)
+        if k > spec.refine_levels:
+            raise ForeignLevel(f"{path}: not a refinement level of this spec ([refine] levels = {spec.refine_levels}); "
+                               f"refusing to mix it in: remove it (rm -r {path}) and run the same command again")
+        want = LV.level_identity(spec, k)
+        st = LV.state(path, want)
+        if st.kind == "foreign":
+            raise ForeignLevel(f"{path}: holds a refinement level of another atlas (sha256 {st.sha256[:12]}; this "
+                               f"spec's level {k}: {want[:12]}); refusing to mix them: remove it (rm -r {path}) and "
+                               f"the same command computes this spec's")
+
+
+def _prepare_level(lv: Level, k: int, say, notices: list) -> None:
+    """Level ``k``'s store before its runs: a damaged one (no .zgroup, no checksums, metadata
+    that do not match them) is removed -- a level is recomputable from the spec and the levels
+    below -- and said in one line; a foreign one was refused before any work (``_check_store``)."""
+    st = LV.state(lv.out, ST.identity(lv.spec))
+    if st.kind == "foreign":                         # appeared since the check: another hand in the store
+        raise ForeignLevel(f"{lv.out}: holds a refinement level of another atlas; remove it (rm -r {lv.out}) and "
+                           f"run the same command again")
+    if st.kind == "damaged":
+        with deferred():
+            IN.remove(lv.out)
+        line = f"{lv.out}: {st.why}; the level is computed again"
+        notices.append(line)
+        say(line)
+
+
+def _clear_creation_leftovers(out: str, say, notices: list) -> None:
+    """The temporary directories a killed creation of this store left beside it
+    (``.NAME.XXXXXXXX.partial``): removed (the lock says no creation is under way), in one line."""
+    left = LV.creation_leftovers(out)
+    if not left:
+        return
+    with deferred():
+        for path in left:
+            IN.remove(path)
+    names = ", ".join(printable(os.path.basename(p), 80) for p in left[:3]) + (" ..." if len(left) > 3 else "")
+    line = (f"{out}: removed {len(left)} temporary director{'ies' if len(left) != 1 else 'y'} an interrupted creation "
+            f"left beside it ({names})")
+    notices.append(line)
+    say(line)
 
 
 @dataclass
@@ -254,48 +344,7 @@ class Level:
         return self.spec.runs if self.wanted is None else int(self.wanted.sum()) * self.spec.members
 
 
-def level_spec(spec: AtlasSpec, k: int) -> AtlasSpec:
-    """The spec of refinement level ``k``: every axis cut 2^k times finer, the rest unchanged."""
-    from dataclasses import replace
-
-    from .engine import refine as RF
-
-    (d0, d1, nd), (c0, c1, nc) = spec.axes["delta"], spec.axes["chi"]
-    return replace(spec, title=f"{spec.title or os.path.basename(spec.path)}: refinement level {k}",
-                   deltas=RF.centres(d0, d1, nd, k), chis=RF.centres(c0, c1, nc, k), refine_levels=0,
-                   axes={"delta": (d0, d1, nd * 2**k), "chi": (c0, c1, nc * 2**k)})
-
-
-def refined_level(spec: AtlasSpec, out: str, levels: list, k: int) -> Level:
-    """Level ``k``: the children of the level-(k - 1) cells that ``refine.flags`` marks, from
-    the types the levels below computed (a cell counts as computed when all its members are)."""
-    from .engine import refine as RF
-
-    sub = level_spec(spec, k)
-    wanted = np.zeros((len(spec.models), len(sub.deltas), len(sub.chis)), dtype=bool)
-    for mi in range(len(spec.models)):
-        maj, share, comp = [], None, []
-        for lv in levels:
-            types, done = level_types(lv.out, mi)
-            m, share = RF.majority(types)
-            maj.append(m)
-            comp.append(done)
-        eff = RF.effective(maj, comp)
-        wanted[mi] = RF.children(RF.flags(maj[-1], share, comp[-1], eff, spec.refine_agree))
-    return Level(sub, ST.level_path(out, k), wanted)
-
-
-def level_types(path: str, model_index: int):
-    """(types (delta, chi, member) int, computed (delta, chi) bool) of one model of a level's
-    store: an approaching run counts for the type it approaches (``refine.type_of``)."""
-    import zarr
-
-    from .engine import refine as RF
-
-    g = zarr.open_group(path, mode="r", zarr_format=2)
-    codes = np.asarray(g["regime"][model_index])
-    types = RF.type_of(codes, np.asarray(g["candidate"][model_index]))
-    return types, (np.asarray(g["done"][model_index]) == 1).all(axis=-1)
+level_spec, level_types = LV.level_spec, LV.level_types      # the levels' rules live with the store
 
 
 class _LazyCluster:
@@ -330,7 +379,7 @@ def _run_level(lv: Level, cluster: _LazyCluster, runs_per_task, flush_s, retry_f
     from .cluster import execute
 
     spec, out = lv.spec, lv.out
-    exists = os.path.exists(os.path.join(out, ".zgroup")) if lv.wanted is not None else os.path.exists(out)
+    exists = os.path.exists(out)                     # a level's damaged or foreign store never gets here
     repaired = 0
     if exists:
         chunks, done, repaired, said = _resume(spec, out, say)

@@ -50,9 +50,16 @@ def task_cost(n: int = 200, workers: int = 2) -> float:
 
 
 def run(spec, workers: int | None = None, progress: bool = True) -> dict:
-    """All measurements (see the module docstring) as a dict of plain numbers."""
+    """All measurements (see the module docstring) as a dict of plain numbers.  ``workers`` (the
+    larger of the two measurements) is checked first, by the atlas's own schema, and the spec's
+    atlas must be feasible on it -- before the first measurement."""
+    from ..inputs.atlas import AtlasArguments
+    from ..inputs.atlas_spec import check_feasible
+
+    args = AtlasArguments(workers=workers, progress=progress)
     spec = spec if isinstance(spec, AtlasSpec) else load_spec(spec)
     many = workers or min(2, os.cpu_count() or 1)
+    check_feasible(spec, AtlasArguments(workers=many, progress=args.progress))
     rows = {"spec": spec.path, "runs": spec.runs, "models": list(spec.models), "cores": os.cpu_count()}
     tmp = tempfile.mkdtemp(prefix="spinviz-atlas-bench-")
     try:
@@ -126,6 +133,10 @@ def store_cost(spec, repeats: int = 3) -> dict:
     from .store import dataset as ST
     from .store import integrity as IN
 
+    if isinstance(repeats, bool) or not isinstance(repeats, int) or not 1 <= repeats <= 100:
+        from ..errors import SpecError
+
+        raise SpecError("repeats", f"must be a whole number in [1, 100] (the median of the write timings), got {repeats!r}")
     spec = spec if isinstance(spec, AtlasSpec) else load_spec(spec)
     rows = {True: [], False: []}
     tmp = tempfile.mkdtemp(prefix="spinviz-atlas-store-")

@@ -32,6 +32,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import math
+import multiprocessing
 import os
 import queue
 import signal
@@ -143,7 +144,8 @@ def _quiet_distributed():
     """Dask's own log lines (reconnect attempts, restarted workers) are not for the user:
     what matters is said in one line by the atlas."""
     names = ("distributed", "distributed.client", "distributed.nanny", "distributed.scheduler", "distributed.worker",
-             "distributed.core", "distributed.comm", "distributed.deploy", "distributed.batched")
+             "distributed.core", "distributed.comm", "distributed.deploy", "distributed.batched", "asyncio",
+             "tornado.application", "tornado.general")
     loggers = [logging.getLogger(n) for n in names]
     levels = [lg.level for lg in loggers]
     for lg in loggers:
@@ -178,6 +180,7 @@ class Cluster:
         self._quiet = None
         self._monitor = None
         self._describe = None
+        self._children_before: set | None = None      # this process's children before the LocalCluster
 
     def __enter__(self) -> Cluster:
         from distributed import Client
@@ -211,6 +214,7 @@ class Cluster:
         from distributed import Client, LocalCluster
 
         RN.warm()                                    # compile once into the on-disk cache; the workers load it
+        self._children_before = {p.pid for p in multiprocessing.active_children()}
         n = self.workers or usable_cores()
         opts = dict(n_workers=0, threads_per_worker=1, processes=self.processes,
                     dashboard_address=None, silence_logs=logging.CRITICAL + 1,
@@ -298,6 +302,9 @@ class Cluster:
         with contextlib.suppress(BaseException):
             if self.cluster is not None:
                 self.cluster.close(timeout=2 if fast else 10)
+        if self._children_before is not None:
+            _kill_new_children(self._children_before)
+            self._children_before = None
         self.client = self.cluster = self._monitor = None
         if self._quiet is not None:
             self._quiet.__exit__(None, None, None)
@@ -325,6 +332,25 @@ def _kill_workers(cluster, wait_s: float = 0.5) -> None:
         pids = [p for p in pids if os.path.exists(f"/proc/{p}")]
         if pids:
             time.sleep(0.01)
+
+
+def _kill_new_children(before: set, wait_s: float = 2.0) -> None:
+    """SIGKILL and reap the worker processes the LocalCluster started that are still alive
+    after it closed (a worker being started when the stop came, one a nanny restarted): they
+    block the stop signals, so nothing else ends them, and multiprocessing's exit hook would
+    wait for them forever.  Only children started since the cluster was made (``before``:
+    the ones there were) are touched; repeated until none is left or ``wait_s`` passed."""
+    end = time.monotonic() + wait_s
+    while True:
+        left = [p for p in multiprocessing.active_children() if p.pid not in before]
+        if not left or time.monotonic() > end:
+            return
+        for p in left:
+            with contextlib.suppress(Exception):
+                p.kill()
+        for p in left:
+            with contextlib.suppress(Exception):
+                p.join(max(0.0, min(0.5, end - time.monotonic())))
 
 
 class _Monitor:

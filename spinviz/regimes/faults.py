@@ -11,6 +11,11 @@ atlas's own, and their text names library parameters, never command-line flags).
   (the scheduler went away, no worker left) or tasks failed as a whole (a task that killed
   its workers, an exception outside the runs).  Nothing of those runs was written: the
   store holds exactly the finished ones and the same call completes it.
+* ``StoreBusy`` -- another spinviz holds the store's lock (it is writing it, or verifying
+  it): refused at once, exit status 75 like a lost cluster (the same command works once the
+  other has finished).
+* ``ForeignLevel`` -- a refinement level inside the store carries another atlas's identity:
+  not mixed, not deleted; the one line says how to remove it.
 
 A run that fails *physically* (a runaway, a singular start, the step budget) is not an error
 here: it is a result, recorded in the store with its reason.
@@ -39,6 +44,16 @@ class OptionError(SpecError):
 
 class StoreDamaged(UsageError):
     """The store's metadata are damaged or unverifiable; it is not resumed."""
+
+
+class StoreBusy(SpinvizError):
+    """Another process holds the store's lock; nothing was done."""
+
+    exit_status = EXIT_CLUSTER_LOST
+
+
+class ForeignLevel(UsageError):
+    """A refinement level of the store is a whole store of another atlas; it is not resumed."""
 
 
 class AtlasIncomplete(SpinvizError):

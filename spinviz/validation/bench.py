@@ -213,13 +213,14 @@ class Plan:
     problems: tuple = PROBLEMS
     radau_up_to: float = 1e2
     notes: list = field(default_factory=list)
+    quick: bool = False                          # the --quick plan (its repeats are cheaper: the work estimate)
 
 
 def quick_plan() -> Plan:
     """The plan of ``spinviz bench --quick``: two problems, 1e2 and 1e4 turns, fewer
     tolerances (~2 min)."""
     return Plan(rtols=(1e-8, 1e-11), taylor_rtols=(1e-8, 1e-11, 1e-13), split_per_T=(10, 40), split_per_turn=(8, 32),
-                repeats=3, horizons=(1e2, 1e4), problems=("6.10", "5.2+q"), radau_up_to=0)
+                repeats=3, horizons=(1e2, 1e4), problems=("6.10", "5.2+q"), radau_up_to=0, quick=True)
 
 
 def _configs(p: BenchProblem, plan: Plan, turns: float):
@@ -246,7 +247,15 @@ def _configs(p: BenchProblem, plan: Plan, turns: float):
 def run(plan: Plan, progress=None) -> list[Row]:
     """Every problem, horizon and configuration; runs predicted to take longer than
     ``plan.max_run_seconds`` (from the same configuration at the previous horizon, cost per
-    turn) are not run and get an extrapolated time."""
+    turn) are not run and get an extrapolated time.  The plan's repeats and problems are
+    checked first (``inputs.options.BenchRequest``: the work they mean within the cap)."""
+    from ..inputs.options import BenchRequest
+
+    if not isinstance(plan, Plan):
+        from ..errors import SpecTypeError
+
+        raise SpecTypeError("plan", f"must be a bench.Plan, got {type(plan).__name__}")
+    BenchRequest(repeats=plan.repeats, quick=plan.quick, problems=plan.problems, known=PROBLEMS)
     rows: list[Row] = []
     say = progress or (lambda msg: None)
     _warm_up()

@@ -153,7 +153,12 @@ def reference(sp: Spec):
 
 
 def run(problems=PROBLEMS, turns: float = 400.0, repeats: int = 3, quick: bool = False, progress=None) -> list[Point]:
-    """Every point of every problem (see the module docstring)."""
+    """Every point of every problem (see the module docstring).  ``problems``, ``turns`` and
+    ``repeats`` are checked first (``inputs.options.BenchRequest``: the work they mean within
+    the cap)."""
+    from ..inputs.options import BenchRequest
+
+    BenchRequest(repeats=repeats, quick=quick, process=True, problems=problems, known=PROBLEMS, turns=turns)
     say = progress or (lambda m: None)
     py = sys.executable
     points: list[Point] = []

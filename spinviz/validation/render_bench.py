@@ -20,11 +20,17 @@ ENCODER = "libx264 yuv420p veryfast crf 20"
 
 
 def run(scene, fps=None, duration=None, frames: int = 150, workers=None) -> list[dict]:
-    """One row per size: frames, workers, seconds, start-up seconds, fps, steady fps, MB."""
+    """One row per size: frames, workers, seconds, start-up seconds, fps, steady fps, MB.
+    ``frames`` and ``workers`` are checked first (``inputs.render.RenderArguments``), the
+    scene's size, fps and duration by its ``RenderSpec`` -- before the scene is simulated."""
+    from ..inputs.render import RenderArguments
+
+    RenderArguments(frames=frames, workers=workers)
+    specs = {size: resolve_spec(scene, size=size, fps=fps, duration=duration)[2] for size in SIZES}
     video = require_render_stack()
     rows, trajs = [], None
     for size in SIZES:
-        _, _, spec = resolve_spec(scene, size=size, fps=fps, duration=duration)
+        spec = specs[size]
         trajs = trajs or scene_trajectories(scene, spec)
         plan = plan_frames(spec, trajs)
         with tempfile.TemporaryDirectory() as d:

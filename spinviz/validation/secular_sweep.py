@@ -65,7 +65,12 @@ def run_case(case: dict) -> dict:
 
 def run(seeds, runs: int = 40, progress=None) -> list[dict]:
     """``runs`` cases of each seed (``draw``, ``run_case``), each row with its "seed";
-    ``progress(row)`` is called after each."""
+    ``progress(row)`` is called after each.  ``seeds`` (a range or a list of non-negative
+    whole numbers) and ``runs`` are checked first (``inputs.options.SweepRequest``: the work
+    they mean within the cap)."""
+    from ..inputs.options import SweepRequest
+
+    seeds = SweepRequest(seeds=seeds, runs=runs).seeds
     rows = []
     for seed in seeds:
         rng = np.random.default_rng(seed)

@@ -8,11 +8,22 @@ member -- omega1 sqrt(tau) against omega2 sqrt(tau) and omega_perp sqrt(tau) aga
 sqrt(tau), dots coloured by log tau -- in the side panel.  The series travel as base64 int16
 at 1e-3 resolution: every other sample of the last ``2 SERIES_POINTS`` (the late decades,
 where the types show).
+
+Nothing from outside is ever markup.  The page is opened from links (its address's
+``#open=`` is anyone's to write) and shows what a store holds (titles, model names, labels):
+in the HTML every such value is escaped (``html.escape``, attributes quoted), the series
+travel as JSON with every ``<`` escaped, and the script builds the side panel with
+``createElement``/``createElementNS``, ``textContent`` and ``setAttribute`` only -- never
+``innerHTML``.  A Content-Security-Policy in the page contains any future slip: no source but
+the page's own script (allowed by its sha256: a static file has no fresh nonce) and its own
+style sheet (by hash too); no inline event handler, ``style`` attribute, remote load, form,
+frame or base.
 """
 
 from __future__ import annotations
 
 import base64
+import hashlib
 import html
 import json
 import math
@@ -51,18 +62,23 @@ def _tip(model: str, c: dict, evidence: dict | None) -> str:
     return "\n".join(parts)
 
 
+def _text(value) -> str:
+    """Any value as HTML text or a quoted attribute's value: escaped, never markup."""
+    return html.escape(str(value), quote=True)
+
+
 def _panel(model: str, cells: list[dict], evidence) -> str:
+    name = _text(model)
     out = [f'<svg class="panel" viewBox="0 0 {PAD_L + W + 10} {PAD_T + H + PAD_B}" role="img" '
-           f'aria-label="{model} model diagram">',
-           f'<text x="{PAD_L + W / 2}" y="{PAD_T - 1}" class="ptitle">{model} model</text>']
+           f'aria-label="{name} model diagram">',
+           f'<text x="{PAD_L + W / 2}" y="{PAD_T - 1}" class="ptitle">{name} model</text>']
     for c in cells:
-        cid = c["id"]
-        out.append(f'<g class="cell" data-id="{cid}"><title>{html.escape(_tip(model, c, evidence(c)))}</title>')
+        out.append(f'<g class="cell" data-id="{_text(c["id"])}"><title>{_text(_tip(model, c, evidence(c)))}</title>')
         x = c["x0"]
         y0, y1 = _y(c["y1"]), _y(c["y0"])
         for name, frac, hatched in c["bars"]:
             w = (c["x1"] - c["x0"]) * frac
-            fill = f"url(#hatch-{name.replace('.', '_')})" if hatched else COLORS[name]
+            fill = f"url(#hatch-{_key(name)})" if hatched else COLORS[name]
             out.append(f'<rect x="{_x(x):.2f}" y="{y0:.2f}" width="{_x(x + w) - _x(x) + 0.4:.2f}" '
                        f'height="{y1 - y0 + 0.4:.2f}" fill="{fill}"/>')
             x += w
@@ -130,32 +146,45 @@ def _pack(series: dict) -> dict:
 
 
 SCRIPT = r"""
+'use strict';
+const NS = 'http://www.w3.org/2000/svg';
 const S = JSON.parse(document.getElementById('series').textContent);
-function hodo(id){
-  const box = document.getElementById('hodo'); const s = S[id];
-  document.querySelectorAll('.cell.sel').forEach(e => e.classList.remove('sel'));
-  const g = document.querySelector(`[data-id="${id}"]`); if (g) g.classList.add('sel');
-  if (!s){ box.innerHTML = `<p>${id}: no stored series for this cell</p>`; return; }
+function svg(tag, attrs, text) {
+  const e = document.createElementNS(NS, tag);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, String(v));
+  if (text !== undefined) e.textContent = text;
+  return e;
+}
+function para(tag, text) { const e = document.createElement(tag); e.textContent = text; return e; }
+function hodo(id) {
+  const box = document.getElementById('hodo');
+  const s = Object.prototype.hasOwnProperty.call(S, id) ? S[id] : null;
+  document.querySelectorAll('.cell').forEach(g => g.classList.toggle('sel', g.dataset.id === id));
+  box.replaceChildren();
+  if (!s) { box.append(para('p', `${id.slice(0, 200)}: no stored series for this cell`)); return; }
   const raw = atob(s.b64), n = raw.length / 6, v = new DataView(new ArrayBuffer(raw.length));
   for (let i = 0; i < raw.length; i++) v.setUint8(i, raw.charCodeAt(i));
   const p = []; for (let k = 0; k < n; k++) p.push([0,1,2].map(a => v.getInt16(6*k + 2*a, true) / 1000));
   const big = (q) => Math.max(Math.abs(q[0]), Math.abs(q[1]), Math.hypot(q[0], q[1]), Math.abs(q[2]));
   const lim = Math.max(0.05, ...p.map(big)) * 1.1;
   const sc = (x) => 110 + 100 * x / lim, col = (k) => `hsl(${260 - 200 * k / Math.max(1, n - 1)},70%,45%)`;
-  let a = '', b = '';
-  p.forEach((q, k) => { a += `<circle cx="${sc(q[0])}" cy="${sc(-q[1])}" r="2" fill="${col(k)}"/>`;
-                        b += `<circle cx="${sc(Math.hypot(q[0], q[1]))}" cy="${sc(-q[2])}" r="2" fill="${col(k)}"/>`; });
-  const ax = `<line x1="10" x2="210" y1="110" y2="110" stroke="#bbb"/><line x1="110" x2="110" y1="10" y2="210" stroke="#bbb"/>`;
-  const fig = (title, dots) => `<svg viewBox="0 0 220 240" class="h"><text x="110" y="232" class="tick">` +
-    `${title}</text>${ax}${dots}</svg>`;
-  box.innerHTML = `<h3>${s.where}: first start, label ${s.label}</h3>` +
-    fig('\u03c9\u2081\u221a\u03c4 \u2192, \u03c9\u2082\u221a\u03c4 \u2191', a) +
-    fig('\u03c9\u22a5\u221a\u03c4 \u2192, \u03c9\u2083\u221a\u03c4 \u2191', b) +
-    `<p>log\u2081\u2080 \u03c4 from ${s.lt0.toFixed(1)} (violet) to ${s.lt1.toFixed(1)} (green); ` +
-    `axes to \u00b1${lim.toFixed(2)}</p>`;
+  const fig = (title, xy) => {
+    const f = svg('svg', {viewBox: '0 0 220 240', class: 'h'});
+    f.append(svg('text', {x: 110, y: 232, class: 'tick'}, title),
+             svg('line', {x1: 10, x2: 210, y1: 110, y2: 110, stroke: '#bbb'}),
+             svg('line', {x1: 110, x2: 110, y1: 10, y2: 210, stroke: '#bbb'}));
+    p.forEach((q, k) => { const [x, y] = xy(q); f.append(svg('circle', {cx: sc(x), cy: sc(-y), r: 2, fill: col(k)})); });
+    return f;
+  };
+  box.append(para('h3', `${s.where}: first start, label ${s.label}`),
+    fig('\u03c9\u2081\u221a\u03c4 \u2192, \u03c9\u2082\u221a\u03c4 \u2191', q => [q[0], q[1]]),
+    fig('\u03c9\u22a5\u221a\u03c4 \u2192, \u03c9\u2083\u221a\u03c4 \u2191', q => [Math.hypot(q[0], q[1]), q[2]]),
+    para('p', `log\u2081\u2080 \u03c4 from ${s.lt0.toFixed(1)} (violet) to ${s.lt1.toFixed(1)} (green); ` +
+              `axes to \u00b1${lim.toFixed(2)}`));
 }
 document.querySelectorAll('.cell').forEach(g => g.addEventListener('click', () => hodo(g.dataset.id)));
-const m = location.hash.match(/open=([^&]+)/); if (m) hodo(decodeURIComponent(m[1]));
+const m = location.hash.match(/open=([^&]+)/);
+if (m) { let id = m[1]; try { id = decodeURIComponent(id); } catch (e) { /* not %-encoded: as written */ } hodo(id); }
 """
 
 STYLE = """
@@ -166,7 +195,25 @@ body{font-family:sans-serif;margin:12px;color:#222} h1{font-size:18px} .row{disp
 .cell:hover rect{opacity:.75} .cell.sel rect{stroke:#000;stroke-width:1} .co{fill:#000;stroke:#fff;stroke-width:.5}
 #hodo{min-width:460px} .h{width:220px} .legend span{display:inline-block;margin:2px 10px 2px 0;font-size:12px}
 .legend i{display:inline-block;width:14px;height:10px;margin-right:4px;border:1px solid #888;vertical-align:middle}
+.defs{position:absolute} .sw-hatched{background:repeating-linear-gradient(45deg,#888 0 2px,#fff 2px 4px)}
 """
+
+
+def _key(label: str) -> str:
+    """A type's label as an id or class name ("3.9" -> "3_9")."""
+    return label.replace(".", "_")
+
+
+def _sha256(text: str) -> str:
+    return "'sha256-" + base64.b64encode(hashlib.sha256(text.encode("utf-8")).digest()).decode("ascii") + "'"
+
+
+def policy(script: str, style: str) -> str:
+    """The page's Content-Security-Policy: nothing loads or runs but its own script and style
+    sheet (each allowed by its sha256), so an inline event handler, a ``style`` attribute, a
+    remote image or script, a form, a frame or a ``<base>`` would all be refused."""
+    return (f"default-src 'none'; script-src {_sha256(script)}; style-src {_sha256(style)}; base-uri 'none'; "
+            f"form-action 'none'")
 
 
 def page(levels, series: dict | None = None, evidence=None, title: str | None = None) -> str:
@@ -181,22 +228,26 @@ def page(levels, series: dict | None = None, evidence=None, title: str | None = 
     drawn = {c["id"] for m in models for c in cells[m]}          # a cell a finer level covers is not drawn
     series = {cid: s for cid, s in (series or {}).items() if cid in drawn}
     hatches = "".join(
-        f'<pattern id="hatch-{k.replace(".", "_")}" patternUnits="userSpaceOnUse" width="4" height="4" '
+        f'<pattern id="hatch-{_key(k)}" patternUnits="userSpaceOnUse" width="4" height="4" '
         f'patternTransform="rotate(45)"><rect width="4" height="4" fill="{c}"/><line x1="0" y1="0" x2="0" y2="4" '
         f'stroke="#fff" stroke-width="1.4"/></pattern>' for k, c in COLORS.items())
     found = {name for m in models for c in cells[m] for name, _, _ in c["bars"]}
-    legend = "".join(f'<span><i style="background:{COLORS[k]}"></i>{html.escape(w)}</span>'
-                     for k, w in WORDS.items() if k in found)
-    legend += ('<span><i style="background:repeating-linear-gradient(45deg,#888 0 2px,#fff 2px 4px)"></i>'
+    legend = "".join(f'<span><i class="sw-{_key(k)}"></i>{_text(w)}</span>' for k, w in WORDS.items() if k in found)
+    legend += ('<span><i class="sw-hatched"></i>'
                'hatched: still approaching that type (a slow hand-over)</span><span>\u25cf two types coexist</span>'
                '<span>black lines: the paper\'s boundaries; blue/red: spinviz\'s (each labelled)</span>')
+    style = STYLE + "".join(f".sw-{_key(k)}{{background:{c}}}" for k, c in COLORS.items()) + "\n"
     if len(levels) > 1:
         legend += (f'<span>smaller cells: {len(levels) - 1} refinement level(s) where the types change, down to '
                    f'{levels[-1].sizes["delta"]} \u00d7 {levels[-1].sizes["chi"]} cells</span>')
-    head = html.escape(title or ds.attrs.get("title", "regime atlas"))
-    data = json.dumps(_pack(series or {}), separators=(",", ":")).replace("</", "<\\/")
-    return (f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>{head}</title><style>{STYLE}</style>'
-            f'</head><body><h1>{head}</h1><svg width="0" height="0" style="position:absolute"><defs>{hatches}</defs></svg>'
+    head = _text(title or ds.attrs.get("title", "regime atlas"))
+    # JSON inside <script type="application/json">: every "<" escaped, so no "</script>" or
+    # "<!--" in a title, label or id can end or change the block
+    data = json.dumps(_pack(series or {}), separators=(",", ":")).replace("<", "\\u003c")
+    csp = _text(policy(SCRIPT, style))
+    return (f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
+            f'<meta http-equiv="Content-Security-Policy" content="{csp}"><title>{head}</title><style>{style}</style>'
+            f'</head><body><h1>{head}</h1><svg width="0" height="0" class="defs"><defs>{hatches}</defs></svg>'
             f'<div class="row">{"".join(panels)}<div id="hodo"><p>Hover a cell for its types and evidence; click it for '
             f'the hodograph of its first start.</p></div></div><div class="legend">{legend}</div>'
             f'<script type="application/json" id="series">{data}</script><script>{SCRIPT}</script></body></html>')

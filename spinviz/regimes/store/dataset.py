@@ -14,8 +14,12 @@ Layout (dims ``model``, ``delta``, ``chi``, ``member``; ``axis`` = 1, 2, 3; ``qu
     omega0                            float64 (member, axis): the starts, the same at every cell
     paper                             float64 (delta, chi, formula): the formulas' predictions
 
-Attributes: ``spec`` (canonical JSON), ``spec_sha256`` (identity), ``seed``, ``spinviz_version``,
-``classifier_version``, ``title``.  Zarr format 2 with consolidated metadata, so plain
+Attributes: ``spec`` (canonical JSON), ``spec_sha256`` (identity: the hash of every setting
+that changes the numbers, the classifier's version among them), ``grid_axes`` (the grid's
+{min, max, cells}, from which the refinement levels' grids follow), ``seed``,
+``spinviz_version``, ``classifier_version``, ``title``.  Every refinement level's store carries
+its own ``spec_sha256`` (of its level's spec), so a level from another atlas is told apart
+(``levels``).  Zarr format 2 with consolidated metadata, so plain
 ``xarray.open_zarr(path)`` opens it with no warning.
 
 Safety.  The store is created complete but empty in a temporary directory and renamed into
@@ -163,6 +167,7 @@ def template(spec, chunks: tuple):
         "title": spec.title or os.path.basename(spec.path),
         "spec": spec.canonical_json(),
         "spec_sha256": identity(spec),
+        **({"grid_axes": json.dumps({k: list(v) for k, v in spec.axes.items()})} if spec.axes else {}),
         "seed": -1 if spec.seed is None else int(spec.seed),
         "spinviz_version": __version__,
         "classifier_version": C.VERSION,
@@ -186,7 +191,9 @@ def create(spec, path: str, chunks: tuple | None = None) -> None:
     chunks = chunks or chunk_shape(spec)
     parent = os.path.dirname(os.path.abspath(path)) or "."
     os.makedirs(parent, exist_ok=True)
-    tmp = tempfile.mkdtemp(prefix=f".{os.path.basename(path)}.", suffix=".partial", dir=parent)
+    # .NAME.XXXXXXXX.partial: what a kill before the rename leaves, recognised by that name
+    # (integrity.creation_leftover) and removed by the next atlas command on this store
+    tmp = tempfile.mkdtemp(prefix=f".{os.path.basename(os.path.abspath(path))}.", suffix=".partial", dir=parent)
     try:
         store = os.path.join(tmp, "atlas.zarr")
         template(spec, chunks).to_zarr(store, mode="w-", compute=False, zarr_format=2, consolidated=True)

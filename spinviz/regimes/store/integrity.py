@@ -31,9 +31,11 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
+import shutil
 from dataclasses import dataclass, field
 
-from ...atomic import write_text
+from ...atomic import open_regular, write_text
 
 DIR = ".checksums"
 SKELETON = "skeleton.json"
@@ -43,15 +45,32 @@ TRAILING = {"evidence": 1, "omega_final": 1, "series": 2}   # per-run variables'
 
 
 def sha256_file(path: str) -> str | None:
-    """sha256 (hex) of a file's bytes, or None if there is no such file."""
+    """sha256 (hex) of a file's bytes, or None if there is no such file; ``NotRegularFile``
+    at once for a directory, FIFO, device or socket in its place (never read, never waited on)."""
     h = hashlib.sha256()
     try:
-        with open(path, "rb") as fh:
+        with open_regular(path) as fh:
             for block in iter(lambda: fh.read(1 << 20), b""):
                 h.update(block)
     except FileNotFoundError:
         return None
     return h.hexdigest()
+
+
+def _hash_or_why(path: str) -> tuple[str | None, str | None]:
+    """(sha256 or None when absent, None) -- or (None, why) when the path is not a regular file
+    or cannot be read."""
+    try:
+        return sha256_file(path), None
+    except OSError as e:
+        return None, e.strerror or str(e)
+
+
+def read_json(path: str):
+    """A record of the store, parsed (``open_regular``: a FIFO planted in its place is refused
+    at once, ``NotRegularFile``)."""
+    with open_regular(path, "r") as fh:
+        return json.load(fh)
 
 
 def key_name(key) -> str:
@@ -104,25 +123,37 @@ def rewrite_metadata(path: str, files, write) -> None:
     if damaged is None or damaged:
         raise ValueError(f"{path}: its metadata do not match their checksums; nothing recorded")
     rec_path = os.path.join(path, DIR, SKELETON)
-    with open(rec_path) as fh:
-        recorded = json.load(fh)["sha256"]
+    recorded = read_json(rec_path)["sha256"]
     write()
     for rel in files:
         recorded[rel] = sha256_file(os.path.join(path, rel))
     write_text(rec_path, json.dumps({"sha256": recorded}, sort_keys=True, indent=0))
 
 
+LEVEL = re.compile(r"level[1-9][0-9]*")        # a refinement level's own store, inside the atlas's
+
+
 def _walk(path: str):
-    """Relative paths of the store's files (the record itself excluded), sorted."""
+    """Relative paths of the store's files, sorted: the record itself, the refinement levels
+    (stores of their own) and the temporary directories of an interrupted level creation
+    excluded."""
     out = []
     for root, dirs, files in os.walk(path):
         rel_root = os.path.relpath(root, path)
         if rel_root == DIR or rel_root.startswith(DIR + os.sep):
             dirs[:] = []
             continue
+        if rel_root == ".":
+            dirs[:] = [d for d in dirs if not LEVEL.fullmatch(d) and not creation_leftover(d)]   # stores of their own
         for f in files:
             out.append(os.path.normpath(os.path.join(rel_root, f)).replace(os.sep, "/"))
     return sorted(out)
+
+
+def creation_leftover(name: str) -> bool:
+    """Whether ``name`` is the temporary directory a store's creation works in
+    (``.NAME.XXXXXXXX.partial``, ``dataset.create``): what a kill during the creation leaves."""
+    return name.startswith(".") and name.endswith(PARTIAL) and name.count(".") >= 3
 
 
 @dataclass
@@ -194,6 +225,8 @@ def verify(path: str, variables) -> Report:
     with _suppress_os():
         rep.leftovers += [f"{DIR}/{CHUNKS}/{n}" for n in sorted(os.listdir(os.path.join(path, DIR, CHUNKS)))
                           if PARTIAL in n]
+    with _suppress_os():
+        rep.leftovers += sorted(n for n in os.listdir(path) if creation_leftover(n) and os.path.isdir(os.path.join(path, n)))
     rep.skeleton = verify_skeleton(path)
     if not rep.skeleton_ok:
         return rep
@@ -202,8 +235,7 @@ def verify(path: str, variables) -> Report:
     for key in _keys(shape, chunks):
         files = chunk_files(variables, key)
         try:
-            with open(record_path(path, key)) as fh:
-                rec = json.load(fh)
+            rec = read_json(record_path(path, key))
             recorded = rec["sha256"]
             runs = int(rec["runs_done"])
             if not isinstance(recorded, dict):
@@ -218,12 +250,12 @@ def verify(path: str, variables) -> Report:
         problems = []
         for v, rel in files.items():
             want = recorded.get(rel, "absent from the record")
-            have = sha256_file(os.path.join(path, rel)) if rel in present else None
-            if have == want:
+            have, why = _hash_or_why(os.path.join(path, rel)) if rel in present else (None, None)
+            if have == want and why is None:
                 rep.per_variable[v][0] += 1
                 continue
             rep.per_variable[v][1] += 1
-            what = ("missing" if have is None else "not recorded" if want is None else
+            what = (why if why is not None else "missing" if have is None else "not recorded" if want is None else
                     "checksum mismatch" if isinstance(want, str) and len(want) == 64 else "record unreadable")
             problems.append(Damage(rel, what))
         if problems:
@@ -236,16 +268,14 @@ def verify(path: str, variables) -> Report:
 
 def layout(path: str) -> tuple:
     """(shape, chunks) of the per-run variables, from ``done``'s Zarr metadata."""
-    with open(os.path.join(path, "done", ".zarray")) as fh:
-        meta = json.load(fh)
+    meta = read_json(os.path.join(path, "done", ".zarray"))
     return tuple(meta["shape"]), tuple(meta["chunks"])
 
 
 def verify_skeleton(path: str) -> list | None:
     """The skeleton's files that do not match their checksums ([] when all do; None without a record)."""
     try:
-        with open(os.path.join(path, DIR, SKELETON)) as fh:
-            recorded = json.load(fh)["sha256"]
+        recorded = read_json(os.path.join(path, DIR, SKELETON))["sha256"]
         if not isinstance(recorded, dict):
             raise ValueError
     except FileNotFoundError:
@@ -254,8 +284,10 @@ def verify_skeleton(path: str) -> list | None:
         return [Damage(f"{DIR}/{SKELETON}", "record unreadable")]
     out = []
     for rel, want in sorted(recorded.items()):
-        have = sha256_file(os.path.join(path, rel))
-        if have != want:
+        have, why = _hash_or_why(os.path.join(path, rel))
+        if why is not None:
+            out.append(Damage(rel, why))
+        elif have != want:
             out.append(Damage(rel, "missing" if have is None else "checksum mismatch"))
     return out
 
@@ -295,15 +327,20 @@ def discard(path: str, variables, keys, leftovers=()) -> None:
     for key in keys:
         forget(path, key)
         for rel in chunk_files(variables, key).values():
-            try:
-                os.unlink(os.path.join(path, rel))
-            except FileNotFoundError:
-                pass
+            remove(os.path.join(path, rel))
     for rel in leftovers:
-        try:
-            os.unlink(os.path.join(path, rel))
-        except FileNotFoundError:
-            pass
+        remove(os.path.join(path, rel))            # a temporary file, or an interrupted level creation's directory
+
+
+def remove(target: str) -> None:
+    """Remove a file, a FIFO or socket planted in its place, or a directory (not followed if a link)."""
+    if os.path.isdir(target) and not os.path.islink(target):
+        shutil.rmtree(target, ignore_errors=True)
+        return
+    try:
+        os.unlink(target)
+    except FileNotFoundError:
+        pass
 
 
 def summary(problems, limit: int = 6) -> str:

@@ -70,7 +70,11 @@ def run_point(model: str, delta: float, chi: float, starts: np.ndarray, horizon:
 
 
 def study(members: int = 32, horizons=HORIZONS, rtol: float = 1e-8, seed: int = 1, progress=None) -> list[dict]:
-    """Per point: labels per horizon and with 4x members (see the module docstring)."""
+    """Per point: labels per horizon and with 4x members (see the module docstring).
+    ``members`` and ``horizons`` are checked first (``inputs.options.EvidenceRequest``)."""
+    from ...inputs.options import EvidenceRequest
+
+    horizons = EvidenceRequest(kind="convergence", members=members, horizons=horizons).horizons
     say = progress or (lambda m: None)
     rows = []
     for name, model, d, cdeg, w in points():
@@ -161,7 +165,11 @@ TOLERANCES = (1e-6, 1e-7, 1e-8, 1e-10)
 def tolerance(members: int = 8, rtols=TOLERANCES, cells: int = 12, seed: int = 12, omega: float = 0.04,
               tau_end: float = 1e10, progress=None) -> list[dict]:
     """Labels and end states against rtol on a ``cells`` x ``cells`` grid (both models),
-    against the tightest rtol of ``rtols``; see the module docstring."""
+    against the tightest rtol of ``rtols``; see the module docstring.  ``members`` and
+    ``tau_end`` are checked first (``inputs.options.EvidenceRequest``)."""
+    from ...inputs.options import EvidenceRequest
+
+    EvidenceRequest(kind="tolerance", members=members, tau_end=tau_end)
     from ...regimes.engine.refine import centres
     from ...regimes.engine.runs import warm
 

@@ -95,7 +95,11 @@ def measures(delta, chi, tau, w) -> dict:
 
 
 def run(members: int = 3, settings: Settings | None = None, progress=None) -> list[dict]:
-    """Integrate every point's starts with SciPy and classify them; one row per start."""
+    """Integrate every point's starts with SciPy and classify them; one row per start.
+    ``members`` is checked first (``inputs.options.EvidenceRequest``)."""
+    from ...inputs.options import EvidenceRequest
+
+    EvidenceRequest(kind="crosscheck", members=members, tau_end=settings.tau_end if settings is not None else None)
     st = settings or Settings()
     starts = directions(members, 1) * 0.1
     rows = []

@@ -19,23 +19,10 @@ from __future__ import annotations
 
 import json
 import sys
-from dataclasses import dataclass
 
 from ...errors import UsageError, printable
 
-
-@dataclass(frozen=True)
-class Kind:
-    """One kind of evidence: its default member count, and what it accepts beyond it."""
-
-    members: int
-    accepts: frozenset = frozenset()
-
-
-KINDS = {"validate": Kind(32, frozenset({"workers"})), "crosscheck": Kind(3),
-         "physical": Kind(4, frozenset({"tau_end"})), "convergence": Kind(32, frozenset({"horizons", "out"})),
-         "tolerance": Kind(8)}
-OPTIONS = {"workers": "--workers", "tau_end": "--tau-end", "horizons": "--horizons", "out": "--out"}
+KINDS = ("validate", "crosscheck", "physical", "convergence", "tolerance")
 
 
 def _say(line: str) -> None:
@@ -43,27 +30,42 @@ def _say(line: str) -> None:
 
 
 def run(kind: str, members: int | None = None, *, workers: int | None = None, tau_end: float | None = None,
-        horizons: str | None = None, out: str | None = None, as_json: bool = False) -> int:
-    """Compute one kind of evidence and print it; returns the exit status.  An option the kind
-    does not use is refused (``UsageError`` naming it) before any work."""
+        horizons=None, out: str | None = None, as_json: bool = False) -> int:
+    """Compute one kind of evidence and print it; returns the exit status.
+
+    Every argument goes through the schema (``inputs.options.EvidenceRequest``: members,
+    tau_end and horizons finite and in range, the estimated work within the cap) and an option
+    the kind does not use is refused (``SpecError`` naming it) -- all before any work.
+    horizons : a sequence of increasing horizons (the command line's ``--horizons 1e10,1e12``)."""
+    from ...inputs.options import EvidenceRequest, check_accepts
+
     if kind not in KINDS:
         raise UsageError(f"--evidence: {printable(kind, 40)} is not one of {', '.join(KINDS)}")
-    given = {"workers": workers, "tau_end": tau_end, "horizons": horizons, "out": out}
-    extra = [OPTIONS[k] for k, v in given.items() if v is not None and k not in KINDS[kind].accepts]
-    if extra:
-        raise UsageError(f"--evidence {kind}: does not use {', '.join(extra)}")
-    n = members or KINDS[kind].members
-    rows, table, status = _compute(kind, n, given)
+    check_accepts(kind, {"workers": workers, "tau_end": tau_end, "horizons": horizons, "out": out})
+    req = EvidenceRequest(kind=kind, members=members, workers=workers, tau_end=tau_end, horizons=horizons, out=out)
+    if req.out is not None:
+        _check_store(req.out)
+    rows, table, status = _compute(req)
     print(json.dumps(rows, indent=2, default=float) if as_json else table)
     return status
 
 
-def _compute(kind: str, n: int, given: dict) -> tuple:
+def _check_store(out: str) -> None:
+    import os
+
+    from ...regimes.store.integrity import verify_skeleton
+
+    if not os.path.exists(os.path.join(out, ".zgroup")) or verify_skeleton(out) is None:
+        raise UsageError(f"--out {printable(out, 200)}: not an atlas store to keep the rows in")
+
+
+def _compute(req) -> tuple:
     """(rows, table, exit status) of one kind."""
+    kind, n = req.kind, req.n_members
     if kind == "validate":
         from . import validate as V
 
-        rows = V.run(n, given["workers"], progress=False)
+        rows = V.run(n, req.workers, progress=False)
         return rows, V.format_table(rows), 0
     if kind == "crosscheck":
         from . import crosscheck as X
@@ -74,30 +76,17 @@ def _compute(kind: str, n: int, given: dict) -> tuple:
     if kind == "physical":
         from . import physical as P
 
-        rows = P.compare(members=n, tau_end=given["tau_end"] or 1e10, progress=_say)
+        rows = P.compare(members=n, tau_end=req.tau_end or 1e10, progress=_say)
         return rows, P.format_table(rows), 0 if all(r["label_atlas"] == r["label_physical"] for r in rows) else 1
     from . import convergence as CV
 
     if kind == "tolerance":
         rows = CV.tolerance(n, progress=_say)
         return rows, CV.format_tolerance(rows), 0
-    horizons = CV.HORIZONS
-    if given["horizons"]:
-        try:
-            horizons = tuple(float(x) for x in given["horizons"].split(","))
-        except ValueError:
-            raise UsageError(f"--horizons: expected numbers separated by commas, got "
-                             f"{printable(given['horizons'], 80)}") from None
-        if len(horizons) < 2 or any(not b > a for a, b in zip(horizons, horizons[1:])) or horizons[0] <= 0:
-            raise UsageError("--horizons: give at least two increasing positive horizons (e.g. 1e10,1e12,1e14)")
-    if given["out"]:
-        import os
+    rows = CV.study(n, req.horizons or CV.HORIZONS, progress=_say)
+    if req.out:
+        from ...regimes.store.lock import StoreLock
 
-        from ...regimes.store.integrity import verify_skeleton
-
-        if not os.path.exists(os.path.join(given["out"], ".zgroup")) or verify_skeleton(given["out"]) is None:
-            raise UsageError(f"--out {printable(given['out'], 200)}: not an atlas store to keep the rows in")
-    rows = CV.study(n, horizons, progress=_say)
-    if given["out"]:
-        CV.record(given["out"], rows)
+        with StoreLock(req.out, exclusive=True, what="--evidence convergence --out"):   # one writer at a time
+            CV.record(req.out, rows)
     return rows, CV.format_table(rows), 0

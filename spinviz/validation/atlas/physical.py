@@ -66,7 +66,11 @@ def physical_run(model: str, delta: float, chi: float, omega0, tau, rtol: float)
 
 def compare(points=POINTS, members: int = 4, omega: float = 0.1, tau_end: float = 1e10, rtol: float = 1e-10,
             seed: int = 1, progress=None) -> list[dict]:
-    """Per point and member: the relative difference of the end states, both labels."""
+    """Per point and member: the relative difference of the end states, both labels.
+    ``members`` and ``tau_end`` are checked first (``inputs.options.EvidenceRequest``)."""
+    from ...inputs.options import EvidenceRequest
+
+    EvidenceRequest(kind="physical", members=members, tau_end=tau_end)
     say = progress or (lambda m: None)
     st = Settings(tau_end=tau_end, rtol=rtol)
     tau = st.times()

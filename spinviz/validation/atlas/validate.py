@@ -40,7 +40,11 @@ POINTS = [
 
 
 def run(members: int = 32, workers: int | None = None, tau_end: float = 1e10, points=POINTS, progress: bool = False):
-    """A single-cell atlas at each validation point; one row per point with its labels and formulas."""
+    """A single-cell atlas at each validation point; one row per point with its labels and formulas.
+    ``members``, ``workers`` and ``tau_end`` are checked first (``inputs.options.EvidenceRequest``)."""
+    from ...inputs.options import EvidenceRequest
+
+    EvidenceRequest(kind="validate", members=members, workers=workers, tau_end=tau_end)
     rows = []
     tmp = tempfile.mkdtemp(prefix="spinviz-atlas-validate-")
     try:

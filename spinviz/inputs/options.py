@@ -1,0 +1,269 @@
+"""The counts and horizons of the commands that run studies -- ``check --sweep``, ``bench``,
+``bench --process``, ``atlas --evidence KIND`` -- as request classes of the one schema.
+
+Each field is named as the library function's argument, which is also the command-line
+option's ``dest`` (``--tau-end`` is ``tau_end``), so a value is refused with the same reason
+from Python (``SpecError("tau_end", ...)``) and from the command line (``--tau-end: ...``),
+before any work.  Numbers are finite and in range, the range and its reason in the message.
+
+Work.  A count can ask for years of computing (``--runs 1000000000``).  Each request
+estimates the time its work takes on this machine from measured costs (below) and refuses it
+above ``max_days()`` -- 30 days unless the environment variable ``SPINVIZ_MAX_DAYS`` says
+otherwise, which is how someone who means it (on a machine or cluster that can take it)
+raises the cap; the message says so.  The atlas's own feasibility check
+(``atlas_spec.check_feasible``) reads the same cap.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from typing import Annotated, Any, Literal
+
+from pydantic import Field, PlainValidator, model_validator
+
+from ..errors import SpecError, brief
+from .base import Flag, Int, Path, Real, between, request, wrong_type
+
+MAX_DAYS_ENV = "SPINVIZ_MAX_DAYS"
+MAX_DAYS = 30.0                  # default cap on the estimated work of one command, days
+
+
+def max_days() -> float:
+    """The cap on one command's estimated work, in days: ``SPINVIZ_MAX_DAYS`` or 30."""
+    raw = os.environ.get(MAX_DAYS_ENV)
+    if raw is None or raw.strip() == "":
+        return MAX_DAYS
+    try:
+        value = float(raw)
+    except ValueError:
+        raise SpecError(MAX_DAYS_ENV, f"must be a number of days, got {brief(raw)}") from None
+    if not (math.isfinite(value) and value > 0):
+        raise SpecError(MAX_DAYS_ENV, f"must be a positive finite number of days, got {brief(raw)}")
+    return value
+
+
+def check_work(key: str, seconds: float, what: str) -> None:
+    """Refuse (``SpecError(key, ...)``) work estimated at more than ``max_days()``."""
+    cap = max_days()
+    if not seconds <= cap * 86400.0:
+        raise SpecError(key, f"{what} would take ~{_duration(seconds)} here, more than the cap of {cap:g} days; "
+                             f"someone who means it (on a machine or cluster that can take it) raises the cap with "
+                             f"{MAX_DAYS_ENV}=DAYS")
+
+
+def _duration(seconds: float) -> str:
+    if not math.isfinite(seconds):
+        return "forever"
+    days = seconds / 86400.0
+    return f"{days / 365.25:.3g} years" if days > 730 else f"{days:.3g} days" if days >= 1 else f"{seconds / 3600:.3g} h"
+
+
+def _count(limit: int, why: str):
+    """A whole number in [1, ``limit``] (beyond the limit the estimate of its work is absurd anyway)."""
+    return Annotated[Int, between(1, limit, why)]
+
+
+def count_of(seeds) -> int:
+    """How many seeds (a range's length without listing it, however long)."""
+    if isinstance(seeds, range):
+        return max(0, -(-(seeds.stop - seeds.start) // seeds.step)) if seeds.step > 0 else max(
+            0, -(-(seeds.start - seeds.stop) // -seeds.step))
+    return len(seeds)
+
+
+# --- check --sweep --------------------------------------------------------------------------
+SWEEP_S_PER_RUN = 0.2            # one secular-against-taylor comparison (README: 18 seeds x 40 runs in 142 s)
+MAX_SEED = 2**63 - 1             # numpy's default_rng takes any non-negative integer; this one fits an int64
+
+
+def _seeds(v):
+    """A non-empty ``range`` or sequence of seeds (non-negative whole numbers), kept as given
+    (a range stays a range: its length is known without listing it)."""
+    if isinstance(v, range):
+        if count_of(v) == 0:
+            raise ValueError(f"no seeds in {v.start}-{v.stop - 1}")
+        ends = (min(v.start, v.start + (count_of(v) - 1) * v.step), max(v.start, v.start + (count_of(v) - 1) * v.step))
+    elif isinstance(v, list | tuple):
+        if not v:
+            raise ValueError("no seeds given")
+        if any(isinstance(s, bool) or not isinstance(s, int) for s in v):
+            raise wrong_type(f"must be whole numbers, got {brief(v)}")
+        ends = (min(v), max(v))
+        v = tuple(v)
+    else:
+        raise wrong_type(f"must be a range or a list of whole numbers, got {brief(v)}")
+    if ends[0] < 0 or ends[1] > MAX_SEED:
+        raise ValueError(f"every seed must lie in [0, {MAX_SEED}] (NumPy's generator), got {ends[0]}..{ends[1]}")
+    return v
+
+
+Seeds = Annotated[Any, PlainValidator(_seeds)]
+
+
+@request
+class SweepRequest:
+    """``check --sweep``'s arguments (``validation.secular_sweep.run``): the seeds and the runs of each."""
+
+    seeds: Seeds = range(1, 4)
+    runs: _count(10**9, "runs per seed") = 40
+
+    @model_validator(mode="after")
+    def _work(self):
+        n = count_of(self.seeds)
+        blame = "seeds" if n / 3 > self.runs / 40 else "runs"           # the one further from its default
+        check_work(blame, float(n) * self.runs * SWEEP_S_PER_RUN,
+                   f"{n} seed(s) x {self.runs} runs (~{SWEEP_S_PER_RUN:g} s a run)")
+        return self
+
+
+# --- bench, bench --process -----------------------------------------------------------------
+# One repeat runs every point of the plan once more (the minimum of the repeats is kept): from
+# the durations the README and the commands' help give for 3 repeats, with their warm-up and
+# reference runs counted as one more repeat.
+BENCH_S_PER_REPEAT = {"quick": 40.0, "full": 600.0}
+PROCESS_S_PER_REPEAT = {"quick": 15.0, "full": 75.0}
+
+
+def _names(v):
+    if isinstance(v, str) or not isinstance(v, list | tuple) or not v or not all(isinstance(x, str) for x in v):
+        raise wrong_type(f"must be a non-empty list of names, got {brief(v)}")
+    return tuple(v)
+
+
+@request
+class BenchRequest:
+    """``spinviz bench``'s arguments (``validation.bench.run``, ``validation.process_bench.run``)."""
+
+    repeats: _count(10**9, "timings per point, the minimum kept") = 3
+    quick: Flag = False
+    process: Flag = False
+    turns: Annotated[Real, between(10.0, 1e5, "turns of each problem with --process; the references resolve every "
+                                               "turn")] = 400.0
+    problems: Annotated[Any, PlainValidator(_names)] | None = None
+    known: Annotated[Any, PlainValidator(_names)] | None = None          # the problems there are (for the message)
+
+    @model_validator(mode="after")
+    def _check(self):
+        if self.problems is not None and self.known is not None:
+            unknown = [n for n in self.problems if n not in self.known]
+            if unknown:
+                raise SpecError("problems", f"unknown {', '.join(map(brief, unknown))}; valid: {', '.join(self.known)}")
+        per = (PROCESS_S_PER_REPEAT if self.process else BENCH_S_PER_REPEAT)["quick" if self.quick else "full"]
+        per *= max(1.0, self.turns / 400.0) if self.process else 1.0
+        check_work("repeats", self.repeats * per, f"{self.repeats} repeats of every point (~{per:g} s a repeat)")
+        return self
+
+
+# --- atlas --evidence KIND ------------------------------------------------------------------
+TAU_END_RANGE = (1e5, 1e16)      # below: the classifier's two 2-decade windows and 100 braking times of |omega0|
+#                                  = 0.04 do not fit; above: float64 time steps (the atlas's own limit)
+MAX_HORIZONS = 8
+# Measured costs at tau = 1e10 (docs/atlas.md), growing as sqrt(tau / 1e10) -- the steps of a spiral:
+ATLAS_S_PER_RUN = 0.096          # a run of the atlas (one core; atlas_spec.CPU_S_PER_RUN)
+PHYSICAL_S_PER_RUN = 0.094       # an atlas run and its physical-unit simulate run (32 in 3 s)
+CROSSCHECK_S_PER_RUN = 25.0      # a SciPy DOP853 run of (4.2)-(4.4) at rtol 1e-10
+CONVERGENCE_S_PER_RUN = 0.0102   # a run of the study, per unit of sqrt(tau / 1e10) (8 min 46 s at its defaults)
+TOLERANCE_S_PER_RUN = 0.009      # a run of the 12 x 12 grid at one rtol (82 s for 9216)
+EVIDENCE_MEMBERS = {"validate": 32, "crosscheck": 3, "physical": 4, "convergence": 32, "tolerance": 8}
+ACCEPTS = {"validate": {"workers"}, "crosscheck": set(), "physical": {"tau_end"}, "convergence": {"horizons", "out"},
+           "tolerance": set()}             # what each kind takes on the command line beyond --members
+
+
+def check_accepts(kind: str, given: dict) -> None:
+    """An option ``--evidence KIND`` does not use is refused (``SpecError`` naming it), not ignored."""
+    for key, value in given.items():
+        if value is not None and key not in ACCEPTS.get(kind, set()):
+            raise SpecError(key, f"not used by --evidence {kind} (it takes "
+                                 f"{', '.join(sorted(ACCEPTS[kind] | {'members'}))})")
+
+
+def _horizons(v):
+    if isinstance(v, str) or not isinstance(v, list | tuple):
+        raise wrong_type(f"must be a list of horizons tau, got {brief(v)}")
+    out = []
+    for x in v:
+        if isinstance(x, bool) or not isinstance(x, int | float):
+            raise wrong_type(f"must be numbers, got {brief(v)}")
+        x = float(x)
+        if not math.isfinite(x):
+            raise ValueError(f"must be finite, got {brief(v)}")
+        lo, hi = TAU_END_RANGE
+        if not lo <= x <= hi:
+            raise ValueError(f"each must lie in [{lo:g}, {hi:g}] (the classifier's windows and 100 braking times below, "
+                             f"float64 time steps above), got {x:g}")
+        out.append(x)
+    if not 2 <= len(out) <= MAX_HORIZONS:
+        raise ValueError(f"give 2 to {MAX_HORIZONS} horizons, got {len(out)}")
+    if any(not b > a for a, b in zip(out, out[1:])):
+        raise ValueError(f"must increase, got {brief(v)}")
+    return tuple(out)
+
+
+@request
+class EvidenceRequest:
+    """``spinviz atlas --evidence KIND``'s arguments (``validation.atlas.evidence.run``): the
+    kind, the starts per point, and what the kind takes beyond them."""
+
+    kind: Literal["validate", "crosscheck", "physical", "convergence", "tolerance"]
+    members: _count(10**9, "starts per point") | None = None
+    workers: Annotated[Int, Field(ge=1)] | None = None
+    tau_end: Annotated[Real, between(*TAU_END_RANGE, "the classifier's windows and 100 braking times below, float64 "
+                                                    "time steps above")] | None = None
+    horizons: Annotated[Any, PlainValidator(_horizons)] | None = None
+    out: Path = None
+
+    @model_validator(mode="after")
+    def _check(self):
+        if self.workers is not None:
+            from .render import usable_cores
+
+            cores = usable_cores()
+            if self.workers > cores:
+                raise SpecError("workers", f"must be at most {cores}, the cores this process may use, got {self.workers}")
+        n = self.n_members
+        key = "members" if self.members is not None else {"physical": "tau_end", "convergence": "horizons"}.get(
+            self.kind, "members")
+        check_work(key, self.seconds(), f"--evidence {self.kind} with {n} member(s) per point")
+        return self
+
+    @property
+    def n_members(self) -> int:
+        """The starts per point: as given, or the kind's default."""
+        return self.members if self.members is not None else EVIDENCE_MEMBERS[self.kind]
+
+    def seconds(self) -> float:
+        """The estimated work, s (see the constants: measured at tau = 1e10, growing as sqrt(tau))."""
+        n = self.n_members
+        grows = math.sqrt((self.tau_end or 1e10) / 1e10)
+        if self.kind == "validate":
+            from .render import usable_cores
+
+            return 11 * n * ATLAS_S_PER_RUN * grows / (self.workers or usable_cores())
+        if self.kind == "crosscheck":
+            return 6 * n * CROSSCHECK_S_PER_RUN * grows
+        if self.kind == "physical":
+            return 8 * n * PHYSICAL_S_PER_RUN * grows
+        if self.kind == "tolerance":
+            return 144 * n * 2 * 4 * TOLERANCE_S_PER_RUN * grows
+        horizons = self.horizons or (1e10, 1e12, 1e14)
+        units = sum(math.sqrt(h / horizons[0]) for h in horizons) + 4
+        return 14 * n * units * CONVERGENCE_S_PER_RUN * math.sqrt(horizons[0] / 1e10)
+
+
+# --- listen ------------------------------------------------------------------------------------
+SOUND_SECONDS = (0.5, 600.0, "seconds of sound")
+LISTEN_SAMPLES = 100_000         # instants of each model's run (the detector's memory per instant)
+
+
+@request
+class ListenRequest:
+    """``spinviz listen``'s sound (``analysis.sonify.listen_scene``): how long, at which pitch,
+    how sound time and pitch follow the run's, how much dynamic range, from how many instants."""
+
+    duration: Annotated[Real, between(*SOUND_SECONDS)] = 20.0
+    f0: Annotated[Real, between(20.0, 5000.0, "Hz: audible, well under the Nyquist frequency")] = 440.0
+    time_map: Literal["log", "linear"] = "log"
+    pitch: Literal["auto", "linear"] = "auto"
+    dynamic_range_db: Annotated[Real, between(1.0, 120.0, "dB of sound")] = 60.0
+    samples: Annotated[Int, between(2, LISTEN_SAMPLES, "instants of each model's run")] = 800

@@ -88,35 +88,48 @@ def test_a_stop_signal_at_any_instant_of_an_atlas(refined_atlas, tmp_path):
         kind = "new" if i % 2 == 0 else "level0"
         sig, to_group = WAYS[i % len(WAYS)]
         delay = rng.uniform(0.0, 1.1 * spans[kind])             # a tenth of them after the end: the shutdown
-        out = tmp_path / f"s{i}.zarr"
-        if kind == "level0":
-            shutil.copytree(level0, out)
-        p, t0 = start(refined_atlas.spec, out, tmp_path / f"p{i}.png", tmp_path)
-        time.sleep(max(0.0, delay - (time.monotonic() - t0)))
-        sent = p.poll() is None
-        if sent:
-            try:
-                (os.killpg if to_group else os.kill)(p.pid, sig)
-            except ProcessLookupError:
-                sent = False
-        try:
-            _, err = p.communicate(timeout=60)
-        except subprocess.TimeoutExpired:
-            os.killpg(p.pid, signal.SIGKILL)
-            pytest.fail(f"instant {i} ({signal.Signals(sig).name} at {delay:.2f} s, {kind}): the command hung")
-        where = f"instant {i} ({signal.Signals(sig).name}{' to the group' if to_group else ''} at {delay:.2f} s of " \
-                f"{spans[kind]:.2f} s, {kind} store)"
-        if p.returncode == 0 and err == "":
-            assert delay > 0.5 * spans[kind], where                    # it had finished before the signal came
-        else:
-            stopped += 1
-            assert p.returncode == 128 + sig, f"{where}: exit {p.returncode}, stderr {err!r}"
-            assert err.count("\n") == 1 and err.strip() in lines_for(signal.Signals(sig).name, out), f"{where}: {err!r}"
-        assert gone(p.pid) == [], where                                 # workers, resource tracker: all gone
-        assert [x.name for x in tmp_path.iterdir() if x.name.endswith(".partial")] == [], where
-        if out.exists():                                                # what it left, completed
-            api.atlas(refined_atlas.spec, out, workers=1, processes=False, progress=False, runs_per_task=4,
-                      notify=lambda line: None)
-            same_atlas(out, refined_atlas.store)
-            shutil.rmtree(out)
+        for _ in range(4):                                       # a shared machine runs faster than it was timed at
+            landed, took = _one_instant(refined_atlas, tmp_path, level0, i, kind, sig, to_group, delay, spans)
+            if landed or delay > spans[kind]:                    # moments: the command finished first, so its span
+                break                                            # is what it took and the instant is drawn again in it
+            spans[kind] = min(spans[kind], took)
+            delay = rng.uniform(0.0, spans[kind])
+        stopped += landed
     assert stopped >= INSTANTS * 0.7, stopped
+
+
+def _one_instant(refined_atlas, tmp_path, level0, i, kind, sig, to_group, delay, spans) -> tuple:
+    """One command stopped at ``delay`` after it answers signals; its exit, line, processes and
+    store checked.  Returns whether the signal landed (the command had not finished) and the
+    seconds the command took after it answered signals."""
+    out = tmp_path / f"s{i}.zarr"
+    if kind == "level0":
+        shutil.copytree(level0, out)
+    p, t0 = start(refined_atlas.spec, out, tmp_path / f"p{i}.png", tmp_path)
+    time.sleep(max(0.0, delay - (time.monotonic() - t0)))
+    sent = p.poll() is None
+    if sent:
+        try:
+            (os.killpg if to_group else os.kill)(p.pid, sig)
+        except ProcessLookupError:
+            sent = False
+    try:
+        _, err = p.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        os.killpg(p.pid, signal.SIGKILL)
+        pytest.fail(f"instant {i} ({signal.Signals(sig).name} at {delay:.2f} s, {kind}): the command hung")
+    took = time.monotonic() - t0
+    where = f"instant {i} ({signal.Signals(sig).name}{' to the group' if to_group else ''} at {delay:.2f} s of " \
+            f"{spans[kind]:.2f} s, {kind} store)"
+    landed = not (p.returncode == 0 and err == "")
+    if landed:
+        assert p.returncode == 128 + sig, f"{where}: exit {p.returncode}, stderr {err!r}"
+        assert err.count("\n") == 1 and err.strip() in lines_for(signal.Signals(sig).name, out), f"{where}: {err!r}"
+    assert gone(p.pid) == [], where                                 # workers, resource tracker: all gone
+    assert [x.name for x in tmp_path.iterdir() if x.name.endswith(".partial")] == [], where
+    if out.exists():                                                # what it left, completed
+        api.atlas(refined_atlas.spec, out, workers=1, processes=False, progress=False, runs_per_task=4,
+                  notify=lambda line: None)
+        same_atlas(out, refined_atlas.store)
+        shutil.rmtree(out)
+    return landed, took

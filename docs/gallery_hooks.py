@@ -1,0 +1,84 @@
+"""sphinx-gallery's hooks for the spinviz gallery (named in ``conf.py``'s ``sphinx_gallery_conf``
+by their dotted names, so that the configuration stays picklable).
+
+* ``ExampleOrder``: the gallery's order, the newcomer's: two models compared, then the 3-D
+  pictures, then the analyses, then the results too long to compute in a build.
+* ``snapshot`` (a ``reset_modules`` hook, run before each example) and ``written_pictures``
+  (an image scraper, run after each code block): spinviz's plots, videos and diagrams are
+  files (``compare.plot(c, "x.png")``, ``spinviz.render(sc, out="x.gif")``), written as a
+  user writes them, into the working directory (sphinx-gallery runs an example in its own
+  folder, ``examples/``).  Every PNG or GIF that appears there while an example runs is moved
+  into the gallery's images and shown under the block that wrote it, in the order written; a
+  file that was there before the example began is never touched.  A GIF stays a GIF, so a
+  video plays on the page.  (matplotlib figures left open are caught by sphinx-gallery's own
+  matplotlib scraper, listed first.)  Any other file an example leaves in ``examples/``
+  stops the build, naming it: an example writes its other outputs (a store, a WAV) to a
+  scratch folder, so that building the site leaves the checkout as it was.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+from sphinx.errors import ExtensionError
+from sphinx_gallery.scrapers import figure_rst
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+PICTURES = (".png", ".gif")
+
+ORDER = [
+    "plot_compare_models.py",
+    "plot_render_frames.py",
+    "plot_video.py",
+    "plot_cellulose_rod.py",
+    "plot_askew_top.py",
+    "plot_observe.py",
+    "plot_listen.py",
+    "plot_atlas_figure.py",
+    "plot_benchmarks.py",
+]
+
+
+class ExampleOrder:
+    """``within_subsection_order``: the examples in ``ORDER``; one missing from it is an error
+    (a new example must be placed, not appended by accident)."""
+
+    def __init__(self, src_dir):
+        self.src_dir = src_dir
+
+    def __call__(self, filename: str) -> int:
+        name = Path(filename).name
+        if name not in ORDER:
+            raise ValueError(f"examples/{name}: not placed in docs/gallery_hooks.py's ORDER")
+        return ORDER.index(name)
+
+
+_before: set[str] = set()
+
+
+def snapshot(gallery_conf, fname) -> None:
+    """Before each example: what ``examples/`` already holds (left alone)."""
+    _before.clear()
+    _before.update(p.name for p in EXAMPLES.iterdir())
+
+
+def written_pictures(block, block_vars, gallery_conf) -> str:
+    """The PNG and GIF files the block wrote into ``examples/``, moved into the gallery's images
+    (sphinx-gallery's next image names, the extension kept), as reST."""
+    new_files = [p for p in EXAMPLES.iterdir() if p.name not in _before]
+    others = sorted(p.name for p in new_files if p.suffix.lower() not in PICTURES)
+    if others:
+        raise ExtensionError(f"{Path(block_vars['src_file']).name} left {', '.join(others)} in examples/: "
+                             f"write outputs other than pictures to a scratch folder (tempfile.mkdtemp())")
+    new = sorted((p.stat().st_mtime_ns, p.name) for p in new_files)
+    iterator = block_vars["image_path_iterator"]
+    shown, names = [], []
+    for _, name in new:
+        src = EXAMPLES / name
+        dest = Path(next(iterator)).with_suffix(src.suffix.lower())
+        shutil.move(src, dest)
+        shown.append(dest)
+        names.append(name)
+    # the alt text: the file names the example wrote (dast_cube_compare.png)
+    return figure_rst(shown, gallery_conf["src_dir"], fig_titles=", ".join(names)) if shown else ""

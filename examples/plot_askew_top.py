@@ -11,6 +11,8 @@ paper's figures 3 and 4 draw them.
 
 # %%
 # The README's scene example: δ = 0.3, χ = 0.7 rad, reduced equation.
+
+# sphinx_gallery_thumbnail_number = 2
 import spinviz
 from spinviz.analysis import compare
 

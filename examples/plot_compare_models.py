@@ -12,7 +12,7 @@ along e3, integrated over 6 Θ (19 days) by both equations of motion from the sa
   dipole at 45° from the axis (6.9), (6.10).
 
 This is what ``spinviz compare scenes/dast_cube.toml`` prints and draws, step by step from
-Python.  The crystal turns ~2e16 times in 19 days, far beyond float64's hold on the spin
+Python.  The crystal turns ~5e15 times in 19 days, far beyond float64's hold on the spin
 phase, so ``auto`` follows it with the ``secular`` method and the models are compared by
 the slow, physical angle between d and L rather than turn by turn.
 """

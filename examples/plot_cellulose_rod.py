@@ -24,7 +24,7 @@ print(compare.format_table(compare.compare(runs), sc.title))
 # %%
 # The scene's poster: the middle frame of its video, at 1.5 T.  The tumbling (the dipole's
 # trail about L) is alike on both sides; the rod's own spin is not, so the two rods show
-# different halves.
+# different halves: the dark one on the left (reduced), the light one on the right.
 with spinviz.Renderer(sc, size=(640, 360)) as r:
     img = r.frame((r.frames - 1) // 2)
 fig = plt.figure(figsize=(6.4, 3.6), dpi=100)

@@ -113,7 +113,7 @@ sphinx_gallery_conf = {
 # a rebuild reruns only what changed ("cache"; a clean build runs everything).
 nb_execution_mode = "cache"
 nb_execution_raise_on_error = True                   # a cell's exception fails the build
-nb_execution_timeout = 600                           # seconds per cell (the tutorial's atlas takes ~20 s)
+nb_execution_timeout = 600                           # seconds per cell (the tutorial's atlas takes ~8 s)
 nb_execution_show_tb = True                          # a failure's traceback in the build log
 nb_merge_streams = True                              # a cell's stdout as one block, not one per print
 

@@ -131,7 +131,7 @@ napoleon_use_ivar = True              # "Attributes" as a field list: no second 
 # Heavy optional stacks are installed for the docs build (the "docs" extra pulls the render
 # and ensemble extras), so nothing is mocked: what the reference shows is what imports.
 
-# Many of the project's docstrings (see STYLE.md) list parameters as lines ``name : meaning``
+# Many of the project's docstrings list parameters as lines ``name : meaning``
 # (shape, units and frame on the line) outside any numpydoc section; shown as reST they would
 # run together into one paragraph.  This turns such a paragraph into a definition list.  (The
 # public entry points use numpydoc sections, which napoleon renders; once every docstring

@@ -8,8 +8,9 @@ by their dotted names, so that the configuration stays picklable).
   files (``compare.plot(c, "x.png")``, ``spinviz.render(sc, out="x.gif")``), written as a
   user writes them, into the working directory (sphinx-gallery runs an example in its own
   folder, ``examples/``).  Every PNG or GIF that appears there while an example runs is moved
-  into the gallery's images and shown under the block that wrote it, in the order written; a
-  file that was there before the example began is never touched.  A GIF stays a GIF, so a
+  into the gallery's images and shown under the block that wrote it, in the order written (a
+  picture left by running the example by hand is taken when the example writes it again); a
+  file the example does not write is never touched.  A GIF stays a GIF, so a
   video plays on the page.  (matplotlib figures left open are caught by sphinx-gallery's own
   matplotlib scraper, listed first.)  Any other file an example leaves in ``examples/``
   stops the build, naming it: an example writes its other outputs (a store, a WAV) to a
@@ -54,19 +55,23 @@ class ExampleOrder:
         return ORDER.index(name)
 
 
-_before: set[str] = set()
+_before: dict[str, int] = {}
+
+
+def _listing() -> dict[str, int]:
+    return {p.name: p.stat().st_mtime_ns for p in EXAMPLES.iterdir()}
 
 
 def snapshot(gallery_conf, fname) -> None:
-    """Before each example: what ``examples/`` already holds (left alone)."""
+    """Before each example: what ``examples/`` already holds, and when each was written."""
     _before.clear()
-    _before.update(p.name for p in EXAMPLES.iterdir())
+    _before.update(_listing())
 
 
 def written_pictures(block, block_vars, gallery_conf) -> str:
     """The PNG and GIF files the block wrote into ``examples/``, moved into the gallery's images
     (sphinx-gallery's next image names, the extension kept), as reST."""
-    new_files = [p for p in EXAMPLES.iterdir() if p.name not in _before]
+    new_files = [EXAMPLES / name for name, mtime in _listing().items() if _before.get(name) != mtime]
     others = sorted(p.name for p in new_files if p.suffix.lower() not in PICTURES)
     if others:
         raise ExtensionError(f"{Path(block_vars['src_file']).name} left {', '.join(others)} in examples/: "

@@ -61,8 +61,6 @@ exclude_patterns = [
     "_build",
     "Thumbs.db",
     ".DS_Store",
-    # a branch's notes to the owners of other files, not documentation
-    "pictures_integration.md",
     # sphinx-gallery writes each example beside its page as a script and a notebook to
     # download; they are not pages of the site (myst-nb would otherwise read the notebooks)
     "gallery/*.ipynb",
@@ -205,6 +203,9 @@ def setup(app):
 html_theme = "pydata_sphinx_theme"
 html_title = f"spinviz {release}"
 html_static_path = ["_static"]
+# the web pages and models the gallery's examples write (gallery_hooks), served from the root
+(DOCS / "gallery" / "pages").mkdir(parents=True, exist_ok=True)
+html_extra_path = ["gallery/pages"]
 html_css_files = ["spinviz.css"]
 html_theme_options = {
     "navigation_with_keys": False,
@@ -218,6 +219,6 @@ html_theme_options = {
 # The section navigation only where there is a section to navigate: the API reference.
 html_sidebars = {page: [] for page in
                  ("index", "tutorial", "getting_started", "scenes", "gallery/**", "physics", "integrators", "accuracy",
-                  "atlas")}
+                  "atlas", "experiment", "design")}
 html_show_sourcelink = False
 html_copy_source = False

@@ -16,7 +16,7 @@ import numpy as np
 from .atomic import check_outputs
 from .driver import simulate_request
 from .errors import SpecError, SpecTypeError, UsageError
-from .inputs.render import RenderArguments, RenderSpec, default_output, poster_for
+from .inputs.render import MODEL_FORMATS, RenderArguments, RenderSpec, default_output, poster_for
 from .inputs.scene_spec import Scene, load_scene
 from .rendering.timeline import FramePlan, frame_times, plan_frames
 from .trajectory import Trajectory
@@ -271,7 +271,9 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
     source : Scene, path, Trajectory or list of one or two Trajectories
         A scene (``Scene`` or the path of its TOML) is simulated at the frame times.
     out : str, optional
-        The .mp4 or .gif path; default ``renders/<scene>.mp4`` for a scene.
+        The .mp4 or .gif path; default ``renders/<scene>.mp4`` for a scene.  A .glb or .gltf
+        path writes the animated glTF model instead, a .html path the self-contained page
+        that shows it (``rendering.export``; no poster, no render processes).
     size : (int, int), optional
         (width, height) px.
     fps : int, optional
@@ -290,14 +292,26 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
 
     Returns
     -------
-    rendering.video.RenderResult
-        Path, poster, frames, size, seconds, fps.
+    rendering.video.RenderResult or rendering.export.ExportResult
+        Path, poster, frames, size, seconds, fps; for a model or page: path, bytes,
+        keyframes, the stated tolerance and the largest measured error.
     """
     args = RenderArguments(out=out, workers=workers, progress=progress)
     scene, trajs, spec = resolve_spec(source, size=size, fps=fps, duration=duration, **overrides)
     out, workers = (default_output(scene if scene is not None else trajs) if args.out is None else args.out), args.workers
     spec.check_output(out, len(scene.models) if scene is not None else len(trajs))
     inputs = [scene.path] if scene is not None and os.path.exists(scene.path) else []
+    if os.path.splitext(os.fspath(out))[1].lower() in MODEL_FORMATS:
+        # an animated glTF model or the page that shows it: the same plan, no drawing stack
+        check_outputs([out], inputs)
+        import importlib.util
+
+        if importlib.util.find_spec("pygltflib") is None:
+            raise MissingRenderStack("a glTF model or page needs the optional package 'pygltflib': "
+                                     "pip install 'spinviz[render]'")
+        from .rendering.export import export
+
+        return export(_plan(scene, trajs, spec), out)
     check_outputs([out, poster_for(out)], inputs)        # before any work: nothing to undo later
     video = require_render_stack()
     # the render processes start now and import the drawing stack while this one simulates

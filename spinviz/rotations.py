@@ -1,6 +1,6 @@
 """Quaternion and SO(3) maths, in plain NumPy (numpy-quaternion for interchange, loaded lazily).
 
-Conventions (DESIGN.md, section 5):
+Conventions (docs/design.md, "Conventions"):
 
 * quaternions are scalar-first float arrays, shape (..., 4), ordered (w, x, y, z);
   ``as_quaternion_array`` / ``as_float_quat`` convert to and from numpy-quaternion's
@@ -10,7 +10,7 @@ Conventions (DESIGN.md, section 5):
 * q and -q are the same rotation: compare rotations with ``misorientation`` or
   ``allclose_up_to_sign``, never element by element;
 * ZXZ Euler angles (phi, theta, psi) in radians with O = Rz(phi) Rx(theta) Rz(psi), the
-  convention of the Poisson equations (6.4) (checked in DESIGN.md, section 2).
+  convention of the Poisson equations (6.4) (``tests/test_rotations.py`` checks it against them).
 
 This module knows no physics and no rendering, and imports nothing but NumPy: the products,
 matrices, exponentials and slerp below are a few vectorized lines each, while importing

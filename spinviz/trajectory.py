@@ -153,7 +153,7 @@ class Trajectory:
         # d omega / d tau in (4.1) units, then d/dt = (1/tau0) d/dtau and Omega = omega / tau0
         return U.omega_from_dimensionless(s.omega_dot(U.omega_to_dimensionless(self.omega, tau0)), tau0) / tau0
 
-    # -- radiation (issue 19) ----------------------------------------------------------------
+    # -- radiation ----------------------------------------------------------------
     def radiation(self, line_of_sight=None):
         """The radiation observables of this run as an ``xarray.Dataset`` with units (erg, s,
         statC cm for CGS bodies; I1 and tau0 units for dimensionless ones): Larmor power, energy,

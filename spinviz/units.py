@@ -23,9 +23,11 @@ C_LIGHT = 2.99792458e10          # speed of light, cm/s (exact)
 DEBYE = 1.0e-18                  # 1 D in statC cm
 AMU = 1.66053906660e-24          # atomic mass unit, g (CODATA 2018)
 NM = 1.0e-7                      # 1 nm in cm
+M_PER_CM = 1.0e-2                # 1 cm in m (the glTF export states real sizes in metres)
 HBAR = 1.054571817e-27           # reduced Planck constant, erg s (CODATA 2018, exact since 2019)
 ERG_PER_S_IN_W = 1.0e-7          # 1 erg/s in W
 STATV_PER_CM_IN_V_PER_M = 2.99792458e4   # 1 statV/cm in V/m (c / 1e4 in SI digits)
+K_BOLTZMANN = 1.380649e-16       # Boltzmann constant, erg/K (exact since 2019)
 
 # --- time ------------------------------------------------------------------------------
 MINUTE = 60.0
@@ -49,7 +51,8 @@ def radiation_coupling(dipole_cgs):
 def tau0_cgs(dipole_magnitude_cgs: float, inertia1_cgs: float) -> float:
     """tau0 = 2 d^2 / (3 I1 c^3), equation (3.8); seconds.
 
-    The printed (3.3)-(3.5) have c^2 where (3.8) has c^3; c^3 is right (DESIGN.md, 2).
+    The printed (3.3)-(3.5) have c^2 where (3.8) has c^3; c^3 is right: the general reduced
+    equation (2.2)+(2.3) reproduces (3.3)-(3.5) with it (``tests/test_equations.py``).
     """
     return 2.0 * dipole_magnitude_cgs**2 / (3.0 * inertia1_cgs * C_LIGHT**3)
 
@@ -159,3 +162,25 @@ def format_frequency(f_hz: float) -> str:
         if a >= scale:
             return f"{f / scale:.4g} {name}"
     return f"{f * 1e3:.3g} mHz"
+
+
+# --- receivers ----------------------------------------------------------------------------------
+def gain_from_dbi(gain_dbi):
+    """An antenna gain in dBi as a ratio to the isotropic antenna: 10^(dBi/10)."""
+    return 10.0 ** (np.asarray(gain_dbi, dtype=float) / 10.0)
+
+
+def noise_density_from_temperature(temperature_k):
+    """The one-sided noise spectral density of a system at noise temperature T: N0 = k_B T, erg
+    (= erg/s per Hz)."""
+    return K_BOLTZMANN * np.asarray(temperature_k, dtype=float)
+
+
+def erg_per_s_from_w(x_w):
+    """A power (or a power spectral density, W/Hz) in erg/s (erg/s/Hz)."""
+    return np.asarray(x_w, dtype=float) / ERG_PER_S_IN_W
+
+
+def wavelength_cm(f_hz):
+    """The free-space wavelength c / f of a line at f Hz, cm."""
+    return C_LIGHT / np.asarray(f_hz, dtype=float)

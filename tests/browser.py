@@ -15,6 +15,9 @@ CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
 # Flags for a root user on a machine whose network is closed: without the background
 # networking ones Chromium keeps trying (and failing) to reach Google's hosts.
+# WebGL on Chromium's software renderer (SwiftShader): without this flag its automatic use is
+# deprecated and may end; a page that draws with WebGL (the glTF page) asks for it.
+WEBGL_FLAGS = ("--enable-unsafe-swiftshader",)
 CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                   "--disable-background-networking", "--disable-component-update", "--disable-sync",
                   "--hide-scrollbars", "--virtual-time-budget=10000"]
@@ -30,12 +33,12 @@ def chromium(page: Path, tmp_path: Path, *args: str, fragment: str = "") -> subp
     return r
 
 
-def screenshot(page: Path, tmp_path: Path, size=(1280, 900), fragment: str = "") -> np.ndarray:
-    """The page as Chromium draws it, RGB (height, width, 3)."""
+def screenshot(page: Path, tmp_path: Path, size=(1280, 900), fragment: str = "", flags=()) -> np.ndarray:
+    """The page as Chromium draws it, RGB (height, width, 3); ``flags``: more Chromium flags."""
     from PIL import Image
 
     png = tmp_path / f"{page.stem}-{len(list(tmp_path.iterdir()))}.png"
-    chromium(page, tmp_path, f"--screenshot={png}", f"--window-size={size[0]},{size[1]}", fragment=fragment)
+    chromium(page, tmp_path, *flags, f"--screenshot={png}", f"--window-size={size[0]},{size[1]}", fragment=fragment)
     return np.asarray(Image.open(png).convert("RGB"))
 
 

@@ -66,3 +66,15 @@ _quiet = [HealthCheck.function_scoped_fixture, HealthCheck.too_slow]
 settings.register_profile("ci", max_examples=60, derandomize=True, deadline=None, suppress_health_check=_quiet)
 settings.register_profile("fuzz", max_examples=3000, deadline=None, suppress_health_check=_quiet)
 settings.load_profile(__import__("os").environ.get("HYPOTHESIS_PROFILE", "ci"))
+
+
+@pytest.fixture(scope="session")
+def observed_cube():
+    """``observe`` of scenes/dast_cube.toml (800 + 800 instants, the default receiver), once for
+    the session (~3 s): tests/test_observe.py and tests/test_receiver.py assert on it."""
+    from spinviz.analysis import observe as OB
+    from spinviz.inputs.scene_spec import load_scene
+
+    obs, trajs = OB.run_scene(load_scene(ROOT / "scenes" / "dast_cube.toml"), samples=800)
+    obs.trajectories = trajs
+    return obs

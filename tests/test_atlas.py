@@ -412,7 +412,7 @@ PHYSICAL_POINTS = [  # one point per domain of figure 2 (reduced) and per trunca
 
 @pytest.mark.parametrize("name,model,delta,chi_deg", PHYSICAL_POINTS, ids=[p[0] for p in PHYSICAL_POINTS])
 def test_dimensionless_atlas_runs_match_physical_unit_simulate(name, model, delta, chi_deg):
-    """Issue 18.4: the atlas's (4.2)-(4.4) (or the truncated analogue), dimensionless, in
+    """The atlas's (4.2)-(4.4) (or the truncated analogue), dimensionless, in
     heyoka's batch mode, against spinviz.simulate on a CGS body with the same delta, chi and
     tau0 = 1e-20 s (Omega0 ~ 1e19 rad/s), the general (2.2)+(2.3) or (2.5), mapped through
     (4.1): every sample within 1e-7 relative to tau = 1e6 (both at rtol 1e-10; measured <= 3e-9
@@ -423,3 +423,16 @@ def test_dimensionless_atlas_runs_match_physical_unit_simulate(name, model, delt
     for r in rows:
         assert r["end_rel_diff"] < 1e-7, r
         assert r["label_atlas"] == r["label_physical"], r
+
+
+def test_the_diagrams_delta_axis_names_each_side_by_its_bodies():
+    """delta = 1 - I3/I1 > 0 is prolate (the cellulose rod, I3 < I1), delta < 0 oblate (the
+    DAST family-1 plate, I3 > I1): the axis label puts "oblate" left of 0 and "prolate" right."""
+    from spinviz.physics.presets import PRESETS
+    from spinviz.regimes.figures.style import DELTA_AXIS
+
+    rod, plate = PRESETS["cellulose_rod"](), PRESETS["dast_family1"]()
+    assert rod.inertia[2] < rod.inertia[0] and 1 - rod.inertia[2] / rod.inertia[0] > 0.9
+    assert 1 - plate.inertia[2] / plate.inertia[0] == pytest.approx(-0.6, abs=0.01)
+    left, right = DELTA_AXIS.split("\u2190 0 \u2192")
+    assert left.rstrip().endswith("oblate") and right.lstrip().startswith("prolate")

@@ -280,8 +280,8 @@ def test_unreachable_scheduler_library_names_the_parameter(spec_path, tmp_path, 
 
 def test_no_dashboard_port_warning(tmp_path):
     """No dashboard is asked for, so none is looked for: with port 8787 taken, starting the
-    embedded cluster warns nothing (before: "Port 8787 is already in use", also in this
-    suite whenever another cluster was up)."""
+    embedded cluster warns nothing (no "Port 8787 is already in use", even while another
+    cluster holds the port)."""
     holder = socket.socket()
     with contextlib.suppress(OSError):                  # already taken by someone else: as good
         holder.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -374,9 +374,8 @@ def command(spec_path, out, *extra, cwd):
 def test_scheduler_killed_mid_atlas_fails_in_one_line_and_resumes(spec_path, reference, tmp_path, external, sig):
     """The stock ``dask scheduler`` killed (SIGKILL) or stopped (SIGTERM, it exits 0) while the
     atlas runs: exit 75, one line saying what was lost and how to resume; every run marked
-    done holds the reference's numbers (before: the runs in flight were written as
-    "failed: NoneType: None" and done, exit 0); the same command then completes the store
-    with the reference's numbers."""
+    done holds the reference's numbers (the runs in flight are not written, neither as done
+    nor as failed); the same command then completes the store with the reference's numbers."""
     ext = external()
     out = tmp_path / "x.zarr"
     p = command(spec_path, out, "--scheduler", ext.addr, "--runs-per-task", "1", cwd=tmp_path)

@@ -1,4 +1,4 @@
-"""The atlas's adaptive refinement end to end (issue 18.2): ``[refine] levels`` computes the
+"""The atlas's adaptive refinement end to end: ``[refine] levels`` computes the
 children of exactly the cells ``refine.flags`` marks, keeps each level as a store of its own
 inside the atlas, resumes level by level, and ``--verify`` covers every level."""
 

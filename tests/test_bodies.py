@@ -1,4 +1,4 @@
-"""Bodies, materials and the section-6 figures (DESIGN.md, section 2)."""
+"""Bodies, materials and the section-6 figures, recomputed from the paper's own inputs."""
 
 import math
 

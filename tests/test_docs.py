@@ -144,19 +144,25 @@ def test_physics_equations_render_offline(site, tmp_path):
 
 def test_gallery_has_a_drawn_thumbnail_for_every_example(site, tmp_path):
     """Every example in examples/ ran in this build and drew something: its thumbnail is made
-    from its first picture (sphinx-gallery's stand-in, no_image.png, marks one that drew none)."""
+    from its first picture (sphinx-gallery's stand-ins, no_image.png and broken_example.png,
+    scaled to the thumbnail size of docs/conf.py, mark one that drew none or failed)."""
+    import sphinx_gallery
+    from sphinx_gallery.utils import scale_image
+
     page = site / "gallery" / "index.html"
     assert_not_blank(screenshot(page, tmp_path))
     dom, text = page_text(page, tmp_path)
     thumbs = {re.match(r"sphx_glr_(.+)_thumb$", p.stem).group(1): p for p in images(page, dom)
               if p.stem.endswith("_thumb")}
     assert sorted(thumbs) == EXAMPLES
-    import sphinx_gallery
-
-    stand_in = (Path(sphinx_gallery.__file__).parent / "_static" / "no_image.png").read_bytes()
+    stand_ins = []
+    for name in ("no_image.png", "broken_example.png"):
+        scale_image(Path(sphinx_gallery.__file__).parent / "_static" / name, tmp_path / name, 400, 280)
+        stand_ins.append(picture(tmp_path / name))
     for name, p in thumbs.items():
-        assert p.read_bytes() != stand_in, f"{name} drew no picture"
-        assert_drawn(picture(p))
+        thumb = picture(p)
+        assert not any(thumb.shape == s.shape and np.array_equal(thumb, s) for s in stand_ins), f"{name} drew no picture"
+        assert_drawn(thumb)
     assert "Every picture on these pages was drawn while this site was built" in text
 
 
@@ -220,3 +226,20 @@ def test_tutorial_ran_in_this_build(site, tmp_path):
     assert (450, 800, 3) in shapes                                         # spinviz.render_frame(sc, size=(800, 450))
     for p in images(page, dom):
         assert_drawn(picture(p))
+
+
+def test_gallery_embeds_the_turnable_page(site, tmp_path):
+    """The gallery's page example embeds the page of the default scene that it wrote in this
+    build (an iframe); that page, opened from the built site, draws both DAST crystals
+    (orange) in Chromium."""
+    from browser import WEBGL_FLAGS
+
+    page = site / "gallery" / "plot_turnable.html"
+    dom, text = page_text(page, tmp_path)
+    src = html.unescape(re.search(r'<iframe class="written-page" src="([^"]+)"', dom).group(1))
+    assert src == "../sphx_glr_plot_turnable_dast_cube_turnable.html"       # served from the site's root
+    assert "Turn the crystal yourself" in text
+    img = screenshot((page.parent / src).resolve(), tmp_path, fragment="frame=200", flags=WEBGL_FLAGS)
+    view = img[175:560].astype(int)
+    orange = (view[..., 0] > 150) & (view[..., 0] - view[..., 2] > 90) & (view[..., 1] > 60)
+    assert orange[:, :640].sum() > 3000 and orange[:, 640:].sum() > 3000

@@ -1,7 +1,7 @@
 """The general equations of motion against the paper's component forms.
 
 (2.2)+(2.3) written for any inertia and dipole must reproduce (3.3)-(3.5) -- with c^3,
-not the c^2 the paper prints there (a typo: (3.8) has c^3; DESIGN.md, section 2) -- and
+not the c^2 the paper prints there (a typo: (3.8) has c^3) -- and
 the dimensionless (4.2)-(4.4); (2.5) must reproduce (5.3) at chi = 0.
 """
 

@@ -104,7 +104,7 @@ def test_hostile_scene_gets_a_finite_result_or_one_line(doc, tmp_path_factory):
     assert sorted(p.name for p in d.iterdir()) == ["out.npz", "s.toml"]     # nothing left behind
 
 
-# --- the atlas spec (issue 20.6): generated from its schema -------------------------------------
+# --- the atlas spec: generated from its schema -------------------------------------
 ATLAS_BASE = {
     "title": "fuzz", "models": ["reduced"],
     "grid": {"delta": [0.3], "chi_deg": [30.0]},
@@ -167,7 +167,7 @@ def printable_line(text: str) -> str:
     return printable(text, 10_000)
 
 
-# --- the Python API (issue 20.6): every public signature, hostile arguments ------------------------
+# --- the Python API: every public signature, hostile arguments ------------------------
 def _tiny_body():
     return spinviz.symmetric_top(0.3, 0.7)
 

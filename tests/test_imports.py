@@ -49,8 +49,8 @@ def test_check_never_imports_rendering(check_quick):
 
 
 def test_public_names_work_any_number_of_times():
-    """spinviz.simulate used to be replaced by its own submodule after the first call.  Every
-    public name must be the same object before and after all submodules are imported."""
+    """No public name is shadowed by a submodule of the same name: every public name is the
+    same object before and after all submodules are imported."""
     code = """
 import importlib, pkgutil
 import spinviz

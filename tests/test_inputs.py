@@ -1,6 +1,5 @@
 """The one schema (``spinviz.inputs``): every input checked once and named in the caller's
-terms (issue 21.2), limits checked before any work (issue 20.3), typed errors from every
-public function (issue 20.4).  Each test here failed on the code before the schema."""
+terms, limits checked before any work, typed errors from every public function."""
 
 import dataclasses
 import json
@@ -54,7 +53,7 @@ def fresh(code: str) -> str:
     return r.stdout.strip().splitlines()[-1]
 
 
-# --- issue 21.2: one schema for every input --------------------------------------------------
+# --- one schema for every input --------------------------------------------------------------
 def test_the_atlas_spec_is_read_with_the_shared_schema_not_the_scenes_code():
     """The atlas spec, the scene and the API share ``spinviz.inputs``; reading a spec loads no
     part of the scene's reading."""
@@ -63,8 +62,8 @@ def test_the_atlas_spec_is_read_with_the_shared_schema_not_the_scenes_code():
 
 
 def test_a_scene_is_read_without_the_rendering_package():
-    """DESIGN.md puts scenes above rendering; scene.py imported rendering.spec.  (lint-imports
-    keeps it so: "Scenes above rendering".)"""
+    """Data flows from the inputs to the pictures: reading a scene loads no rendering module
+    (lint-imports keeps it so: "Inputs above rendering")."""
     code = ("import sys, spinviz\nspinviz.load_scene('scenes/default.toml')\n"
             "print(sorted(m for m in sys.modules if m.startswith('spinviz.rendering') or m == 'spinviz.pipeline'))")
     assert fresh(code) == "[]"
@@ -118,8 +117,8 @@ def test_a_scene_hands_the_driver_a_typed_frozen_request_with_units():
 
 
 def test_library_errors_name_the_argument_the_command_line_its_option(tmp_path, capsys):
-    """``spinviz.atlas(workers=0)`` said "--workers: ..." -- a flag a Python caller never
-    gave.  The library names the argument; the command line maps it to its option."""
+    """``spinviz.atlas(workers=0)`` names the argument ``workers``, never a flag a Python caller
+    did not give; the command line maps it to its option, ``--workers``."""
     out = tmp_path / "a.zarr"
     with pytest.raises(SpecError) as e:
         spinviz.atlas(SCENES / "atlas_quick.toml", out=out, workers=0)
@@ -134,14 +133,14 @@ def test_library_errors_name_the_argument_the_command_line_its_option(tmp_path, 
 
 
 def test_trajectory_omega_body_is_the_documented_name():
-    """``Trajectory.omega`` is the body-frame angular velocity; ``omega_body`` says so (DESIGN.md
-    section 5) and is the same array (``omega`` stays: the field, the keyword and the saved name)."""
+    """``Trajectory.omega`` is the body-frame angular velocity; ``omega_body`` says so (the frame in
+    the name) and is the same array (``omega`` stays: the field, the keyword and the saved name)."""
     tr = spinviz.simulate(BODY, "reduced", W0, t_end=10.0, samples=3)
     assert tr.omega_body is tr.omega and tr.omega_body.shape == (3, 3)
     np.testing.assert_array_equal(tr.omega_body[0], W0)
 
 
-# --- issue 20.3: limits before work ----------------------------------------------------------------
+# --- limits before work -------------------------------------------------------------------------
 ATLAS = """
 models = ["reduced"]
 [grid]
@@ -156,7 +155,7 @@ omega = 0.1
 
 @pytest.mark.parametrize("cells, members", [(4096, 1), (100, 10000)], ids=["4096x4096 cells", "1e8 runs"])
 def test_an_atlas_that_cannot_finish_is_refused_before_any_work(tmp_path, monkeypatch, cells, members):
-    """4096 x 4096 cells, or 1e8 runs, started and grew memory until MemoryError.  The memory
+    """4096 x 4096 cells, or 1e8 runs, would grow memory until MemoryError.  The memory
     of this process and the time on its workers are estimated from the spec and the machine
     (here a 16 GB machine, one worker), and refused in one line naming the key."""
     from spinviz.inputs import atlas_spec as SP
@@ -192,8 +191,9 @@ GOOD_SPEC = {"models": ["reduced"], "grid": {"delta": [0.3], "chi_deg": [30.0]},
     ("run", "atol", 1e300, "[run].atol: is not used since the atlas integrates with Taylor's method"),
 ])
 def test_atlas_times_tolerances_and_starts_that_cannot_run_are_refused(table, key, value, message):
-    """``tau_start = 5e-324`` made every run fail (and the command exit 0); ``omega = 5e-324``
-    was accepted.  Each value must lie where a run can finish, said with the key."""
+    """A time, tolerance or start where no run can finish (``tau_start = 5e-324``, ``omega =
+    5e-324``) is refused before any work; each value must lie where a run can finish, said
+    with the key."""
     data = json.loads(json.dumps(GOOD_SPEC))
     if key == "list":
         data["members"] = {"list": value}
@@ -206,7 +206,7 @@ def test_atlas_times_tolerances_and_starts_that_cannot_run_are_refused(table, ke
 
 @pytest.mark.parametrize("command, ext", [("simulate", ".npz"), ("render", ".gif")])
 def test_an_output_name_the_file_system_cannot_hold_is_refused_before_the_run(tmp_path, monkeypatch, capsys, command, ext):
-    """An output name over 255 bytes was refused only after the run, by the write."""
+    """An output name over 255 bytes is refused before the run, not by the write after it."""
     from spinviz import driver, pipeline
 
     def run(*a, **k):
@@ -225,13 +225,13 @@ def test_an_output_name_the_file_system_cannot_hold_is_refused_before_the_run(tm
 
 @pytest.mark.parametrize("method", ["auto", "rk45", "dop853"])
 def test_a_nan_in_t_eval_is_refused_not_integrated(method):
-    """A NaN in t_eval gave a trajectory of nan and 4e160 (and it was saved)."""
+    """A NaN in t_eval is refused, naming t_eval, not integrated into a trajectory of NaN."""
     with pytest.raises(SpecError) as e:
         spinviz.simulate(BODY, "reduced", W0, t_eval=[0.0, math.nan, 5.0], method=method)
     assert str(e.value) == "t_eval: must be finite, got [0.0, nan, 5.0]"
 
 
-# --- issue 20.4: every public function raises spinviz's errors, naming the argument -------------------
+# --- every public function raises spinviz's errors, naming the argument ------------------------------
 def sim(**kw):
     args = {"t_end": 10.0, "samples": 5, **kw}
     body = args.pop("body", BODY)
@@ -289,9 +289,9 @@ ATLAS_API = [
 
 @pytest.mark.parametrize("call, kind, message", [c[1:] for c in API], ids=[c[0] for c in API])
 def test_python_api_raises_spinviz_errors_naming_the_argument(call, kind, message):
-    """102 of 132 hostile calls were clean: step=0 gave ZeroDivisionError, a 3-element q0
-    IndexError, NaN tolerances were accepted, samples=1e12 MemoryError, a path for a body
-    AttributeError, NaN omega was named "omega", render_frame(None) a TypeError."""
+    """Hostile arguments (step=0, a 3-element q0, NaN tolerances, samples=1e12, a path for a
+    body, NaN omega, render_frame(None)) get spinviz's typed error naming the argument as the
+    caller wrote it, never ZeroDivisionError, IndexError, MemoryError or AttributeError."""
     with pytest.raises(SpinvizError) as e:
         call()
     assert type(e.value) is kind and isinstance(e.value, ValueError | TypeError)
@@ -300,8 +300,8 @@ def test_python_api_raises_spinviz_errors_naming_the_argument(call, kind, messag
 
 @pytest.mark.parametrize("kw, kind, message", [c[1:] for c in ATLAS_API], ids=[c[0] for c in ATLAS_API])
 def test_atlas_arguments_raise_spinviz_errors_before_any_work(tmp_path, kw, kind, message):
-    """``atlas(workers=1.5)`` or ``"2"`` gave a TypeError from deep inside; ``runs_per_task <= 0``
-    was accepted."""
+    """``atlas(workers=1.5)`` or ``"2"`` and ``runs_per_task <= 0`` are refused by the schema,
+    naming the argument, before any work."""
     with pytest.raises(SpinvizError) as e:
         atlas(tmp_path, **kw)()
     assert type(e.value) is kind and str(e.value) == message
@@ -370,9 +370,8 @@ def test_a_damaged_trajectory_file_is_one_typed_error(tmp_path, damage, reason):
 
 
 def test_render_frame_at_t_0_is_the_first_frame_and_t_is_the_runs_time():
-    """``render_frame(scene, t=0.0)`` was refused ("t must lie in (0, 1200]") although t = 0
-    is the first frame of every video; t is the trajectory's time, and a video's own end is
-    ``Renderer(t_end=...)``."""
+    """``render_frame(scene, t=0.0)`` is the first frame of every video; t is the trajectory's
+    time, and a video's own end is ``Renderer(t_end=...)``."""
     sc = spinviz.load_scene(SCENES / "askew_example.toml")
     look = {"size": (64, 48), "duration": 1.0, "fps": 8}
     first = spinviz.render_frame(sc, t=0.0, **look)

@@ -16,7 +16,7 @@ def send(sig=signal.SIGTERM):
 
 def test_deferred_holds_a_signal_back_even_with_other_threads_running():
     """A signal mask would cover only the main thread; with other threads alive (as OpenBLAS's
-    are) the handler used to raise inside the block.  Now it raises when the block ends."""
+    are) the handler must still not raise inside the block: it raises when the block ends."""
     stop = threading.Event()
     helper = threading.Thread(target=stop.wait, daemon=True)
     helper.start()

@@ -1,5 +1,7 @@
-"""What a detector records, when the two models part, and the sonification (issue 19)."""
+"""What a detector and a stated receiver record, when the two models part across resolutions,
+the start-free test on each model's own line, and the sonification."""
 
+import json
 import math
 import re
 from pathlib import Path
@@ -30,10 +32,9 @@ def run(argv, capsys):
 
 
 @pytest.fixture(scope="module")
-def cube():
-    sc = load_scene(SCENES / "dast_cube.toml")
-    obs, trajs = OB.run_scene(sc, samples=800)
-    return sc, obs, trajs
+def cube(observed_cube):
+    """(scene, observation, trajectories) of scenes/dast_cube.toml (conftest's session run)."""
+    return load_scene(SCENES / "dast_cube.toml"), observed_cube, observed_cube.trajectories
 
 
 def cube_closed_forms(t, tau0):
@@ -46,9 +47,9 @@ def cube_closed_forms(t, tau0):
 def test_cube_models_part_when_the_closed_forms_say(cube):
     """DAST cube (sphere, d along e3): the power toward a detector across L goes as |Omega|^2
     |Omega across d|^2 and the only line is at |Omega|/2 pi, so (6.7) and (6.9) give the parting
-    times in closed form: a factor 2 in power and 1 % in frequency.  The command finds them to
-    0.2 % (linear interpolation between log-spaced instants 1.7 % apart), and the polarization
-    (linear, along the same axis for both) never parts."""
+    times in closed form: a factor 2 in power (ln 2), 1 % and 1e-6 in frequency.  The parting
+    curves (from physics.longitudinal's closed forms on a dense log grid) find them to 1e-4, and
+    the polarization (linear, along the same axis for both) never parts."""
     sc, obs, _ = cube
     tau0 = sc.body.tau0
 
@@ -62,11 +63,70 @@ def test_cube_models_part_when_the_closed_forms_say(cube):
 
     t_power = brentq(lambda t: power_ratio(t) - 2.0, 1.0, sc.t_end)
     t_freq = brentq(lambda t: freq_ratio(t) - 1.01, 1.0, sc.t_end)
-    assert obs.parting["power"] == pytest.approx(t_power, rel=2e-3)
-    assert obs.parting["frequency"] == pytest.approx(t_freq, rel=2e-3)
-    assert obs.parting["polarization"] is None
-    # and the numbers the README gives: 1.9 days and 8.6 hours, against Theta = 3.15 days
+    t_1e6 = brentq(lambda t: freq_ratio(t) - 1.0 - 1e-6, 1.0, sc.t_end)
+    assert obs.parting["power"].at(math.log(2.0)) == pytest.approx(t_power, rel=1e-4)
+    assert obs.parting["frequency"].at(0.01) == pytest.approx(t_freq, rel=1e-4)
+    assert obs.parting["frequency"].at(1e-6) == pytest.approx(t_1e6, rel=1e-4)
+    assert obs.parting["polarization"].at(math.radians(0.1)) is None
+    # the README's numbers: 1.9 days, 8.6 hours, 4.5 minutes, against Theta = 3.15 days
     assert t_power / 86400 == pytest.approx(1.92, abs=0.01) and t_freq / 3600 == pytest.approx(8.6, abs=0.05)
+    assert t_1e6 / 60 == pytest.approx(4.54, abs=0.01)
+
+
+def test_parting_curves_agree_with_the_runs_and_never_go_back(cube):
+    """Where the differences are well above the runs' accuracy (1e-11), the integrated runs part
+    when the closed forms say (to the 1.7 % spacing of their log-spaced instants); a parting time
+    never decreases with the resolution."""
+    from spinviz.analysis import parting as PT
+
+    _, obs, _ = cube
+    runs = PT.differences(*obs.detections)
+    t = obs.detections[0].t
+    for key, r in (("frequency", 1e-6), ("frequency", 1e-3), ("power", 0.01), ("power", 0.3)):
+        assert PT.parting_time(t, runs[key], r) == pytest.approx(obs.parting[key].at(r), rel=0.02), (key, r)
+    for c in obs.parting.values():
+        ok = np.isfinite(c.times)
+        assert np.all(np.diff(c.times[ok]) >= 0)
+
+
+def test_receiver_parts_the_cube_at_five_sigma(cube):
+    """This receiver (5 dBi at 10 cm, 5 K, 1 s): the frequency differs by more than 5 sigma of one
+    integration at the first one (1 s: 1.1e-11 against a relative resolution of 2.2e-12); the power
+    first when ln(P_tru/P_red) = 5 sigma_P/P, with sigma_P/P = 2/sqrt(rho) of the fainter model."""
+    from spinviz.physics import longitudinal as LG
+
+    sc, obs, _ = cube
+    f = obs.parting["frequency"]
+    u0, b0 = LG.start_state(sc.omega0, sc.body.dipole_direction, 1.0)
+    fr, _ = LG.line("reduced", 1.0, u0, b0, sc.body.tau0)
+    ft, _ = LG.line("truncated", 1.0, u0, b0, sc.body.tau0)
+    bg = obs.budgets[0]
+    rel = bg.sigma_f[1] / bg.freq[1, bg.dominant[1]]
+    assert f.setup_time == pytest.approx(1.0, rel=1e-6)
+    assert abs(fr / ft - 1) > 5 * rel and rel == pytest.approx(2.2e-12, rel=0.02)
+    p = obs.parting["power"]
+    i = np.searchsorted(p.t, p.setup_time)
+    assert p.D[i] >= 5 * p.sigma[i] and p.D[i - 1] < 5 * p.sigma[i - 1]
+    assert p.setup_time / 86400 == pytest.approx(1.75, abs=0.01)
+
+
+def test_observe_record_is_strict_json(cube):
+    """The cube's record (receiver, budgets, parting curves, P-f tests with an infinite Z) holds no
+    NaN or Infinity: None stands for them."""
+    _, obs, _ = cube
+    rec = json.loads(json.dumps(obs.record(), allow_nan=False))
+    assert rec["pf_test"]["fits"]["truncated"]["reduced_law_rejected_outright"] is True
+    assert rec["parting"]["frequency"]["setup_time"] == pytest.approx(1.0)
+
+
+def test_cube_line_as_this_receiver_measures_it_passes_the_pf_test(cube):
+    """Each model's own line, one 1 s integration at each instant where it is detected in the
+    radiation zone (with the receiver's noise): the reduced run goes to the reduced law (f_inf near
+    5 GHz), the truncated run to the truncated law, which rejects the reduced start's 5 GHz outright."""
+    _, obs, _ = cube
+    red, tru = obs.pf["reduced"], obs.pf["truncated"]
+    assert red.verdict == "reduced" and red.z > 50 and red.f_inf == pytest.approx(5e9, rel=2e-3)
+    assert tru.verdict == "truncated" and tru.z_expected == math.inf and abs(tru.exponent - 4) < 3 * tru.exponent_sigma
 
 
 def test_cube_detector_sees_larmor_toward_n(cube):
@@ -92,7 +152,8 @@ def test_rod_parts_in_frequency_after_a_hundred_T_and_in_power_after_Theta():
     """The cellulose rod (chi = 0), over its [observe] horizon of 2e4 T: (5.2) and (5.4) are exact,
     and the only line is at |L|/(2 pi I1) = sqrt(w_perp^2 + eps^2 w3^2)/2 pi; the reduced top keeps
     w3, so the lines part by 1 % once eps^2 w3^2 ~ 0.02 w_perp^2 (~90 T, 2e8 years), and the power
-    w_perp^2 (w_perp^2 + eps^2 w3^2) by a factor 2 only after Theta (~1.5 Theta, 1.5e10 years)."""
+    w_perp^2 (w_perp^2 + eps^2 w3^2) by a factor 2 only after Theta (~1.5 Theta, 1.5e10 years).  The
+    default receiver never detects it: 4.7e-26 W in all, an SNR of 1e-5 in a second."""
     sc = load_scene(SCENES / "cellulose_rod.toml")
     obs, _ = OB.run_scene(sc, samples=800)
     b = sc.body
@@ -112,27 +173,48 @@ def test_rod_parts_in_frequency_after_a_hundred_T_and_in_power_after_Theta():
 
     t_freq = brentq(lambda t: freq(states(t)[0]) / freq(states(t)[1]) - 1.01, b.tau0, obs.horizon)
     t_power = brentq(lambda t: power(states(t)[1]) / power(states(t)[0]) - 2.0, b.tau0, obs.horizon)
-    assert obs.parting["frequency"] == pytest.approx(t_freq, rel=5e-3)
-    assert obs.parting["power"] == pytest.approx(t_power, rel=5e-3)
+    assert obs.parting["frequency"].at(0.01) == pytest.approx(t_freq, rel=1e-4)
+    assert obs.parting["power"].at(math.log(2.0)) == pytest.approx(t_power, rel=1e-4)
     T, Theta = obs.scales["T"], obs.scales["Theta"]
     assert 80 < t_freq / T < 100 and 1.3 < t_power / Theta < 1.7
+    for bg in obs.budgets:
+        assert not np.any(bg.detected) and np.nanmax(bg.rho) < 1e-4
+    assert all(c.setup_time is None for c in obs.parting.values())
 
 
-def test_observe_command_prints_the_answer_and_writes_two_plots(tmp_path, capsys):
+@pytest.mark.slow
+def test_observe_command_prints_the_answer_and_writes_three_plots(tmp_path, capsys):
     """The parting times test_cube_models_part_when_the_closed_forms_say finds from the closed forms
-    (1.92 days, 8.6 h), the start's line at sqrt(2) pi 1e10 / 2 pi = 7.071 GHz, the reduced
-    cube's end at Omega3 / 2 pi = 5 GHz, Theta = 3.15 days; and two drawn plots."""
+    (1.92 days at ln 2 in power, 8.62 h at 1 % in frequency), this receiver's (1 s and 1.75 days),
+    the start's line at sqrt(2) pi 1e10 / 2 pi = 7.071 GHz in the radiation zone, the reduced cube's
+    end at Omega3 / 2 pi = 5 GHz, Theta = 3.15 days, the P-f verdicts; and three drawn plots."""
     from PIL import Image
 
     code, out, err = run(["observe", SCENES / "dast_cube.toml", "--out", tmp_path / "cube", "--samples", "200"], capsys)
     assert code == 0, err
-    assert re.search(r"factor 2 in power toward the detector +1\.92 days", out), out
-    assert re.search(r"1 % in dominant frequency +8\.6\d h", out), out
+    assert re.search(r"power +0\.001: .*; 0\.693: 1\.92 days\n +this receiver \(5σ in one 1 s integration, [\d.]+\): "
+                     r"1\.75 days", out), out
+    assert re.search(r"frequency +1e-12: .*; 0\.01: 8\.62 h\n +this receiver .*: 1 s ", out), out
     assert re.search(r"dominant frequency +7\.071 GHz +7\.071 GHz\n(.*\n)*.*dominant frequency +5 GHz", out), out
+    assert re.search(r"wavelength, zone at the antenna +4\.24 cm, radiation +4\.24 cm, radiation", out), out
+    assert "verdict: reduced" in out and "verdict: truncated" in out
     assert re.search(r"Theta += 3\.15 days +\(the paper, section 6\.2", out), out
-    for name in ("cube_observe.png", "cube_detector.png"):
+    for name in ("cube_observe.png", "cube_detector.png", "cube_receiver.png"):
         img = np.asarray(Image.open(tmp_path / name).convert("L"))
         assert min(img.shape) > 800 and 0.01 < (img < 128).mean() < 0.5, (name, img.shape)   # drawn, not blank or solid
+
+
+def test_antenna_inside_a_wavelength_gets_no_snr():
+    """At 1 cm the cube's 4.2 cm line has the antenna in the intermediate zone: the whole field is
+    given (1.84 times the radiation term: the closed form of test_receiver's), the radiation-zone
+    SNR is not, and so no parting for this receiver."""
+    obs, _ = OB.run_scene(load_scene(SCENES / "dast_cube.toml"), samples=50, distance_cm=1.0)
+    rec = json.loads(json.dumps(obs.record(), allow_nan=False))          # strict JSON: no NaN, no Infinity
+    start = rec["budget"]["reduced"]["start"]
+    assert start["zone"] == "intermediate" and start["snr_integration"] is None and start["received_w"] is None
+    assert start["field_full_rms_v_per_m"] / start["field_radiation_term_rms_v_per_m"] == pytest.approx(1.84, abs=0.01)
+    assert all(rec["parting"][k]["setup_time"] is None for k in ("power", "frequency", "polarization"))
+    assert "near zone" in OB.format_table(obs) or "intermediate" in OB.format_table(obs)
 
 
 def spectral_peak(x, rate, center_s, window_s=0.25):
@@ -207,7 +289,14 @@ TWO_MODELS = ONE_MODEL.replace('model = "reduced"', 'models = ["reduced", "trunc
      "needs a symmetric top"),
     (["observe", "{scene}", "--los", "1,2"], TWO_MODELS, "--los: expected three numbers"),
     (["observe", "{scene}", "--los", "0,0,0"], TWO_MODELS, "--los: must not be zero"),
-    (["observe", "{scene}", "--power-factor", "0.5"], TWO_MODELS, "--power-factor: must lie in"),
+    (["observe", "{scene}", "--power-factor", "2"], TWO_MODELS,
+     "argument --power-factor: the resolutions are computed from the receiver"),
+    (["observe", "{scene}"], TWO_MODELS + "[observe]\nfrequency_resolution = 0.01\n",
+     "[observe].frequency_resolution: the resolutions are computed from the receiver"),
+    (["observe", "{scene}"], TWO_MODELS + "[observe]\nnoise_temperature_k = 4.0\nnoise_density_w_per_hz = 1e-22\n",
+     "[observe].noise_density_w_per_hz: give only one of noise_temperature_k, noise_density_w_per_hz"),
+    (["observe", "{scene}"], TWO_MODELS + "[observe]\nintegration_s = 0.0\n", "[observe].integration_s: must lie in"),
+    (["observe", "{scene}", "--distance-cm", "0"], TWO_MODELS, "--distance-cm: must lie in"),
     (["observe", "{scene}"], TWO_MODELS + "[observe]\ncolour = 1\n", "[observe].colour: unknown key"),
     (["observe", "{scene}"], TWO_MODELS + "[observe]\nline_of_sight = [0.0, 0.0, 0.0]\n",
      "[observe].line_of_sight: must not be zero"),

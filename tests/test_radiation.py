@@ -1,4 +1,4 @@
-"""Radiation observables and the balance of L and E against them (issue 19): closed forms,
+"""Radiation observables and the balance of L and E against them: closed forms,
 identities of (2.1), (2.4a), (2.4b), orders in eps_rad."""
 
 import json

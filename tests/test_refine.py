@@ -1,4 +1,4 @@
-"""Adaptive refinement of the atlas (issue 18.2) on a synthetic label field with a known boundary."""
+"""Adaptive refinement of the atlas on a synthetic label field with a known boundary."""
 
 import numpy as np
 

@@ -275,11 +275,11 @@ def test_progress_is_reported_while_rendering(tmp_path, capsys):
     plan = pipeline.plan(sc, fps=8, duration=1.0)
     render_video(plan, str(tmp_path / "p.mp4"), workers=1, progress=True, poster=False)
     err = capsys.readouterr().err.splitlines()
-    assert [line.split(": ")[-1] for line in err] == ["25 % (2/8 frames)", "50 % (4/8 frames)", "75 % (6/8 frames)",
-                                                     "100 % (8/8 frames)"]
+    assert [line.split(": ", 1)[1].split(",")[0] for line in err] == ["2/8 frames (25 %)", "4/8 frames (50 %)",
+                                                                      "6/8 frames (75 %)", "8/8 frames (100 %)"]
 
 
-# --- pictures a viewer can read (issue 11) ---------------------------------------------------
+# --- pictures a viewer can read ---------------------------------------------------
 SCENES = sorted(p for p in (pathlib.Path(__file__).resolve().parents[1] / "scenes").glob("*.toml")
                 if not p.name.startswith("atlas_"))           # atlas specs are not scenes
 
@@ -522,7 +522,7 @@ def test_render_starts_its_workers_before_it_simulates(tmp_path, monkeypatch):
     assert multiprocessing.active_children() == []
 
 
-# --- the power inset (issue 19.5) --------------------------------------------------------------
+# --- the power inset --------------------------------------------------------------
 def _near(px, rgb, tol=40):
     """Pixels within ``tol`` (sum of channel differences) of a colour."""
     return np.abs(px.astype(int) - np.array(rgb)).sum(axis=-1) <= tol

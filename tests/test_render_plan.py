@@ -311,7 +311,7 @@ print(sorted(m for m in ("PIL", "vtk", "vtkmodules", "pyvista", "imageio", "matp
     assert r.stdout.strip() == "[]"
 
 
-# --- the power inset (issue 19.5) --------------------------------------------------------------
+# --- the power inset --------------------------------------------------------------
 def _rows_of(value_w, box, scale):
     """The pixel row (float) of a power ``value_w`` (W) in a log plot ``box`` of ``scale``."""
     _, lo, hi = scale

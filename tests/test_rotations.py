@@ -1,4 +1,4 @@
-"""Quaternion and Euler-angle conventions (DESIGN.md, section 5)."""
+"""Quaternion and Euler-angle conventions (docs/design.md, "Conventions")."""
 
 import math
 

@@ -86,7 +86,7 @@ def test_secular_is_exact_for_6_10():
 def test_secular_slow_variables_are_second_order_in_tau0_omega_for_an_askew_top():
     """Askew top (delta = -0.6, chi = 55 deg) over 2 T against a resolved run: with the
     near-identity transform the slow variables are off by O(eps^2) (first-order averaging
-    alone was O(eps)); measured here ~2-5 eps^2, bound 20 eps^2, and the order in eps ~2."""
+    without it is O(eps)); measured here ~2-5 eps^2, bound 20 eps^2, and the order in eps ~2."""
     body = B.symmetric_top(-0.6, math.radians(55.0))
     errs = []
     for eps_rad in (3e-4, 1e-4):

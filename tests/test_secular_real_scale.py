@@ -19,9 +19,9 @@ def horizon(eps, n_T, w_dir=W_DIR):
 
 
 def test_auto_matches_full_integration_in_the_domain_of_4_20():
-    """delta = 0.8, chi = 1.2 (the '?' domain), tau0 |Omega0| = 1e-4, 30 T: auto used to pick
-    the averaged flow and be 14 % off in |Omega| (omega3 sent monotonically to 0 while it
-    oscillates).  Now auto resolves the ~1e4 turns with Taylor's method at the default rtol
+    """delta = 0.8, chi = 1.2 (the '?' domain), tau0 |Omega0| = 1e-4, 30 T: the first-order
+    averaged flow is 14 % off in |Omega| here (it sends omega3 monotonically to 0 while it
+    oscillates), so auto resolves the ~1e4 turns with Taylor's method at the default rtol
     1e-10, and |Omega| matches the run at rtol 1e-12 to 8.3e-12 (measured); bound 1e-10, the
     default rtol."""
     body = B.symmetric_top(0.8, 1.2)
@@ -57,7 +57,7 @@ def test_secular_follows_the_oscillating_regime_in_full():
 @pytest.mark.parametrize("eps", [1e-4, 1e-5])
 def test_secular_refuses_when_a_resonance_makes_L_uncertain(eps):
     """The direction of L after the resonance |L|/I1 = delta omega3 is off by ~sqrt(eps) (2.6e-3,
-    7.3e-4 measured): secular now predicts that, refuses, and says why."""
+    7.3e-4 measured): secular predicts that, refuses, and says why."""
     body = B.symmetric_top(0.8, 1.2)
     with pytest.raises(spinviz.SimulationError, match=r"resonance \|L\|/I1 = 1 delta omega3 .* uncertain by ~"):
         spinviz.simulate(body, "reduced", W_DIR * eps, t_end=horizon(eps, 30), samples=5, method="secular")
@@ -65,9 +65,9 @@ def test_secular_refuses_when_a_resonance_makes_L_uncertain(eps):
 
 @pytest.mark.parametrize("eps", [1e-4, pytest.param(3e-6, marks=pytest.mark.slow)])       # 3e-6: ~3 s
 def test_phase_resolved_is_never_claimed_beyond_the_stated_error(eps):
-    """delta = 0.3, chi = 1.0, 3 T: the phases were off by O(1) rad (2.8 rad in q) while
-    reported resolved.  Now q is within the stated phase error, and called resolved only when
-    that is below 1e-3 rad.  Measured q error / stated: 1.2e-3 / 1.1e-2 at eps = 1e-4 (not
+    """delta = 0.3, chi = 1.0, 3 T: first-order averaging leaves the phases O(1) rad off (2.8
+    rad in q); q must be within the stated phase error, and called resolved only when that is
+    below 1e-3 rad.  Measured q error / stated: 1.2e-3 / 1.1e-2 at eps = 1e-4 (not
     resolved), 1.2e-4 / 1.1e-3 at 1e-5 (not resolved: the stated bound counts the drift an
     O(eps^2) error in omega3 could give the phases), 3.5e-5 / 3.4e-4 at 3e-6 (resolved)."""
     body = B.symmetric_top(0.3, 1.0)
@@ -85,8 +85,8 @@ def test_phase_resolved_is_never_claimed_beyond_the_stated_error(eps):
 
 def test_a_runaway_says_so_and_when():
     """tau0 |Omega0| = 10, an asymmetric body: the reduced solution blows up (|omega| ~ 1/(t* - t),
-    t* = 21.93).  It used to end after 35-50 s in scipy's 'Required step size is less than
-    spacing between numbers'."""
+    t* = 21.93): the run stops at once with one line giving the time and the extrapolated
+    blow-up, instead of grinding for tens of seconds into scipy's step-size failure."""
     body = B.Body("asymmetric", "dimensionless", (1.0, 0.8, 0.5), (0.042, 0.938, -0.344))
     with pytest.raises(spinviz.SimulationError) as e:
         spinviz.simulate(body, "reduced", (-7.154, 5.648, 4.115), t_end=25.0, samples=6)
@@ -96,7 +96,7 @@ def test_a_runaway_says_so_and_when():
 
 def test_4_18_amplitude_corrected():
     """(4.18) prints A^2 = 1/(2 - xi); the averaged flow (4.12) and the full equations give
-    (1 + xi)/(2 + xi) (DESIGN.md, section 2).  At delta = 0.5, chi = 39 deg (inside domain "4",
+    (1 + xi)/(2 + xi).  At delta = 0.5, chi = 39 deg (inside domain "4",
     where the spiral is the late state), omega_perp^2 tau of the full reduced equation at
     tau = 1e10 is within 1 % of the corrected A^2 = 0.6235 (it converges like tau^(beta + 1/2) =
     tau^-0.12: 0.616-0.622 at 1e8), and 16 % below the printed 0.744."""
@@ -147,8 +147,8 @@ def test_stated_errors_bound_the_measured_ones_on_random_bodies():
 @pytest.mark.parametrize("model", ["reduced", "truncated"])
 def test_a_start_on_the_axis_keeps_its_orientation_and_stated_errors(model):
     """omega_perp(0) = 0: only phi + psi is defined at the start, and the precession angle
-    is taken from it (it used to come from the quaternion's own split, which turned the body
-    by 90 deg about L).  From rest across the axis the forced response swings to twice its
+    is taken from it (not from the quaternion's own split of phi and psi, which would turn
+    the body by 90 deg about L).  From rest across the axis the forced response swings to twice its
     amplitude (measured 1.8 |c| at delta = 0.3, chi = 0.5, reduced), inside the stated 2 |c|."""
     eps = 1e-4
     body = B.symmetric_top(0.3, 0.5)

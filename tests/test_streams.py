@@ -1,4 +1,4 @@
-"""Standard streams and echoed text (issue 20.5): a closed or full stdout or stderr never
+"""Standard streams and echoed text: a closed or full stdout or stderr never
 costs the output file nor crashes a command, and every name echoed to the terminal is one
 escaped line.  Each test here failed on the code before."""
 
@@ -75,8 +75,8 @@ def test_a_full_stdout_names_the_stream_and_keeps_the_output(tmp_path):
 
 @pytest.mark.parametrize("how", ["closed", "full"])
 def test_a_closed_or_full_stderr_never_costs_the_video(tmp_path, how):
-    """``2>/dev/full`` or a closed stderr made a render exit 1 having written nothing: the
-    progress bar could not be drawn.  Now the bar is skipped and the video is made."""
+    """``2>/dev/full`` or a closed stderr never costs the video: the progress bar, which cannot
+    be drawn, is skipped and the video is made."""
     out = tmp_path / "v.gif"
     args = ["render", str(scene(tmp_path)), "--out", str(out)]
     if how == "closed":
@@ -98,10 +98,10 @@ NAMES = [
 
 @pytest.mark.parametrize("raw, shown", NAMES, ids=[n[1] for n in NAMES])
 def test_every_echoed_name_is_one_escaped_line(tmp_path, raw, shown):
-    """Newline, carriage return, \\x1c, \\x1d, U+2028, U+202E and 0x9b in paths were echoed raw
-    (lines split or reordered on screen), and a strict-UTF-8 terminal with a 0xff file name
-    gave exit 2 and no file.  Now the output is written and its name echoed escaped, on a
-    strict UTF-8 stdout; errors naming it are escaped alike."""
+    """Newline, carriage return, \\x1c, \\x1d, U+2028, U+202E and 0x9b in paths are echoed
+    escaped (no line split or reordered on screen), and with a 0xff file name on a strict
+    UTF-8 stdout the output is written and its name echoed escaped; errors naming it are
+    escaped alike."""
     out = bytes(tmp_path) + b"/" + raw + b".npz"
     r = spinviz_cmd(["simulate", os.fsencode(scene(tmp_path)), "--out", out])
     assert r.returncode == 0, r.stderr

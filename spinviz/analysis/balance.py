@@ -17,8 +17,9 @@ remains is the model's departure from the balance plus the integrator's error.
 What each model should show (dimensionless eps_rad = tau0 |Omega|):
 
 * truncated (2.5) is (2.4a) solved for Omega_dot: r_a at the integrator's error; r_1 = -(K(t) - K(0)),
-  a bounded oscillation; r_E does not close:
-  dE/dt + P - dE_S/dt = (2/3c^3) d_ddot . (Omega_dot x d) - (2/3c^3) d_dot . d_dddot
+  a bounded oscillation; r_E does not close: with dE/dt = Omega . N = -P + (2/3c^3) d_ddot .
+  (Omega_dot x d) (N the torque of (2.4a), d_dot = Omega x d) and dE_S/dt = P + (2/3c^3) d_dot . d_dddot,
+  dE/dt + P - dE_S/dt = (2/3c^3) d_ddot . (Omega_dot x d) - P - (2/3c^3) d_dot . d_dddot
   is O(1) relative to P for a top that precesses (delta != 0), e.g.
   -(2/3c^3) d^2 delta (1 - delta) Omega3^2 Omega_perp^2 on average for chi = 0;
 * reduced (2.2)+(2.3) is (2.1) with the free-motion Omega_dot, Omega_ddot in d_dddot: r_1 and r_E

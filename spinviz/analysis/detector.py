@@ -1,4 +1,4 @@
-"""A detector far away along a line of sight n: what it records from a run (issue 19).
+"""A detector far away along a line of sight n: what it records from a run.
 
 The far field is E = (d_ddot x n) x n / (c^2 R) at the retarded time t + R/c (a constant shift,
 left out: times are the source's).  Near each stored state the symmetric top's motion is its
@@ -40,7 +40,10 @@ class Detection:
 
     freq (N, K) line frequencies (Hz, or cycles per tau0), non-negative; line_power_sr (N, K)
     each line's dP/dOmega toward n; line_field (N, K, 2) complex field amplitudes on (u1, u2) with
-    E(t) = 2 Re(line_field exp(2 pi i freq t)) (V/m at ``distance_cm``, or in g units); power
+    E(t) = 2 Re(line_field exp(2 pi i freq t)) (V/m at ``distance_cm``, or in g units); line_ddot
+    (N, K, 3) complex world-frame amplitudes of the dipole's second derivative, d_ddot(t) =
+    2 Re(line_ddot exp(2 pi i freq t)) (statC cm/s^2, or |d|/tau0^2), for the field at any
+    distance (``physics.dipole_field``); power
     (N,) total Larmor power averaged over the precession; power_sr (N,) dP/dOmega toward n;
     field_rms (N,); f_dom, f_rot, f_prec (N,); pol_angle (N,) rad from u1 in [-pi/2, pi/2);
     linear, circular (N,) fractions; photons_sr (N,) photons per second per steradian (CGS).
@@ -54,6 +57,7 @@ class Detection:
     freq: np.ndarray
     line_power_sr: np.ndarray
     line_field: np.ndarray
+    line_ddot: np.ndarray
     power: np.ndarray
     power_sr: np.ndarray
     field_rms: np.ndarray
@@ -127,6 +131,8 @@ def detect(traj: Trajectory, line_of_sight=None, distance_cm: float = 1.0, M: in
     to_hz = 1.0 / (2.0 * math.pi * tau0)                 # rad per tau0 -> Hz (cycles per tau0 if dimensionless)
     freq = np.abs(lines.angular_frequency) * to_hz
     e = np.where((lines.angular_frequency < 0)[..., None], np.conj(e), e)
+    ddot = np.where((lines.angular_frequency < 0)[..., None], np.conj(lines.amplitude), lines.amplitude)
+    ddot = ddot * (body.dipole_magnitude / tau0**2 if cgs else 1.0)      # g of unit size -> d_ddot
     line_power_sr = U.radiation_from_dimensionless(psr, "power_per_sr", I1, tau0)
     sig = math.sqrt(I1 / tau0**3) if cgs else 1.0        # g-unit signal -> (erg/s)^1/2
     to_field = (math.sqrt(1.5 / U.C_LIGHT) / distance_cm * U.STATV_PER_CM_IN_V_PER_M) if cgs else 1.0
@@ -149,7 +155,7 @@ def detect(traj: Trajectory, line_of_sight=None, distance_cm: float = 1.0, M: in
                  else np.sqrt(8.0 * math.pi / 3.0 * power_sr))
     return Detection(
         model=traj.model, units=traj.units, t=np.asarray(traj.t), line_of_sight=n, distance_cm=float(distance_cm),
-        freq=freq, line_power_sr=line_power_sr, line_field=e * sig * to_field,
+        freq=freq, line_power_sr=line_power_sr, line_field=e * sig * to_field, line_ddot=ddot,
         power=traj.radiated_power(), power_sr=power_sr, field_rms=field_rms, f_dom=freq[rows, strongest],
         f_rot=lines.phi_dot * to_hz, f_prec=np.abs(lines.psi_dot) * to_hz,
         pol_angle=0.5 * np.arctan2(Uq, Q), linear=linear, circular=circular, photons_sr=photons,

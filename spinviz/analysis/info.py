@@ -2,7 +2,7 @@
 
 Every printed figure that differs from what spinviz computes from the paper's own
 inputs by more than ``FLAG_THRESHOLD`` (5 %) is flagged, so a user sees both numbers
-and knows which to trust (DESIGN.md, section 2).
+and knows which to trust (docs/design.md, "Verified against the paper").
 """
 
 from __future__ import annotations

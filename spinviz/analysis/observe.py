@@ -1,20 +1,22 @@
-"""``spinviz observe``: when does a detector tell the two models apart?
+"""``spinviz observe``: what a stated receiver records from both models of a scene, and when it
+tells them apart.
 
-For a two-model scene, both runs are watched by the same detector (``detector.detect``: the same
-line of sight and distance) and compared, instant by instant, on three observables at a stated
-resolution each:
+Both runs are watched by the same detector (``detector.detect``: one line of sight) and the
+same receiver (``receiver.budget``, CGS bodies: distance, band, integration time, noise,
+antenna), which gives, per output instant and line, the received power, the SNR of one
+integration, the coherent interval of the drifting line and the resolutions it reaches in
+frequency, power and polarization angle (Cramer-Rao bounds), the field at the antenna with all
+its terms and the zone the antenna is in.  From them:
 
-* the power toward the detector: the models part when one receives ``power_factor`` (2) times
-  the other's;
-* the dominant frequency: when they differ by ``frequency_resolution`` (1 %) of the truncated
-  model's;
-* the polarization angle: when the angles of the linear polarization differ by
-  ``polarization_deg`` (5 deg), counted only where both are at least 10 % linearly polarized
-  (the angle of a circular signal means nothing).
+* when the models part (``parting``): for each observable the first time they differ by a
+  given resolution, across resolutions, from the same known start -- and the time this
+  receiver sees it (the difference reaching 5 standard errors of one integration);
+* the start-free test (``pftest``): each model's own line, as this receiver would measure it
+  (one integration at each output instant with its noise, a fixed seed), fitted to the P-f
+  laws; for a top without them, why not.
 
-The first such time (linear interpolation between output instants, log-spaced from 1e-6 of
-the horizon on) is reported in human units and in the scene's T and Theta, beside the figures
-the paper prints for them.  Numbers from NumPy; matplotlib only to draw the PNGs.
+Times are reported in human units and in the scene's T and Theta, beside the figures the paper
+prints.  Numbers from NumPy (and SciPy for the fits); matplotlib only to draw the PNGs.
 """
 
 from __future__ import annotations
@@ -26,77 +28,74 @@ import numpy as np
 
 from .. import units as U
 from ..plotting import pyplot, save
-from .compare import compare_times, first_crossing, model_color, time_unit
+from . import parting as PT
+from .compare import compare_times, model_color, time_unit
 from .detector import Detection
 
-MIN_LINEAR = 0.1          # below this linear fraction a polarization angle is not compared
-OBSERVABLES = ("power", "frequency", "polarization")
-
-
-@dataclass(frozen=True)
-class Resolution:
-    """How finely the detector resolves each observable."""
-
-    power_factor: float = 2.0
-    frequency: float = 0.01
-    polarization_deg: float = 5.0
-
-    def label(self, key: str) -> str:
-        """The resolution of observable ``key`` ("power", "frequency" or "polarization") in words."""
-        return {"power": f"factor {self.power_factor:g} in power toward the detector",
-                "frequency": f"{100 * self.frequency:g} % in dominant frequency",
-                "polarization": f"{self.polarization_deg:g}° in polarization angle"}[key]
-
-
-def differences(a: Detection, b: Detection) -> dict[str, np.ndarray]:
-    """Per instant: the power ratio (>= 1), the relative frequency difference |f_a/f_b - 1| and
-    the polarization-angle difference in degrees (NaN where either is < 10 % linear)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        hi, lo = np.maximum(a.power_sr, b.power_sr), np.minimum(a.power_sr, b.power_sr)
-        ratio = np.where(lo > 0, hi / np.where(lo > 0, lo, 1.0), np.where(hi > 0, np.inf, 1.0))
-        fdiff = np.abs(a.f_dom / b.f_dom - 1.0)
-    d = np.degrees(a.pol_angle - b.pol_angle)
-    d = np.abs((d + 90.0) % 180.0 - 90.0)
-    d = np.where((a.linear >= MIN_LINEAR) & (b.linear >= MIN_LINEAR), d, np.nan)
-    return {"power": ratio, "frequency": fdiff, "polarization": d}
-
-
-def parting_times(a: Detection, b: Detection, res: Resolution) -> dict[str, float | None]:
-    """The first time each observable differs by its resolution, or None within the run."""
-    diff = differences(a, b)
-    thresholds = {"power": res.power_factor, "frequency": res.frequency, "polarization": res.polarization_deg}
-    out = {}
-    for key in OBSERVABLES:
-        x = np.nan_to_num(diff[key], nan=0.0, posinf=1e300)
-        out[key] = first_crossing(a.t, x, thresholds[key])
-    return out
+OBSERVABLES = PT.OBSERVABLES
+SEED = 1                  # the synthetic P-f series' noise: fixed, so a report is reproducible
 
 
 @dataclass
 class Observation:
-    """Both models' detections, the resolution and the parting times, with the scene's scales."""
+    """Both models' detections, the receiver and its budgets (CGS), the parting curves and the
+    P-f tests, with the scene's scales."""
 
     title: str
     units: str
     detections: list
-    resolution: Resolution
     parting: dict
     scales: dict = field(default_factory=dict)       # "T", "Theta" in the body's time unit
     printed: dict = field(default_factory=dict)      # the paper's figures for them, seconds
     horizon: float = 0.0
+    receiver: object = None                          # inputs.receiver.ReceiverSpec, CGS only
+    budgets: list | None = None
+    pf: dict = field(default_factory=dict)           # model -> pftest.PfTest (or None)
+    pf_series: dict = field(default_factory=dict)    # model -> pftest.Series (or None)
+    pf_law: str | None = None
+    pf_reason: str = ""
+    notes: list = field(default_factory=list)
 
     def record(self) -> dict:
-        """The observation as a JSON-ready dict (``spinviz observe --json``): scales, parting
-        times, and per model the scalar observables at the first and last samples."""
+        """The observation as a JSON-ready dict (``spinviz observe --json``): the receiver, per
+        model its observables and budget at the first and last samples, the parting curves, the
+        P-f tests, the scales."""
         a, b = self.detections
-        return {
+        out = {
             "title": self.title, "units": self.units, "horizon": self.horizon,
             "line_of_sight": a.line_of_sight.tolist(), "distance_cm": a.distance_cm,
-            "resolution": vars(self.resolution), "parting": self.parting, "scales": self.scales,
+            "parting": {k: c.record() for k, c in self.parting.items()}, "scales": self.scales,
             "printed": self.printed, "phase_resolved": bool(a.phase_resolved and b.phase_resolved),
             "start": {d.model: d.record(0) for d in self.detections},
-            "end": {d.model: d.record(-1) for d in self.detections},
+            "end": {d.model: d.record(-1) for d in self.detections}, "notes": self.notes,
         }
+        if self.receiver is not None:
+            out["receiver"] = self.receiver.record()
+            out["budget"] = {bg.model: {"start": bg.record(_first(bg)), "end": bg.record(-1),
+                                        "series": _thinned(bg)} for bg in self.budgets}
+        out["pf_test"] = {"law": self.pf_law, "reason": self.pf_reason or None,
+                          "fits": {m: (r.record() if r is not None else None) for m, r in self.pf.items()}}
+        return out
+
+
+def _first(bg) -> int:
+    """The first instant after t = 0 (the budget's drift rates are one-sided at t = 0)."""
+    return int(np.argmax(bg.t > 0))
+
+
+def _thinned(bg, n: int = 60) -> dict:
+    """The strongest line's SNR and resolutions at ~n log-spaced instants (JSON)."""
+    i = np.unique(np.searchsorted(bg.t, np.geomspace(max(bg.t[bg.t > 0][0], 1e-300), bg.t[-1], n)))
+    i = i[i < bg.t.size]
+    rows = np.arange(bg.t.size)
+
+    def clean(x):
+        return [float(v) if math.isfinite(v) else None for v in x]
+
+    return {"t": clean(bg.t[i]), "snr_integration": clean(bg.rho[rows, bg.dominant][i]),
+            "sigma_f_relative": clean((bg.sigma_f / bg.freq[rows, bg.dominant])[i]),
+            "sigma_power_relative": clean(bg.sigma_lnp[i]), "sigma_polarization_rad": clean(bg.sigma_pol[i]),
+            "zone": [str(z) for z in bg.zone[i]]}
 
 
 def observe_times(t_end: float, n: int = 800) -> np.ndarray:
@@ -104,17 +103,40 @@ def observe_times(t_end: float, n: int = 800) -> np.ndarray:
     return compare_times(t_end, n)
 
 
-def observe(trajs, title: str, res: Resolution = Resolution(), line_of_sight=None, distance_cm: float = 1.0,
-            omega0=None) -> Observation:
-    """Detect both runs (same times) and find when they part; ``omega0`` (the scene's start)
-    gives T and Theta."""
+def observe(trajs, title: str, line_of_sight=None, receiver=None, omega0=None, rtol: float = 1e-10,
+            receive: bool = True) -> Observation:
+    """Detect both runs (same times), put them through ``receiver`` (an
+    ``inputs.receiver.ReceiverSpec``; CGS bodies, unless ``receive`` is False) and find when they
+    part; ``omega0`` (the scene's start) gives T, Theta and, for a top with d along its axis or a
+    sphere, the closed forms the parting curves use."""
+    from ..inputs.receiver import ReceiverSpec
+    from ..physics import longitudinal as LG
     from .detector import default_line_of_sight, detect
 
     if len(trajs) != 2:
         raise ValueError("observe needs a scene with two models (models = [\"reduced\", \"truncated\"])")
+    receiver = ReceiverSpec() if receiver is None else receiver
     n = default_line_of_sight(trajs[0]) if line_of_sight is None else line_of_sight
-    dets = [detect(tr, n, distance_cm) for tr in trajs]
+    dets = [detect(tr, n, receiver.distance_cm) for tr in trajs]
     body = trajs[0].body
+    scales, printed = _scales(body, omega0)
+    law = LG.has_line_law(body.delta, body.chi, body.is_symmetric)
+    start = (LG.start_state(omega0, body.dipole_direction, body.epsilon)
+             if law and omega0 is not None and {t.model for t in trajs} == set(LG.MODELS) else None)
+    by_model = {d.model: d for d in dets}
+    a, b = (by_model["reduced"], by_model["truncated"]) if start is not None else dets
+    obs = Observation(title=title, units=body.units, detections=dets,
+                      parting=PT.curves(a, b, start, body.tau0, rtol), scales=scales, printed=printed,
+                      horizon=float(trajs[0].t[-1]))
+    if body.units == "cgs" and receive:
+        _receive(obs, receiver, body, start)
+    elif body.units != "cgs":
+        obs.notes.append("a dimensionless body: no receiver (it needs distances, powers and noise in physical units)")
+    return obs
+
+
+def _scales(body, omega0) -> tuple[dict, dict]:
+    """T, Theta and 1/(tau0 Omega0^2) of the start, and the paper's printed T and Theta."""
     scales, printed = {}, {}
     if omega0 is not None:
         w = np.asarray(omega0, dtype=float)
@@ -127,9 +149,37 @@ def observe(trajs, title: str, res: Resolution = Resolution(), line_of_sight=Non
     for p in body.printed:
         if p.key in ("T", "Theta"):
             printed[p.key] = {"value_s": p.value, "where": p.where, "approx": p.approx}
-    return Observation(title=title, units=body.units, detections=dets, resolution=res,
-                       parting=parting_times(dets[0], dets[1], res), scales=scales, printed=printed,
-                       horizon=float(trajs[0].t[-1]))
+    return scales, printed
+
+
+def _receive(obs: Observation, receiver, body, start) -> None:
+    """The receiver's budgets, its parting times and the P-f tests, into ``obs``."""
+    from . import pftest as PF
+    from .receiver import budget
+
+    obs.receiver = receiver
+    obs.budgets = [budget(d, receiver) for d in obs.detections]
+    by = {bg.model: bg for bg in obs.budgets}
+    rows = {m: np.arange(bg.t.size) for m, bg in by.items()}
+    sig = {"frequency": [bg.sigma_f / bg.freq[rows[m], bg.dominant] for m, bg in by.items()],
+           "power": [bg.sigma_lnp for bg in by.values()], "polarization": [bg.sigma_pol for bg in by.values()]}
+    t = obs.budgets[0].t
+    for key, c in obs.parting.items():
+        worse = np.fmax(*sig[key]) if len(sig[key]) == 2 else sig[key][0]
+        worse = np.where(np.isnan(sig[key][0]) | np.isnan(sig[key][1]), np.nan, worse)
+        PT.setup_parting(c, t, worse, receiver.integration_s)
+    obs.pf_law, obs.pf_reason = PF.line_law(body)
+    if obs.pf_law is None:
+        return
+    rng = np.random.default_rng(SEED)
+    f_inf = math.sqrt(start[1]) / (2.0 * math.pi) if start is not None else None
+    for bg in obs.budgets:
+        series = PF.synthetic(bg, rng)
+        obs.pf_series[bg.model] = series
+        obs.pf[bg.model] = PF.fit(series, f_inf_expected=f_inf) if series is not None else None
+        if series is None:
+            obs.notes.append(f"{bg.model}: fewer than four instants with the line detected in the radiation zone: "
+                             f"no P-f series")
 
 
 def _when(t: float | None, obs: Observation) -> str:
@@ -140,28 +190,36 @@ def _when(t: float | None, obs: Observation) -> str:
     return out + (f"  ({', '.join(extra)})" if extra else "")
 
 
+def _res_text(key: str, r: float) -> str:
+    return f"{math.degrees(r):.3g}°" if key == "polarization" else f"{r:.3g}"
+
+
 def format_table(obs: Observation) -> str:
-    """The answer for people: the detector, what it sees at the start and the end, and when the
-    models part."""
+    """The answer for people: the detector and receiver, what they see at the start and the end,
+    when the models part across resolutions and for this receiver, and the P-f tests."""
     a, b = obs.detections
     cgs = obs.units == "cgs"
     n = ", ".join(f"{x:.3g}" for x in a.line_of_sight)
-    lines = [obs.title, "", f"detector along n = ({n}) (world frame)" + (f", field at {a.distance_cm:g} cm" if cgs else "")]
-    for note in a.notes:
+    lines = [obs.title, "", f"detector along n = ({n}) (world frame)"]
+    if obs.receiver is not None:
+        lines.append(f"receiver: {obs.receiver.describe()}")
+    for note in a.notes + obs.notes:
         lines.append(f"note: {note}")
     lines.append(f"{_horizon_text(obs)} (the scene's [observe] horizon, else its own)")
     lines.append("")
-    head = f"{'':<34} {a.model:>22} {b.model:>22}"
+    head = f"{'':<40} {a.model:>22} {b.model:>22}"
+    budgets = {bg.model: bg for bg in obs.budgets} if obs.budgets else {}
     for label, i in (("at the start", 0), (f"at the end, t = {U.format_time(obs.horizon, obs.units)}", -1)):
         lines += [label, head]
         cells = [_cells(d, i, cgs) for d in obs.detections]
+        if budgets:
+            for c, d in zip(cells, obs.detections):
+                c.update(_budget_cells(budgets[d.model], _first(budgets[d.model]) if i == 0 else -1))
         for name in cells[0]:
-            lines.append(f"  {name:<32} {cells[0][name]:>22} {cells[1][name]:>22}")
+            lines.append(f"  {name:<38} {cells[0][name]:>22} {cells[1][name]:>22}")
         lines.append("")
-    lines.append("when do the models part?")
-    for key in OBSERVABLES:
-        lines.append(f"  {obs.resolution.label(key):<44} {_when(obs.parting[key], obs)}")
-    lines.append("")
+    lines += _parting_lines(obs)
+    lines += _pf_lines(obs)
     for k, v in obs.scales.items():
         printed = obs.printed.get(k)
         text = f"  {k:<18} = {U.format_time(v, obs.units)}"
@@ -171,18 +229,77 @@ def format_table(obs: Observation) -> str:
     return "\n".join(lines)
 
 
+def _parting_lines(obs: Observation) -> list[str]:
+    out = ["when do the models part? (the same, known start; first time the difference reaches the resolution)"]
+    for key in OBSERVABLES:
+        c = obs.parting[key]
+        cells = [f"{_res_text(key, r)}: {_short_when(c.at(r), obs)}" for r in PT.TABLE[key]]
+        out.append(f"  {key:<13} " + "; ".join(cells))
+        if obs.receiver is not None:
+            if c.setup_time is not None:
+                out.append(f"  {'':<13} this receiver (5σ in one {obs.receiver.integration_s:g} s integration, "
+                           f"{_res_text(key, c.setup_resolution)}): {_when(c.setup_time, obs)}")
+            else:
+                out.append(f"  {'':<13} this receiver: not within the run")
+    out.append(f"  (power and frequency from {obs.parting['frequency'].source})")
+    out.append("")
+    return out
+
+
+def _short_when(t, obs) -> str:
+    return "never" if t is None else U.format_time(t, obs.units)
+
+
+def _pf_lines(obs: Observation) -> list[str]:
+    if obs.receiver is None:
+        return []
+    out = ["the start-free test: each model's line as this receiver measures it, fitted to the P-f laws"]
+    if obs.pf_law is None:
+        return out + [f"  none: {obs.pf_reason}", ""]
+    out.append(f"  line: {obs.pf_law}")
+    for m, r in obs.pf.items():
+        if r is None:
+            out.append(f"  {m}: no series (the line is not detected in the radiation zone at four instants)")
+            continue
+        out.append(f"  {m}'s run:")
+        out += [f"    {line}" for line in r.summary()]
+    out.append("")
+    return out
+
+
 def _cells(d: Detection, i: int, cgs: bool) -> dict[str, str]:
     """One column of ``format_table``: the detection's observables at sample i, as text."""
     freq = (lambda f: U.format_frequency(f)) if cgs else (lambda f: f"{f:.4g} {d.freq_unit}")
     pol = round(math.degrees(d.pol_angle[i]), 1) + 0.0                      # never "-0.0"
     out = {"radiated power": _num(d.power[i], d.power_unit, cgs, "power"),
            "power toward the detector": _num(d.power_sr[i], d.power_sr_unit, cgs, "sr"),
-           "RMS field": _num(d.field_rms[i], d.field_unit, cgs, "field"),
            "dominant frequency": freq(d.f_dom[i]), "rotation |L|/(2 pi I1)": freq(d.f_rot[i]),
            "polarization angle (from u1)": f"{pol:.1f}° ({100 * d.linear[i]:.0f} % lin.)"}
     if cgs:
         out["photons per second per sr"] = f"{d.photons_sr[i]:.3g}"
+    else:
+        out["RMS field"] = _num(d.field_rms[i], d.field_unit, cgs, "field")
     return out
+
+
+def _budget_cells(bg, i: int) -> dict[str, str]:
+    """The receiver's view of the strongest line at sample i, as text."""
+    r = bg.record(i)
+
+    def g(x, fmt="{:.3g}", none="-"):
+        return none if x is None else fmt.format(x)
+
+    lam = r["wavelength_cm"]
+    return {"wavelength, zone at the antenna": f"{g(lam)} cm, {r['zone']}",
+            "field at the antenna, all terms (1/R)": f"{r['field_full_rms_v_per_m'] * 1e6:.3g} "
+                                                     f"({r['field_radiation_term_rms_v_per_m'] * 1e6:.3g}) µV/m",
+            "received power": g(r["received_w"], "{:.3g} W", "(near zone)"),
+            "SNR of one integration": g(r["snr_integration"], "{:.3g}", "(near zone)"),
+            "coherent interval (SNR, threshold)": f"{g(r['coherent_interval_s'], '{:.3g} s')} "
+                                                  f"({g(r['snr_coherent'])}, {g(r['threshold'])})",
+            "resolution: frequency (relative)": g(r["sigma_f_relative"], "{:.2g}", "not detected"),
+            "resolution: power (relative)": g(r["sigma_power_relative"], "{:.2g}", "not detected"),
+            "resolution: polarization angle": g(r["sigma_polarization_deg"], "{:.2g}°", "not detected")}
 
 
 def _num(x, unit, cgs, kind) -> str:
@@ -204,17 +321,22 @@ def _style(model: str):
     return {"color": model_color(model), "ls": ls, "lw": lw, "label": model}
 
 
-def _scale_marks(ax, obs: Observation, scale: float, t) -> None:
-    """Dotted verticals at T and Theta (one label when they coincide)."""
+def _scale_marks(ax, obs: Observation, scale: float, t, axis: str = "x") -> None:
+    """Dotted lines at T and Theta (one label when they coincide), across the time axis."""
     marks = {}
     for k, v in obs.scales.items():
         if k in ("T", "Theta") and t[0] <= v / scale <= t[-1]:
             marks.setdefault(round(math.log10(v), 3), []).append({"T": "T", "Theta": "Θ"}[k])
     for lv, names in marks.items():
         x = 10.0**lv / scale
-        ax.axvline(x, color="0.7", lw=0.8, ls=":")
-        ax.annotate(" = ".join(names), (x, 0.02), xycoords=("data", "axes fraction"), xytext=(2, 2),
-                    textcoords="offset points", fontsize=8, color="0.4")
+        if axis == "x":
+            ax.axvline(x, color="0.7", lw=0.8, ls=":")
+            ax.annotate(" = ".join(names), (x, 0.02), xycoords=("data", "axes fraction"), xytext=(2, 2),
+                        textcoords="offset points", fontsize=8, color="0.4")
+        else:
+            ax.axhline(x, color="0.7", lw=0.8, ls=":")
+            ax.annotate(" = ".join(names), (0.98, x), xycoords=("axes fraction", "data"), xytext=(0, 2),
+                        textcoords="offset points", fontsize=8, color="0.4", ha="right")
 
 
 def _horizon_text(obs: Observation) -> str:
@@ -223,53 +345,85 @@ def _horizon_text(obs: Observation) -> str:
 
 def _observable_panel(ax, obs: Observation, key: str, series, t, scale: float) -> None:
     """One observable of both models (``series``, one array per detection, at times ``t`` in
-    the plot's unit), with the time the models part in it, or that they never do."""
+    the plot's unit), with the time this receiver tells them apart in it."""
     for d, y in zip(obs.detections, series):
         ax.plot(t, y, **_style(d.model))
-    tp = obs.parting[key]
-    word = obs.resolution.label(key).split(" in ")[0]
-    if tp is not None and tp > 0:
+    tp = obs.parting[key].setup_time
+    if tp is not None and t[0] <= tp / scale:
         ax.axvline(tp / scale, color="tab:red", lw=1.0, ls="--")
-        ax.annotate(f"{word} apart\nat {U.format_time(tp, obs.units)}", (tp / scale, 0.96),
+        ax.annotate(f"apart for this receiver\nat {U.format_time(tp, obs.units)}", (tp / scale, 0.96),
                     xycoords=("data", "axes fraction"), xytext=(4, 0), textcoords="offset points", fontsize=8,
                     color="tab:red", va="top")
-    elif tp is None:
-        ax.annotate(f"never {word} apart within the run", (0.98, 0.96), xycoords="axes fraction", fontsize=8,
-                    color="0.35", va="top", ha="right")
+    elif tp is not None:
+        ax.annotate(f"apart for this receiver at {U.format_time(tp, obs.units)}\n(before the first plotted instant)",
+                    (0.02, 0.22), xycoords="axes fraction", fontsize=8, color="tab:red", va="bottom")
+    elif obs.receiver is not None:
+        ax.annotate("never apart for this receiver within the run", (0.98, 0.96), xycoords="axes fraction",
+                    fontsize=8, color="0.35", va="top", ha="right")
 
 
-def _difference_panel(ax, obs: Observation, t, pos) -> None:
-    """Each observable's difference between the models in units of its resolution: the models
-    part where a curve crosses 1."""
-    diff = differences(*obs.detections)
-    res = obs.resolution
-    with np.errstate(divide="ignore", invalid="ignore"):
-        norm = {"power": np.log(diff["power"]) / math.log(res.power_factor), "frequency": diff["frequency"] / res.frequency,
-                "polarization": diff["polarization"] / res.polarization_deg}
-    for key, col in zip(OBSERVABLES, ("tab:orange", "tab:blue", "tab:green")):
-        y = np.clip(np.nan_to_num(norm[key][pos], nan=np.nan, posinf=1e6), 1e-8, 1e6)
-        flat = not np.any(y > 1e-6)                        # below the axis: say so in the legend
-        ax.plot(t, y, color=col, lw=1.6, label=res.label(key) + (" (below 1e-6 throughout)" if flat else ""))
-    ax.axhline(1.0, color="tab:red", lw=1.0, ls="--")
-    ax.annotate("resolved: the models part", (0.01, 1.0), xycoords=("axes fraction", "data"), xytext=(2, 3),
-                textcoords="offset points", fontsize=8, color="tab:red")
+def _parting_panel(ax, obs: Observation, key: str, scale: float, tl: str) -> None:
+    """Parting time against resolution (log-log), with this receiver's 5 sigma over time and the
+    point where they meet."""
+    c = obs.parting[key]
+    conv = (lambda r: np.degrees(r)) if key == "polarization" else (lambda r: r)   # noqa: E731
+    ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_ylim(1e-6, 1e4)
-    ax.set_ylabel("difference / resolution")
-    ax.set_title("reduced vs truncated, in units of the resolution")
+    if c.resolutions.size == 0:
+        ax.annotate("the models never differ in this observable" + (" beyond the runs' accuracy" if c.floor > 0
+                                                                    else ""), (0.6, 0.3), xycoords="axes fraction",
+                    ha="center", fontsize=9, color="0.35")
+    else:
+        ok = np.isfinite(c.times)
+        ax.plot(conv(c.resolutions[ok]), c.times[ok] / scale, color="black", lw=2.0,
+                label="the models part (same known start)")
+    if c.sigma is not None:
+        pos = (c.t > 0) & np.isfinite(c.sigma)
+        if np.any(pos):
+            ax.plot(conv(PT.DECISION_SIGMA * c.sigma[pos]), c.t[pos] / scale, color="tab:blue", lw=1.3, ls="--",
+                    label=f"this receiver: 5σ of one {obs.receiver.integration_s:g} s integration")
+        if c.setup_time is not None:
+            x, y = conv(c.setup_resolution), c.setup_time / scale
+            ax.plot([x], [y], "o", color="tab:red", ms=7, zorder=5)
+            ax.annotate(f"  {U.format_time(c.setup_time, obs.units)}", (x, y), fontsize=8, color="tab:red",
+                        va="center")
+    first = [float(np.nanmin(x.times)) for x in obs.parting.values() if np.any(np.isfinite(x.times))]
+    t_lo = 0.5 * max(obs.receiver.integration_s / 100.0 if obs.receiver is not None else obs.horizon * 1e-8,
+                     min(first, default=0.0)) / scale
+    ax.set_ylim(t_lo, 2.0 * obs.horizon / scale)
+    _few_log_ticks(ax)
+    ax.set_xlabel(PT.LABELS[key] + ", log scale")
+    ax.set_ylabel(tl + ", log scale")
+    ax.set_title(f"{key}: when do they part, across resolutions?")
+    ax.grid(True, which="major", color="0.9", lw=0.6)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=8, loc="upper left")
+
+
+def _few_log_ticks(ax) -> None:
+    """At most ~8 labelled decades on a log axis (a parting curve spans 20): fast to lay out,
+    legible; an axis under two decades gets 1, 2, 5 in each."""
+    from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullLocator
+
+    for axis, lim in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+        narrow = lim[0] > 0 and lim[1] / lim[0] < 100.0
+        axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0) if narrow else (1.0,), numticks=8 if not narrow else 12))
+        axis.set_major_formatter(LogFormatterSciNotation(labelOnlyBase=not narrow))
+        axis.set_minor_locator(NullLocator())
 
 
 def plot(obs: Observation, path: str) -> None:
-    """Four panels against log time: power toward the detector, dominant frequency, polarization
-    angle (both models in their video colours), and each difference in units of its resolution
-    (the models part where a curve crosses 1); parting times marked (PNG, atomic)."""
+    """Two rows against log time and resolution: power toward the detector, dominant frequency
+    and polarization angle of both models (their video colours), each with the time this
+    receiver tells them apart; below each, the parting time against the resolution, with the
+    receiver's 5 sigma over time and the point where they meet (PNG, atomic)."""
     plt = pyplot()
     a = obs.detections[0]
     scale, tl = time_unit(obs.horizon, obs.units)
     pos = a.t > 0
     t = a.t[pos] / scale
     cgs = obs.units == "cgs"
-    fig, axes = plt.subplots(2, 2, figsize=(14, 8.6))
+    fig, axes = plt.subplots(2, 3, figsize=(18, 9.4))
     fs = 1e9 if cgs else 1.0
     f_all = np.concatenate([d.f_dom[pos] for d in obs.detections])
     f_log = float(np.max(f_all)) > 5.0 * max(float(np.min(f_all)), 1e-300)
@@ -279,23 +433,25 @@ def plot(obs: Observation, path: str) -> None:
                f"({a.freq_unit})", "log" if f_log else "linear", "strongest spectral line"),
               ("polarization", lambda d: np.degrees(d.pol_angle), "polarization angle from u1 (°)", "linear",
                "linear polarization"))
-    for ax, (key, fn, ylabel, yscale, title) in zip(axes.flat, panels):
+    for ax, (key, fn, ylabel, yscale, title) in zip(axes[0], panels):
         _observable_panel(ax, obs, key, [fn(d)[pos] for d in obs.detections], t, scale)
         ax.set_yscale(yscale)
         ax.set_title(title)
         ax.set_ylabel(ylabel)
-    axes[1, 0].set_ylim(-95, 95)
-    axes[1, 0].set_yticks([-90, -45, 0, 45, 90])
-    _difference_panel(axes[1, 1], obs, t, pos)
-    for ax in axes.flat:
         ax.set_xscale("log")
         ax.set_xlabel(tl + ", log scale")
         ax.grid(True, which="major", color="0.9", lw=0.6)
         ax.legend(fontsize=8, loc="lower left")
         _scale_marks(ax, obs, scale, t)
+    axes[0, 2].set_ylim(-95, 95)
+    axes[0, 2].set_yticks([-90, -45, 0, 45, 90])
+    for ax, key in zip(axes[1], OBSERVABLES):
+        _parting_panel(ax, obs, key, scale, tl)
+        _scale_marks(ax, obs, scale, t, axis="y")
     n = ", ".join(f"{x:.2g}" for x in a.line_of_sight)
+    rx = f"\nreceiver: {obs.receiver.describe()}" if obs.receiver is not None else ""
     note = " — line frequencies and powers from the slow variables (spin phase not resolved)" if a.notes else ""
-    fig.suptitle(f"{obs.title}\nwhat a detector along n = ({n}) sees, {_horizon_text(obs)}{note}", fontsize=11)
+    fig.suptitle(f"{obs.title}\nwhat a detector along n = ({n}) sees, {_horizon_text(obs)}{note}{rx}", fontsize=11)
     fig.tight_layout()
     save(fig, path)
 
@@ -348,7 +504,7 @@ def plot_detector(obs: Observation, path: str, epochs: int = 4) -> None:
             ax.axvline(math.log10(tp / scale), color="0.6", lw=0.6, ls=":")
         _waveforms(fig.add_subplot(grid[2, col]), obs, d, picks)
     _field_strength(fig.add_subplot(grid[1, :]), obs, pos, scale, tl)
-    dist = f", field at {a.distance_cm:g} cm" if cgs else ""
+    dist = f", antenna at {a.distance_cm:g} cm" if cgs else ""
     n = ", ".join(f"{v:.2g}" for v in a.line_of_sight)
     fig.suptitle(f"{obs.title}\ndetector along n = ({n}){dist}, {_horizon_text(obs)}: the spectral lines of the free "
                  f"precession at each instant" + ("\nfrom the slow variables; waveform phases reconstructed (the spin "
@@ -424,11 +580,14 @@ def _field_strength(ax, obs: Observation, pos, scale: float, tl: str) -> None:
     t = a.t[pos] / scale
     for d in obs.detections:
         ax.plot(t, d.field_rms[pos] * (1e6 if cgs else 1.0), **_style(d.model))
+    for bg in obs.budgets or ():
+        ax.plot(t, bg.field_full_rms[pos] * 1e6, color=model_color(bg.model), lw=0.9, ls=":",
+                label=f"{bg.model}: all terms (1/R, 1/R², 1/R³)")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(tl + ", log scale")
     ax.set_ylabel(f"RMS field at {a.distance_cm:g} cm (µV/m)" if cgs else f"RMS field ({a.field_unit})")
-    ax.set_title("the detected signal's strength over the run (its time series, averaged over each turn)")
+    ax.set_title("the detected signal's strength over the run (radiation term; dotted: the whole field at the antenna)")
     ax.grid(True, which="major", color="0.9", lw=0.6)
     ax.legend(fontsize=8, loc="lower left")
     _scale_marks(ax, obs, scale, t)
@@ -446,17 +605,14 @@ def _log_ticks(ax, x) -> None:
 MIN_LINE = 1e-6
 
 
-def scene_resolution(sc, power_factor=None, frequency=None, polarization_deg=None) -> Resolution:
-    """The scene's ``[observe]`` resolutions, each overridden when given."""
-    o = sc.observe
-    return Resolution(power_factor=o.power_factor if power_factor is None else float(power_factor),
-                      frequency=o.frequency_resolution if frequency is None else float(frequency),
-                      polarization_deg=o.polarization_deg if polarization_deg is None else float(polarization_deg))
-
-
-def run_scene(sc, samples: int = 800, line_of_sight=None, distance_cm=None, resolution: Resolution | None = None):
+def run_scene(sc, samples: int = 800, line_of_sight=None, distance_cm=None, receive: bool = True,
+              integration_s=None):
     """Simulate both models of scene ``sc`` over its ``[observe]`` horizon (or its own) at
-    ``observe_times`` and observe them: (Observation, trajectories)."""
+    ``observe_times`` and observe them with its receiver (its distance and integration time
+    overridden by ``distance_cm``, ``integration_s``; none with ``receive`` False):
+    (Observation, trajectories)."""
+    from dataclasses import replace
+
     from ..driver import simulate_request
 
     if len(sc.models) != 2:
@@ -467,6 +623,10 @@ def run_scene(sc, samples: int = 800, line_of_sight=None, distance_cm=None, reso
     times = observe_times(horizon, samples)
     trajs = [simulate_request(sc.request(m, t_eval=times)) for m in sc.models]
     los = line_of_sight if line_of_sight is not None else sc.observe.line_of_sight
-    dist = sc.observe.distance_cm if distance_cm is None else float(distance_cm)
-    obs = observe(trajs, sc.title, resolution or scene_resolution(sc), los, dist, omega0=sc.omega0)
+    receiver = sc.observe.receiver
+    if distance_cm is not None:
+        receiver = replace(receiver, distance_cm=float(distance_cm))
+    if integration_s is not None:
+        receiver = replace(receiver, integration_s=float(integration_s))
+    obs = observe(trajs, sc.title, los, receiver, omega0=sc.omega0, rtol=sc.rtol, receive=receive)
     return obs, trajs

@@ -334,7 +334,7 @@ def listen_scene(sc, out_wav: str, out_png: str | None, duration: float = 20.0, 
     atomic as a group (these write in place)."""
     from .observe import run_scene
 
-    obs, _ = run_scene(sc, samples, line_of_sight, distance_cm)
+    obs, _ = run_scene(sc, samples, line_of_sight, distance_cm, receive=False)     # the sound needs no receiver
     # the log map's knee: a tenth of the braking time 1/(tau0 |Omega0|^2), where the motion starts to
     # change, unless t_end/1000 comes first (a geological horizon must not spend its first second on nothing)
     w0 = np.asarray(sc.omega0, dtype=float)

@@ -26,8 +26,8 @@ from .. import interrupt
 from ..errors import RenderError, SceneError, SimulationError, SpecError, SpinvizError, UsageError
 from .shared import EXIT_FAIL, EXIT_USAGE, Parser, Stream, WriteFailed, named, options_of, say
 
-COMMANDS = ("check", "info", "simulate", "render", "compare", "observe", "listen", "bench", "stress", "report",
-            "methods", "atlas")
+COMMANDS = ("check", "info", "simulate", "render", "compare", "observe", "decide", "listen", "bench", "stress",
+            "report", "methods", "atlas")
 
 
 def command(name: str):

@@ -6,8 +6,9 @@ from __future__ import annotations
 import os
 
 from ..errors import SimulationError, UsageError
-from .observe import MAX_SAMPLES, add_detector_options, detector_overrides
-from .shared import EXIT_OK, cannot_write, need_matplotlib, out, p, positive, real
+from .shared import EXIT_OK, add_detector_options, cannot_write, detector_overrides, need_matplotlib, out, p, positive, real
+
+MAX_SAMPLES = 100_000
 
 
 def add_parser(sub) -> None:

@@ -1,5 +1,6 @@
 """``spinviz render SCENE [--out PATH] [--size WxH] [--fps N] [--duration S] [--workers N]``:
-off-screen video (MP4 or GIF by the extension) with a PNG poster; ``--bench``: frames per
+off-screen video (MP4 or GIF by the extension) with a PNG poster, or an animated glTF model
+(.glb, .gltf) or a self-contained page where the crystal can be turned (.html); ``--bench``: frames per
 second.  A value refused by the schema is named by its option when given here, else by the
 scene's ``[render]`` key."""
 
@@ -13,9 +14,11 @@ SCENE_TABLE = "render"          # where a refused value came from when no option
 
 def add_parser(sub) -> None:
     """Add ``spinviz render`` (the video (or --bench)) and its options to ``sub``."""
-    r = sub.add_parser("render", help="render a scene off-screen to MP4 or GIF, with a PNG poster")
+    r = sub.add_parser("render", help="render a scene off-screen to MP4 or GIF, with a PNG poster; or write it as an "
+                                      "animated glTF model (.glb, .gltf) or a page where the crystal can be turned (.html)")
     r.add_argument("scene")
-    r.add_argument("--out", help="output .mp4 or .gif (default renders/<scene>.mp4)")
+    r.add_argument("--out", help="output .mp4 or .gif, .glb or .gltf (3-D model), .html (self-contained page) "
+                                 "(default renders/<scene>.mp4)")
     r.add_argument("--size", type=size, help="WIDTHxHEIGHT in pixels, e.g. 1280x720")
     r.add_argument("--fps", type=whole, help="frames per second (1..240)")
     r.add_argument("--duration", type=real, help="video length in seconds")
@@ -47,6 +50,11 @@ def run(args) -> int:
         raise                                           # says what it is about (an output, the scene, an option)
     except ValueError as e:
         raise UsageError(f"{args.scene}: {e}") from None
+    if hasattr(res, "describe"):                        # a glTF model or a page
+        out(res.describe())
+        for note in res.notes:
+            out(note)
+        return EXIT_OK
     out(f"{p(res.path)}: {res.frames} frames {res.size[0]}x{res.size[1]}, "
         f"rendered in {res.seconds:.1f} s ({res.fps:.1f} fps, {res.workers} workers)")
     if res.poster:

@@ -98,6 +98,32 @@ def size(text: str):
     return (w, h)
 
 
+# --- the detector's options (observe, decide, listen) ----------------------------------------
+def add_detector_options(parser, keys=("line_of_sight", "distance_cm"), hidden: tuple = ()) -> None:
+    """The detector's options of a scene command, each overriding the scene's ``[observe]`` key
+    of the same name (``detector_overrides`` checks them with that table's schema)."""
+    helps = {"line_of_sight": ("--los", vector, "X,Y,Z", "line of sight X,Y,Z in the world frame (default: the "
+                                                          "scene's [observe], else across L(0))"),
+             "distance_cm": ("--distance-cm", real, None, "the antenna's distance (default: the scene's [observe], "
+                                                          "else 10)"),
+             "integration_s": ("--integration-s", real, None, "the length of one estimate (default: the scene's "
+                                                              "[observe], else 1)")}
+    for key in keys:
+        flag, kind, metavar, text = helps[key]
+        parser.add_argument(flag, dest=key, type=kind, metavar=metavar,
+                            help=argparse.SUPPRESS if key in hidden else text)
+
+
+def detector_overrides(args, keys=("line_of_sight", "distance_cm")) -> dict:
+    """The detector options given, checked by the scene's ``[observe]`` table's own schema (so an
+    option and the key it overrides take the same values; a ``SpecError`` names the option)."""
+    from ..inputs.scene import ObserveTable
+
+    given = {k: getattr(args, k) for k in keys if getattr(args, k, None) is not None}
+    ObserveTable(**given)
+    return given
+
+
 # --- reports ------------------------------------------------------------------------------
 def say(prefix: str, message) -> None:
     """One line on stderr, control characters escaped and cut: nothing from a file or a key

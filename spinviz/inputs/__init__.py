@@ -35,8 +35,8 @@ To add a key: one annotated field in the request class of its table (type, range
 reason, default, a line in the class docstring).  The TOML key, the keyword argument, the
 error messages and -- for an atlas spec -- the spec's identity follow from it
 (``inputs.atlas`` says how ``[run]`` keys reach ``regimes.runs.Settings``).  A command-line
-option for it is one ``add_argument`` in ``spinviz.cli`` and one entry in that command's map
-of options to argument names.
+option for it is one ``add_argument`` in its ``spinviz.commands`` module, whose ``dest`` is the
+argument's name (the command line names a refused value by the option, read from the parser).
 
 Importing this package loads nothing; its modules load pydantic when a scene, a spec or a
 call is first validated (~65 ms once per process with the schema's classes, measured on this

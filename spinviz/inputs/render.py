@@ -29,6 +29,9 @@ SHOW_ITEMS = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud", 
 DEFAULT_SHOW = ("body", "dipole", "axes", "trail", "sphere", "hud")
 ORIENTATION_ITEMS = ("body", "dipole", "omega", "L", "trail")
 VIDEO_FORMATS = (".mp4", ".gif")
+MODEL_FORMATS = (".glb", ".gltf", ".html")      # the animated glTF model, and the page that shows it
+MODEL_ITEMS = ("body", "dipole", "omega", "L")   # what a model or page is made of: at least one must be shown
+MAX_PAGE_FRAMES = 20_000        # a page carries the captions of every frame (~0.2 kB each)
 
 MIN_SIZE, MAX_SIZE = 16, 7680
 MAX_FPS = 240
@@ -172,10 +175,15 @@ class RenderSpec:
 
     def check_output(self, path: str, panels: int = 1) -> None:
         """The output format and the layout: .mp4 or .gif; MP4 (H.264, yuv420p) needs even
-        sides; the width must split evenly into ``panels`` side-by-side panels."""
+        sides; the width must split evenly into ``panels`` side-by-side panels.  A model or
+        page (.glb, .gltf, .html) needs a body or an arrow among ``show``."""
         ext = os.path.splitext(os.fspath(path))[1].lower()
+        if ext in MODEL_FORMATS:
+            self._check_model(ext)
+            return
         if ext not in VIDEO_FORMATS:
-            raise SpecError("out", f"unknown video format {brief(ext) if ext else '(none)'}; use .mp4 or .gif")
+            raise SpecError("out", f"unknown output format {brief(ext) if ext else '(none)'}; "
+                                   f"use .mp4 or .gif (video), .glb or .gltf (animated 3-D model) or .html (web page)")
         w, h = self.size
         if ext == ".mp4" and (w % 2 or h % 2):
             raise SpecError("size", f"MP4 (H.264, yuv420p) needs an even width and height, got {w}x{h}")
@@ -184,6 +192,14 @@ class RenderSpec:
         if ext == ".gif" and 3 * self.frames * w * h > MAX_GIF_BYTES:
             raise SpecError("duration", f"a GIF of {self.frames} frames at {w}x{h} needs {3 * self.frames * w * h / 1e9:.1f} GB "
                                         f"of memory (limit {MAX_GIF_BYTES / 1e9:g} GB); make it shorter or smaller, or use .mp4")
+
+    def _check_model(self, ext: str) -> None:
+        if not any(item in self.show for item in MODEL_ITEMS):
+            raise SpecError("show", f"a {ext} shows the body and its arrows; this scene shows none of "
+                                    f"{', '.join(MODEL_ITEMS)} (show = {list(self.show)})")
+        if ext == ".html" and self.frames > MAX_PAGE_FRAMES:
+            raise SpecError("duration", f"{self.duration:g} s at {self.fps} fps is {self.frames} frames; a page holds "
+                                        f"the captions of every frame, at most {MAX_PAGE_FRAMES}")
 
 
 # --- the arguments of render, render_frame, Renderer and plan -------------------------------------

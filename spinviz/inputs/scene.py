@@ -22,7 +22,8 @@ from .. import units as U
 from ..errors import SpecError, brief
 from ..physics import bodies as B
 from ..physics import presets as P
-from .base import Line, Positive, Real, Text, between, check_vector, one_line, request, wrong_type
+from . import receiver as RX
+from .base import Line, Positive, Real, Text, between, check_vector, one_line, refused, request, wrong_type
 from .render import MAX_TITLE
 from .simulation import MODELS, Atol, Method, Quaternion, Rtol, Samples, Vector3
 from .toml import Table
@@ -33,7 +34,6 @@ LENGTH_NM = (0.1, 1e9, "from an atom to a metre")
 DENSITY = (1e-3, 1e3, "g/cm^3")
 DIPOLE_DEBYE = (1e-6, 1e30, "D")
 ASPECT = (1e-3, 1e3, "L/D")
-DISTANCE_CM = (1e-4, 1e30, "from a micron to a megaparsec")
 
 Length = Annotated[Real, between(*LENGTH_NM)]
 Density = Annotated[Real, between(*DENSITY)]
@@ -285,29 +285,43 @@ class SimulationTable:
 # --- [observe] -----------------------------------------------------------------------------
 @request
 class ObserveTable:
-    """``[observe]``: how a detector watches the scene (``spinviz observe``, ``listen``) -- the
-    same keys are the command's options (``--distance-cm`` ...)."""
+    """``[observe]``: how a detector watches the scene (``spinviz observe``, ``decide``, ``listen``)
+    -- the horizon, the line of sight, and the receiver (``inputs.receiver.ReceiverSpec``'s keys,
+    with its defaults); the same keys are the commands' options (``--distance-cm`` ...).  The
+    resolutions are computed from the receiver, so the fixed thresholds power_factor,
+    frequency_resolution and polarization_deg are refused with the reason."""
 
     t_end: Positive | None = None
     t_end_T: Positive | None = None
     t_end_Theta: Positive | None = None
     line_of_sight: Vector3 | None = None
-    distance_cm: Annotated[Real, between(*DISTANCE_CM)] = 1.0
-    power_factor: Annotated[Real, between(1.0001, 1e6, "a ratio above 1")] = 2.0
-    frequency_resolution: Annotated[Real, between(1e-12, 0.5, "a relative difference")] = 0.01
-    polarization_deg: Annotated[Real, between(0.01, 89.0, "degrees")] = 5.0
+    distance_cm: RX.Distance = RX.DEFAULT_DISTANCE_CM
+    bandwidth_hz: RX.Bandwidth = RX.DEFAULT_BANDWIDTH_HZ
+    integration_s: RX.Integration = RX.DEFAULT_INTEGRATION_S
+    noise_temperature_k: RX.NoiseTemperature | None = None
+    noise_density_w_per_hz: RX.NoiseDensity | None = None
+    antenna_gain_dbi: RX.GainDbi | None = None
+    antenna_area_cm2: RX.AreaCm2 | None = None
+    power_factor: refused(RX.RESOLUTION_COMPUTED) = None
+    frequency_resolution: refused(RX.RESOLUTION_COMPUTED) = None
+    polarization_deg: refused(RX.RESOLUTION_COMPUTED) = None
 
     @model_validator(mode="after")
     def _check(self):
         one_of(self, *HORIZON_KEYS)
         if self.line_of_sight is not None and not math.hypot(*self.line_of_sight) > 0.0:
             raise SpecError("line_of_sight", "must not be zero")
+        self.receiver()                                      # one of each noise and antenna key
         return self
 
     @property
     def horizon_key(self) -> str | None:
         """The key the detector's horizon was given by, or None (the scene's horizon)."""
         return one_of(self, *HORIZON_KEYS)
+
+    def receiver(self) -> RX.ReceiverSpec:
+        """The table's receiver (its detector keys, defaults where absent)."""
+        return RX.ReceiverSpec(**{k: getattr(self, k) for k in RX.DETECTOR_KEYS})
 
 
 # --- the file ------------------------------------------------------------------------------

@@ -40,6 +40,7 @@ import numpy as np
 from ..errors import SceneError, SpecError, SpecTypeError, brief, printable
 from ..physics import bodies as B
 from . import scene as IS
+from .receiver import ReceiverSpec
 from .render import MAX_TITLE, RenderSpec
 from .simulation import SimulationRequest
 from .toml import document, read_document, read_toml
@@ -53,16 +54,13 @@ class ObserveSpec:
 
     t_end : how long it watches, in the scene's time unit (None: the scene's horizon);
     line_of_sight : world-frame direction to the detector (None: across L(0));
-    distance_cm : where the field is given; power_factor, frequency_resolution,
-    polarization_deg : the resolutions at which the two models count as told apart.
+    receiver : the detector's distance, band, integration, noise and antenna
+    (``inputs.receiver.ReceiverSpec``), from which the resolutions are computed.
     """
 
     t_end: float | None = None
     line_of_sight: tuple[float, float, float] | None = None
-    distance_cm: float = 1.0
-    power_factor: float = 2.0
-    frequency_resolution: float = 0.01
-    polarization_deg: float = 5.0
+    receiver: ReceiverSpec = field(default_factory=ReceiverSpec)
 
 
 def _readonly(a) -> np.ndarray:
@@ -228,7 +226,7 @@ def _render(spec: RenderSpec, own_title: bool, title: str, path: str, t_end: flo
 
 def _observe(ot, path: str, body: B.Body, omega0, requests: list) -> ObserveSpec:
     """[observe] (``ot``, validated; None when absent): the detector's horizon (checked like
-    the scene's: it is simulated), line of sight, distance and resolutions."""
+    the scene's: it is simulated), line of sight and receiver."""
     if ot is None:
         return ObserveSpec()
     t_end = None
@@ -240,9 +238,7 @@ def _observe(ot, path: str, body: B.Body, omega0, requests: list) -> ObserveSpec
             _checked(path, {**keys, "step": "[simulation].step", "method": "[simulation].method"},
                      **{f: getattr(r, f) for f in ("body", "model", "omega0", "q0", "method", "rtol", "atol", "step")},
                      t_end=t_end, samples=2)
-    return ObserveSpec(t_end=t_end, line_of_sight=ot.line_of_sight, distance_cm=ot.distance_cm,
-                       power_factor=ot.power_factor, frequency_resolution=ot.frequency_resolution,
-                       polarization_deg=ot.polarization_deg)
+    return ObserveSpec(t_end=t_end, line_of_sight=ot.line_of_sight, receiver=ot.receiver())
 
 
 def load_scene(path) -> Scene:

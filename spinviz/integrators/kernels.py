@@ -1,5 +1,5 @@
-"""Compiled kernels (numba): the splitting integrators and the shared DOP853 pieces of the
-secular slow flow.
+"""Compiled kernels (numba): the splitting integrators and the shared Dormand-Prince 8(5,3)
+pieces (``tableaus.DP853``) of the secular slow flow.
 
 They stay compiled where ``spinviz bench`` shows they win: the splitting (``split2`` ..
 ``split8``) takes steps set by the braking, not the spin, where the torque commutes with the
@@ -154,7 +154,7 @@ def second_guess(f0, f1, n, sc, h0, d1, h_max):
 
 @_jit
 def error_norm(K, y, y_new, h, n, rtol, atol, E3, E5, by_increment=-1):
-    """DOP853's scaled error of the step (5th- and 3rd-order embedded estimates, SciPy's norm),
+    """The Dormand-Prince 8(5,3) pair's scaled error of the step (5th- and 3rd-order embedded estimates, SciPy's norm),
     and whether y_new is finite.  Component ``by_increment`` (if >= 0), a phase that grows to
     2 pi x the turns, is held to rtol x its increment rather than rtol x its size."""
     e5 = 0.0
@@ -208,7 +208,7 @@ def dense_eval(F, y, x, n, out):
         out[k] = y[k] + v
 
 
-DOP853_ARRAYS = (T.DOP853_A, T.DOP853_B, T.DOP853_E3, T.DOP853_E5, T.DOP853_D)   # the system is autonomous: no c
+DP853_ARRAYS = (T.DP853_A, T.DP853_B, T.DP853_E3, T.DP853_E5, T.DP853_D)   # the system is autonomous: no c
 
 
 # --- splitting: exact torque-free flow of a symmetric top + radiation torque ------------
@@ -243,7 +243,7 @@ def free_flow(st, q, tau, J, with_q, ec):
 @_jit
 def radiation_flow(model, st, tau, J, g, A, b, rh_max, ec):
     """Omega under the radiation torque alone over time tau (q does not move), by the 8th-order
-    DOP853 formula in substeps of at most rh_max in units of the local decay time.
+    Dormand-Prince formula (``tableaus.DP853``) in substeps of at most rh_max in units of the local decay time.
 
     The increment dOmega is accumulated on its own (it is small) and then turned into
     increments of rho, phi and Omega3 without cancellation, each added with compensation."""

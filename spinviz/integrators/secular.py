@@ -150,7 +150,7 @@ def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, st
     problem : Problem
         In spin units (|omega(0)| = 1); omega0 body frame, q0 (w, x, y, z).
     rtol, atol : float
-        Tolerances of the slow flow's DOP853 steps.
+        Tolerances of the slow flow's Dormand-Prince 8(5,3) steps.
     step : float, optional
         Ignored (the method is adaptive); accepted for the common interface.
 
@@ -178,8 +178,8 @@ def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, st
     J = tuple(float(x) for x in s.inertia)
     g = tuple(float(x) for x in s.coupling)
     out, cnt, switches, recorded, status = call_stoppable(
-        SF.hybrid_dop853, ST.MODEL_ID[s.model], J, g, setup.w0, t, float(rtol), float(atol), MU_STAR, setup.equivariant,
-        MAX_STEPS, _phi0(setup), *KN.DOP853_ARRAYS)
+        SF.integrate_hybrid, ST.MODEL_ID[s.model], J, g, setup.w0, t, float(rtol), float(atol), MU_STAR, setup.equivariant,
+        MAX_STEPS, _phi0(setup), *KN.DP853_ARRAYS)
     stats = _stats(setup, cnt, switches, rtol, t)
     if status != ST.OK:
         if status == ST.TOO_MANY_STEPS and cnt[8] >= REGIME5_SIGN_CHANGES:

@@ -4,7 +4,8 @@ is fast, with the spin about the fixed L_world integrated as a phase.
 
 The body-frame equation does not involve the orientation.  Its only fast motion is the
 precession of omega_perp about e3 at the rate delta w3; its slow motion is the braking, at
-the rate eps |w|^2 (spin units, eps = tau0 |Omega0|).  Two modes, one DOP853 loop:
+the rate eps |w|^2 (spin units, eps = tau0 |Omega0|).  Two modes, one loop of
+Dormand-Prince 8(5,3) steps (``tableaus.DP853``):
 
 * FULL: y = (w1, w2, w3, Sigma), the equation itself -- cheap wherever the precession is
   slow, exact wherever it stops (the domain "?" of (4.20), where w3 changes sign again and
@@ -268,7 +269,7 @@ def phase_nodes(M):
 
 
 @_jit
-def hybrid_dop853(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_steps, phi0, A, B, E3, E5, D, stop):
+def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_steps, phi0, A, B, E3, E5, D, stop):
     """Integrate from the body-frame w0 (spin units) over t_eval.
 
     Returns (out (N, 6): w1, w2, w3, phi, p, mode at each output; counters (16,); switches

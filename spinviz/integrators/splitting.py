@@ -12,7 +12,7 @@ tops), a step longer than a turn samples that component at a few phases and the 
 stops converging: the step must again resolve the spin.  ``spinviz bench`` measures both.
 
 The radiation sub-flow uses the torque alone (no cancellation against the free part) and
-the 8th-order DOP853 formula in substeps of at most 1/50 of the local decay time.
+the 8th-order Dormand-Prince formula (``tableaus.DP853``) in substeps of at most 1/50 of the local decay time.
 """
 
 from __future__ import annotations
@@ -66,7 +66,7 @@ def _solver(order: int):
 
         model, J, g, w0, q0, t, with_q = _args(problem)
         w, q, nfev, nsteps, status = call_stoppable(KN.split_symmetric, model, J, g, w0, q0, t, float(step), gammas, with_q,
-                                                        int(max_steps), RH_MAX, T.DOP853.A, T.DOP853.b)
+                                                        int(max_steps), RH_MAX, T.DP853.A, T.DP853.b)
         return _solution(problem, w, q, status, {"nfev": int(nfev), "nsteps": int(nsteps), "stages": len(gammas)})
 
     return solve

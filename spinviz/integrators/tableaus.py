@@ -1,7 +1,8 @@
-"""Butcher tableaux as data (methods are data, not hand-written loops; STYLE.md).
+"""Butcher tableaux as data: a method is its coefficients, not a hand-written loop.
 
-DOP853: the Dormand-Prince 8(5,3) pair with its 7th-order dense output, coefficients
-from E. Hairer's DOP853 Fortran code (Hairer, Norsett & Wanner, "Solving Ordinary
+The Dormand-Prince 8(5,3) pair with its 7th-order dense output (``DP853``; SciPy calls its own
+implementation DOP853, which spinviz offers as the method ``dop853``): coefficients from E.
+Hairer's DOP853 Fortran code (Hairer, Norsett & Wanner, "Solving Ordinary
 Differential Equations I", 2nd ed., 1993), as transcribed in SciPy's
 ``scipy/integrate/_ivp/dop853_coefficients.py`` (BSD-3-Clause).  Copied here rather than
 imported because that SciPy module is private.
@@ -33,7 +34,7 @@ RK4 = Tableau(
     order=4,
 )
 
-# --- DOP853 ------------------------------------------------------------------------------
+# --- Dormand-Prince 8(5,3) ------------------------------------------------------------------------------
 N_STAGES = 12
 N_STAGES_EXTENDED = 16
 INTERPOLATOR_POWER = 7
@@ -226,12 +227,12 @@ D[3, 13] = 0.96324553959188282948394950600e+2
 D[3, 14] = -0.39177261675615439165231486172e+2
 D[3, 15] = -0.14972683625798562581422125276e+3
 
-DOP853_A = A
-DOP853_B = B
-DOP853_E3 = E3
-DOP853_E5 = E5
-DOP853_D = D
-DOP853 = Tableau(name="dop853", c=C[:N_STAGES].copy(), A=A[:N_STAGES, :N_STAGES].copy(), b=B.copy(), order=8)
+DP853_A = A
+DP853_B = B
+DP853_E3 = E3
+DP853_E5 = E5
+DP853_D = D
+DP853 = Tableau(name="dormand-prince-8(5,3)", c=C[:N_STAGES].copy(), A=A[:N_STAGES, :N_STAGES].copy(), b=B.copy(), order=8)
 del A, B, C, E3, E5, D
 
 

@@ -34,13 +34,8 @@ and a resolving method would otherwise follow it turn by turn for ever.
 
 from __future__ import annotations
 
-import contextlib
 import copy
-import hashlib
 import math
-import os
-import pickle
-import tempfile
 import threading
 from dataclasses import dataclass
 
@@ -48,6 +43,7 @@ import numpy as np
 
 from ..interrupt import call_stoppable
 from ..physics import equations as E
+from . import cache
 from . import status as ST
 from .base import Integrator, Problem, Solution, register
 
@@ -181,7 +177,7 @@ def template(model: str, kinematics: str, tol: float, precision: str = "double",
 
     Start-up: heyoka caches machine code on disk itself, but still rebuilds the expression
     decomposition at every construction (~45 ms for the 7-variable reduced system); the built
-    integrator is therefore also kept pickled in ``cache_dir()`` (loads in ~6 ms), keyed by the
+    integrator is therefore also kept pickled (``cache``: loads in ~6 ms), keyed by the
     system's own expressions, the tolerance, heyoka's version and the CPU's features (the
     pickle holds code compiled for this CPU)."""
     key = (model, kinematics, float(tol), precision, int(batch), symmetric, residual, runaway)
@@ -192,8 +188,9 @@ def template(model: str, kinematics: str, tol: float, precision: str = "double",
             sys_ = equations(model, kinematics, symmetric)
             fp = PRECISIONS[precision]
             evs = events(model, bool(batch), fp, symmetric, residual, runaway)
-            digest = _digest(sys_, evs, tol, precision, batch)
-            ta = _load_pickled(digest)
+            digest = cache.digest(hy.__version__, repr(float(tol)), precision, str(batch), str(sys_),
+                                  *(str(e) for e in evs))
+            ta = cache.load(digest)
             if ta is None:
                 n = len(sys_)
                 npar = n_pars(symmetric, residual, runaway)
@@ -204,64 +201,9 @@ def template(model: str, kinematics: str, tol: float, precision: str = "double",
                     ta = hy.taylor_adaptive_batch(sys_, np.zeros((n, batch)), pars=np.zeros((npar, batch)), **kw)
                 else:
                     ta = hy.taylor_adaptive(sys_, np.zeros(n, dtype=fp), pars=np.zeros(npar, dtype=fp), **kw)
-                _store_pickled(digest, ta)
+                cache.store(digest, ta)
             _templates[key] = ta
     return ta
-
-
-def cache_dir() -> str:
-    """Where built integrators are kept: $SPINVIZ_CACHE_DIR, else $XDG_CACHE_HOME/spinviz or
-    ~/.cache/spinviz (a sub-folder ``taylor``)."""
-    base = os.environ.get("SPINVIZ_CACHE_DIR") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "spinviz")
-    return os.path.join(base, "taylor")
-
-
-def _cpu_features() -> str:
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("flags"):
-                    return line
-    except OSError:
-        pass
-    import platform
-
-    return platform.machine() + platform.processor()
-
-
-def _digest(sys_, evs, tol, precision, batch) -> str:
-    hy = _hy()
-    text = "\n".join([hy.__version__, _cpu_features(), repr(float(tol)), precision, str(batch), str(sys_),
-                       *(str(e) for e in evs)])
-    return hashlib.sha256(text.encode()).hexdigest()
-
-
-def _load_pickled(digest: str):
-    path = os.path.join(cache_dir(), digest + ".pickle")
-    try:
-        with open(path, "rb") as f:
-            return pickle.load(f)
-    except FileNotFoundError:
-        return None
-    except Exception:                            # damaged or from an incompatible heyoka: rebuild
-        with contextlib.suppress(OSError):
-            os.remove(path)
-        return None
-
-
-def _store_pickled(digest: str, ta) -> None:
-    """Written atomically (temporary file, then rename); a cache that cannot be written is skipped."""
-    folder = cache_dir()
-    try:
-        os.makedirs(folder, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=folder, prefix=".", suffix=".partial")
-        with os.fdopen(fd, "wb") as f:
-            pickle.dump(ta, f, protocol=pickle.HIGHEST_PROTOCOL)
-        os.replace(tmp, os.path.join(folder, digest + ".pickle"))
-    except OSError:
-        with contextlib.suppress(OSError, UnboundLocalError):
-            os.remove(tmp)
 
 
 def tolerance(rtol: float, atol: float, precision: str = "double") -> tuple[float, bool]:

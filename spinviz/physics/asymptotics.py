@@ -18,7 +18,7 @@ Misprints handled here (each reported beside the printed value, never silently):
 
 * (4.18) prints A^2 = 1/(2 - xi), negative for xi > 2.  Averaging (4.12) with omega3 -> 0
   gives d omega_perp/d tau = -(n3^2 + n1^2/2) omega_perp^3, hence A^2 = 1/(2 n3^2 + n1^2) =
-  (1 + xi)/(2 + xi) (DESIGN.md, section 2); ``type4_eq4_18`` returns both.
+  (1 + xi)/(2 + xi); ``type4_eq4_18`` returns both.
 * (4.43) prints xi > 2(1 - delta)/(7 delta - 6), delta > 4/7.  (4.42)'s B = -sqrt((1 - A^2)/2)
   is real only where A^2 <= 1, i.e. xi (7 delta - 4) >= 2 (1 - delta): the printed "delta > 4/7"
   belongs to 7 delta - 4, and for 4/7 < delta < 6/7 the printed bound (negative) would admit

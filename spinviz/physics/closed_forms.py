@@ -124,7 +124,7 @@ def omega_eq6_2(t, tau0: float, omega20: float, omega30: float):
 def euler_eq6_5(t, tau0: float, omega20: float, omega30: float):
     """(6.5): phi = Omega20 vartheta(t), theta = pi/2, psi = Omega3 t -- the Poisson
     equations (6.4) solved with (6.1), start phi = psi = 0, theta = pi/2.  Exact only as
-    eps = I3/I1 -> 0 (DESIGN.md, section 2)."""
+    eps = I3/I1 -> 0: at finite eps the motion departs from it by an amount that vanishes with eps."""
     t = _t(t)
     return np.stack([omega20 * vartheta_eq6_3(t, tau0, omega20), np.full_like(t, 0.5 * np.pi), omega30 * t], axis=-1)
 
@@ -200,6 +200,6 @@ def spiral4_amplitude_sq_eq4_18(chi: float) -> float:
     right.  With omega3 -> 0 faster than omega_perp, (4.12) reduces to d omega_perp / d tau =
     -(n3^2 + n1^2/2) omega_perp^3, so omega_perp^2 tau -> 1/(2 n3^2 + n1^2) = 1/(1 + n3^2)
     = (1 + xi)/(2 + xi) -- 1/(2 - n1^2): the printed xi was probably meant for n1^2.
-    (DESIGN.md, section 2; checked against the averaged and the full equations in the tests.)"""
+    (Checked against the averaged and the full equations in the tests.)"""
     xi = math.tan(chi) ** 2
     return (1.0 + xi) / (2.0 + xi)

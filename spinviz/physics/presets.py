@@ -1,7 +1,7 @@
 """The section-6 presets: the cellulose nanocrystal and the DAST crystals, with provenance.
 
 Each preset states where its numbers come from and keeps the figures the paper prints, so
-``spinviz info`` can show both (DESIGN.md, section 2).  CGS throughout.
+``spinviz info`` can show both (docs/design.md, "Verified against the paper").  CGS throughout.
 """
 
 from __future__ import annotations

@@ -326,7 +326,8 @@ def _run_level(lv: Level, cluster: _LazyCluster, runs_per_task, flush_s, retry_f
                notices: list, totals: dict):
     """Compute what level ``lv`` lacks (its wanted cells): the store created or verified and
     resumed, the batches planned, executed and written.  Returns the execution's stats or None."""
-    from .cluster import Progress, execute
+    from ..progress import Progress
+    from .cluster import execute
 
     spec, out = lv.spec, lv.out
     exists = os.path.exists(os.path.join(out, ".zgroup")) if lv.wanted is not None else os.path.exists(out)

@@ -35,7 +35,6 @@ import math
 import os
 import queue
 import signal
-import sys
 import threading
 import time
 from dataclasses import dataclass, field
@@ -45,6 +44,7 @@ from distributed.diagnostics.plugin import WorkerPlugin
 from ..errors import printable
 from ..inputs.render import usable_cores
 from ..interrupt import SIGNALS, check
+from ..progress import Progress
 from .engine import runs as RN
 from .faults import OptionError
 
@@ -357,50 +357,6 @@ class _Monitor:
     def stop(self) -> None:
         self._stop.set()
         self._thread.join(0.2)                     # an RPC in progress fails when the client closes
-
-
-# --- progress ------------------------------------------------------------------------------
-class Progress:
-    """Runs done, runs per second and the time left, on stderr (a bar on a terminal, a line
-    every 10 % otherwise); silent when ``enabled`` is False."""
-
-    def __init__(self, total: int, label: str, enabled: bool = True, stream=None):
-        self.total, self.label, self.enabled = max(1, total), label, enabled
-        self.stream = stream or sys.stderr
-        self.tty = enabled and getattr(self.stream, "isatty", lambda: False)()
-        self.t0 = time.perf_counter()
-        self.last = 0.0
-        self.next_mark = 0.1
-        self.done = 0
-
-    def update(self, done: int) -> None:
-        """Count ``n`` more runs done and redraw the bar (at most a few times a second)."""
-        self.done = done
-        if not self.enabled:
-            return
-        now = time.perf_counter()
-        rate = done / (now - self.t0) if now > self.t0 else 0.0
-        left = (self.total - done) / rate if rate > 0 else math.inf
-        frac = done / self.total
-        eta = f"{left:5.0f} s left" if math.isfinite(left) else "  ?   s left"
-        if self.tty and (now - self.last > 0.2 or done >= self.total):
-            self.last = now
-            bar = "#" * int(30 * frac)
-            self.stream.write(f"\r{self.label} [{bar:<30}] {done}/{self.total} runs {rate:7.1f} runs/s {eta} ")
-            if done >= self.total:
-                self.stream.write("\n")
-            self.stream.flush()
-        elif not self.tty and (frac >= self.next_mark or done >= self.total):
-            self.stream.write(f"{self.label}: {done}/{self.total} runs ({100 * frac:.0f} %), {rate:.1f} runs/s, {eta}\n")
-            self.stream.flush()
-            while self.next_mark <= frac:
-                self.next_mark += 0.1
-
-    def finish(self) -> None:
-        """Draw the bar at its end and close its line."""
-        if self.enabled and self.tty and self.done < self.total:
-            self.stream.write("\n")
-            self.stream.flush()
 
 
 # --- execution -------------------------------------------------------------------------------

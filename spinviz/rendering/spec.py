@@ -18,6 +18,7 @@ from ..inputs.render import (  # noqa: F401  (re-exported)
     MAX_SIZE,
     MAX_TITLE,
     MIN_SIZE,
+    MODEL_FORMATS,
     ORIENTATION_ITEMS,
     SHOW_ITEMS,
     VIDEO_FORMATS,

@@ -16,13 +16,13 @@ parent integrates.
 from __future__ import annotations
 
 import os
-import sys
 import time
 from dataclasses import dataclass, field
 
 from .. import interrupt
 from ..atomic import Outputs
 from ..errors import RenderError, printable
+from ..progress import Progress
 from .encode import save_png
 from .fonts import Fonts
 from .picture import Picture, plan_picture
@@ -96,35 +96,6 @@ def render_frames(plan, frames, supersample: float | None = None):
     return [session.frame(f) for f in frames], session
 
 
-class _Progress:
-    def __init__(self, label: str, total: int, enabled: bool):
-        self.label, self.total, self.enabled = label, total, enabled
-        self.tty = enabled and sys.stderr.isatty()
-        self.t0 = time.perf_counter()
-        self.last = 0.0
-        self.next_mark = 0.25
-
-    def update(self, done: int):
-        """``done`` of the frames are drawn: a bar (terminal) or a line at each quarter (log)."""
-        if not self.enabled:
-            return
-        now = time.perf_counter()
-        frac = done / self.total
-        if self.tty and (now - self.last > 0.2 or done == self.total):
-            self.last = now
-            rate = done / (now - self.t0) if now > self.t0 else 0.0
-            eta = (self.total - done) / rate if rate > 0 else 0.0
-            bar = "#" * int(30 * frac)
-            sys.stderr.write(f"\r{self.label} [{bar:<30}] {done}/{self.total} frames {rate:5.1f} fps  {eta:4.0f} s left ")
-            if done == self.total:
-                sys.stderr.write("\n")
-            sys.stderr.flush()
-        elif not self.tty and frac >= self.next_mark:
-            sys.stderr.write(f"{self.label}: {int(100 * frac)} % ({done}/{self.total} frames)\n")
-            while self.next_mark <= frac:
-                self.next_mark += 0.25
-
-
 def plan_workers(spec, out: str, workers: int | None = None, frames: int | None = None) -> int:
     """How many processes ``render_video`` uses: one per core (at most 4) for an MP4 long
     enough to split (4 frames per worker at least); 1 (in-process) otherwise."""
@@ -183,7 +154,7 @@ def render_video(plan, out: str, workers: int | None = None, supersample: float 
     F = plan.frames if max_frames is None else min(plan.frames, max_frames)
     workers = plan_workers(plan.spec, out, pool.workers if pool is not None else workers, F)
     poster_f = min(int(round(plan.spec.poster * (plan.frames - 1))), F - 1)
-    bar = _Progress(f"rendering {printable(out, 80)}", F, progress)
+    bar = Progress(F, f"rendering {printable(out, 80)}", unit="frames", rate_unit="fps", enabled=progress, every=0.25)
     plan.spec.check_output(out, len(plan.panels))          # the format's rules live in the spec
     paths = [out, poster_for(out)] if poster else [out]
     start = time.perf_counter()

@@ -2,7 +2,7 @@
 
 Each check integrates the full system (Euler equation + q_dot = 1/2 q (x) (0, Omega))
 and compares with a closed form.  What "agreement" means depends on the formula
-(DESIGN.md, section 2):
+(docs/design.md, "Verified against the paper"):
 
 * exact solutions -- (3.9), (5.2), (5.4), (6.10): the error must be at the integrator's
   tolerance;
@@ -332,7 +332,7 @@ def check_secular(name: str, delta: float, chi: float, epsilons=SECULAR_EPS, hor
     )
 
 
-# --- balance of angular momentum and energy against the radiation (issue 19) -----------------
+# --- balance of angular momentum and energy against the radiation -----------------
 BALANCE_EPS = (1e-2, 1e-3, 1e-4)
 
 

@@ -1,4 +1,4 @@
-"""Adaptive refinement of the atlas where the types change (issue 18.2): a quadtree on the
+"""Adaptive refinement of the atlas where the types change: a quadtree on the
 (delta, chi) grid.
 
 Level 0 is the spec's grid of ``n_delta x n_chi`` equal cells over [delta_min, delta_max] x

@@ -15,7 +15,7 @@ import numpy as np
 from ...physics import asymptotics as FM
 from ...plotting import pyplot
 from .cells import compose_levels, spec_of
-from .style import COLORS, LINE_STYLE, ORDER, WORDS
+from .style import COLORS, DELTA_AXIS, LINE_STYLE, ORDER, WORDS
 
 
 def diagram(levels, path: str, title: str | None = None):
@@ -38,7 +38,7 @@ def diagram(levels, path: str, title: str | None = None):
         n = ds.sizes["member"]
         ax.set_xlim(-1, 1)
         ax.set_ylim(0, 90)
-        ax.set_xlabel("\u03b4 = 1 \u2212 I\u2083/I\u2081   (prolate \u2190 0 \u2192 oblate)")
+        ax.set_xlabel(DELTA_AXIS)
         ax.set_ylabel("\u03c7 = angle of the dipole from the symmetry axis (deg)")
         ax.set_title(f"{model} model: type of each of {n} starts per cell", fontsize=11)
     _legend(fig, seen, ncol=2 if one else 3)

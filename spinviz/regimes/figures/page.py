@@ -1,4 +1,4 @@
-"""The atlas as a self-contained web page (issue 18.6): the delta-chi diagram of each model in
+"""The atlas as a self-contained web page: the delta-chi diagram of each model in
 SVG, a cell's type shares and evidence on hover, its hodograph on click.
 
 No library and no network: the page is one file with inline SVG, CSS and a few lines of

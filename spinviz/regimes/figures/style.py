@@ -33,3 +33,6 @@ LINE_STYLE = {  # name prefix -> (colour, style, where to write its label: delta
     "alpha": ("#0b3d91", "-", -0.62), "beta = -3/4": ("#a3001b", "-", 0.3),
     "delta = 0": ("#0b3d91", "-", 0.0), "beta_T": ("#a3001b", "-", 0.75),
 }
+
+# delta = 1 - I3/I1 > 0 is a prolate top (I3 < I1: a rod), delta < 0 an oblate one (a plate)
+DELTA_AXIS = "\u03b4 = 1 \u2212 I\u2083/I\u2081   (oblate \u2190 0 \u2192 prolate)"

@@ -1,4 +1,4 @@
-"""Convergence evidence for the atlas's labels (issue 18.3): horizon, member count and tolerance.
+"""Convergence evidence for the atlas's labels: horizon, member count and tolerance.
 
     spinviz atlas --evidence convergence [--members 32] [--horizons 1e10,1e12,1e14] [--out STORE] [--json]
     spinviz atlas --evidence tolerance [--members 8]

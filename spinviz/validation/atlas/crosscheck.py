@@ -15,7 +15,7 @@ The points (|omega0| = 0.1, tau_end = 1e10, starts from the atlas's seeded direc
 * (-0.6, 77 deg): delta < -1/2, excluded by (4.17), yet type 3 with (4.16)'s amplitudes;
 * (0.5, 39 deg): type 4 (beta = -0.617 > -3/4) with A^2 = (1 + xi)/(2 + xi), not (4.18)'s 1/(2 - xi);
 * (0.5, 45 deg): in (4.19)'s domain "4", but beta = -0.833 < -3/4: the phase is captured into
-  type 5, omega_perp sqrt(tau) -> 0.882 (DESIGN.md's 0.81 is the pre-capture value at tau ~ 1e3-1e4);
+  type 5, omega_perp sqrt(tau) -> 0.882 (the paper's 0.81 is the value passed before the capture, at tau ~ 1e3-1e4);
 * (0.2, 70 deg): far outside (4.43) (delta < 4/7), type 5 all the same;
 * (0.8, 1.2): inside (4.43): type 5, against (4.42)'s A^2, B, M^2, and the sign of (4.45)'s K
   (fitted: omega2 sqrt(tau) = B + K cos 2 psi, cos psi = omega_angle / envelope).

@@ -1,4 +1,4 @@
-"""The atlas's dimensionless system against the full physical-unit equation (issue 18.4).
+"""The atlas's dimensionless system against the full physical-unit equation.
 
     spinviz atlas --evidence physical [--members 4] [--tau-end 1e10] [--json]
 

@@ -1,0 +1,288 @@
+"""Keyframes for a glTF animation: which of a video's frames a viewer needs so that its own
+interpolation redraws the video.
+
+Pure NumPy (a planning module: no drawing library).  A glTF viewer draws a rotation between
+two keyframes by slerp at a constant rate in the animation's clock (the sampler's LINEAR
+interpolation, as the glTF specification defines it and three.js does), lengths and offsets by
+linear interpolation.  The keyframes are a subset of the video's own frames
+(``FramePlan``): at a keyframe the file holds exactly the pose the video draws there, and the
+subset is chosen, greedily from the first frame, so that at every frame in between the
+viewer's interpolated pose -- body orientation, the direction of every moving arrow -- lies
+within ``tolerance`` (rad) of the pose the video draws at that frame, and every arrow's
+length within ``LENGTH_TOLERANCE``.  Consecutive keyframes are sign-aligned (q . q' >= 0) and
+less than ``MAX_STEP`` (50 deg) apart: a viewer that interpolates the four numbers component
+by component and normalizes (Blender's quaternion F-curves) then follows the same short arc
+as slerp, off slerp's timing by at most 0.16 deg (2 max_t |atan2(t sin a, 1 - t + t cos a) -
+t a| for a step of 2a = 50 deg); where two neighbouring video frames are further apart (an
+aliased spin), slerp midpoints are added -- poses on the path every viewer draws anyway,
+flagged as not drawn by the video.
+
+Quaternions here are scalar-first (w, x, y, z), body -> world for the body, and for an arrow
+the rotation taking +x along it; the glTF writer reorders them to (x, y, z, w).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import rotations as R
+from .stage import ARROW_VECTORS, arrow_length
+
+TOLERANCE_DEG = 0.25            # default: the viewer's pose within this angle of the video's at every frame
+LENGTH_TOLERANCE = 0.003        # arrow lengths, in units of the dipole arrow (1 = the glTF metre)
+MAX_STEP = math.radians(50.0)   # rotation between consecutive keyframes stays below this (rad): under a quarter turn,
+                                # and component-wise interpolation within 0.16 deg of slerp
+MOVING_ARROWS = ("L", "omega")  # turned in the world frame; the dipole arrow rides on the body
+
+
+@dataclass
+class PanelKeys:
+    """One model's animated values at the K keyframes.
+
+    q : (K, 4) body -> world, (w, x, y, z), sign-aligned; arrows : key ("L", "omega") ->
+    (q (K, 4) the rotation taking +x along the arrow, (K,) its drawn length, dipole-arrow units).
+    """
+
+    model: str
+    q: np.ndarray | None
+    arrows: dict = field(default_factory=dict)
+
+
+@dataclass
+class Keyframes:
+    """The animation of a frame plan.
+
+    frame : (K,) the video frame each keyframe shows, or -1 for a slerp midpoint added between
+    two frames more than ``MAX_STEP`` apart; video_t : (K,) video seconds (the animation's
+    clock); sim_t : (K,) simulation time, scene unit (a midpoint's by the time map); panels :
+    one ``PanelKeys`` per model; tolerance : the stated bound (rad); max_error : the largest
+    angle between the interpolated pose and the video's, over every frame (rad);
+    max_length_error : the same for the arrows' lengths (dipole-arrow units); max_step : the
+    largest rotation between consecutive keyframes (rad).
+    """
+
+    frame: np.ndarray
+    video_t: np.ndarray
+    sim_t: np.ndarray
+    panels: list
+    tolerance: float
+    max_error: float = 0.0
+    max_length_error: float = 0.0
+    max_step: float = 0.0
+
+    @property
+    def count(self) -> int:
+        """K, the number of keyframes."""
+        return int(self.frame.size)
+
+
+def arrow_track(v_world: np.ndarray, key: str) -> tuple[np.ndarray, np.ndarray]:
+    """(q (F, 4), length (F,)) of an arrow along ``v_world`` (F, 3) at every frame: q takes +x
+    along v, carried from frame to frame by the smallest rotation between consecutive
+    directions (so the arrow's roll about itself, which no one sees, stays continuous and
+    slerp between nearby frames sweeps the direction along the great circle); length as the
+    video draws it (``stage.arrow_length``).  A zero vector keeps the previous direction."""
+    v = np.asarray(v_world, dtype=float)
+    n = np.linalg.norm(v, axis=1)
+    lengths = np.array([arrow_length(key, float(x)) for x in n])
+    q = np.empty((v.shape[0], 4))
+    prev_u, prev_q = np.array([1.0, 0.0, 0.0]), np.array([1.0, 0.0, 0.0, 0.0])
+    for f in range(v.shape[0]):
+        if n[f] > 0.0:
+            u = v[f] / n[f]
+            prev_q = R.normalize(R.multiply(R.quat_between(prev_u, u), prev_q))
+            prev_u = u
+        q[f] = prev_q
+    return R.unflip(q), lengths
+
+
+def _tracks(plan) -> list[dict]:
+    """Per panel {"body": q (F, 4) sign-aligned or absent, arrow key: (q, length)}."""
+    out = []
+    for panel in plan.panels:
+        tr = {}
+        if panel.q is not None:
+            tr["body"] = R.unflip(panel.q)
+        for key in MOVING_ARROWS:
+            v = getattr(panel, ARROW_VECTORS[key])
+            if v is not None and key in plan.spec.show:
+                tr[key] = arrow_track(v, key)
+        out.append(tr)
+    return out
+
+
+def _slerp(qa, qb, tau):
+    """slerp from qa to qb (each (4,), sign-aligned) at fractions tau (n,) -> (n, 4)."""
+    rel = R.multiply(R.conjugate(qa), qb)
+    half = math.atan2(float(np.linalg.norm(rel[1:])), float(rel[0]))
+    v = rel[1:]
+    nv = float(np.linalg.norm(v))
+    axis = v / nv if nv > 0.0 else np.zeros(3)
+    return R.multiply(qa[None, :], R.exp_rotvec(2.0 * np.asarray(tau)[:, None] * half * axis[None, :]))
+
+
+def _span_errors(tracks, i: int, j: int, vt) -> tuple[float, float]:
+    """(largest angle, largest length error) at frames i+1 .. j-1 when the viewer
+    interpolates from frame i to frame j: body misorientation, arrow direction."""
+    if j - i < 2:
+        return 0.0, 0.0
+    tau = (vt[i + 1:j] - vt[i]) / (vt[j] - vt[i])
+    ang, dlen = 0.0, 0.0
+    for tr in tracks:
+        for key, val in tr.items():
+            q = val if key == "body" else val[0]
+            s = _slerp(q[i], q[j], tau)
+            if key == "body":
+                ang = max(ang, float(np.max(R.misorientation(s, q[i + 1:j]))))
+            else:
+                x = np.array([1.0, 0.0, 0.0])
+                ang = max(ang, float(np.max(R.angle_between(R.world_from_body(s, x), R.world_from_body(q[i + 1:j], x)))))
+                ln = val[1]
+                lin = ln[i] + tau * (ln[j] - ln[i])
+                dlen = max(dlen, float(np.max(np.abs(lin - ln[i + 1:j]))))
+    return ang, dlen
+
+
+def _step(tracks, i: int, j: int) -> float:
+    """The largest rotation (rad) of any animated quaternion from frame i to frame j."""
+    worst = 0.0
+    for tr in tracks:
+        for key, val in tr.items():
+            q = val if key == "body" else val[0]
+            worst = max(worst, float(R.misorientation(q[i], q[j])))
+    return worst
+
+
+def choose(plan, tolerance_deg: float = TOLERANCE_DEG) -> Keyframes:
+    """The keyframes of ``plan`` (a ``FramePlan`` that shows the orientation).
+
+    Greedy: from the last keyframe, the next is the furthest frame such that interpolating
+    to it keeps every frame in between within ``tolerance_deg`` (body and arrow directions)
+    and ``LENGTH_TOLERANCE`` (arrow lengths) of the video, and turns nothing by ``MAX_STEP``
+    or more.  The first and last frames are always keyframes.
+
+    Returns
+    -------
+    Keyframes
+        Frame indices, video and simulation times, per-panel values (sign-aligned) and the
+        measured largest errors over every frame of the plan.
+    """
+    tol = math.radians(tolerance_deg)
+    tracks = _tracks(plan)
+    vt = np.asarray(plan.video_t, dtype=float)
+    F = vt.size
+    keep = [0]
+    i = 0
+    while i < F - 1:
+        j = i + 1
+        while j + 1 < F:
+            if _step(tracks, i, j + 1) >= MAX_STEP:
+                break
+            ang, dlen = _span_errors(tracks, i, j + 1, vt)
+            if ang > tol or dlen > LENGTH_TOLERANCE:
+                break
+            j += 1
+        keep.append(j)
+        i = j
+    frames = np.array(keep)
+    return _assemble(plan, tracks, frames, tol)
+
+
+def _assemble(plan, tracks, frames, tol) -> Keyframes:
+    """The chosen frames' values, slerp midpoints where neighbours turn by ``MAX_STEP`` or
+    more, and the measured errors."""
+    vt, st = np.asarray(plan.video_t, dtype=float), np.asarray(plan.sim_t, dtype=float)
+    # split any step that is too large (neighbouring frames alone: an aliased spin) into equal parts
+    rows = []                       # (frame or -1, video time, {track: (i, j, tau)})
+    for a, b in zip(frames[:-1], frames[1:]):
+        parts = max(1, math.ceil(_step(tracks, a, b) / (0.9 * MAX_STEP))) if b - a == 1 else 1
+        rows.append((int(a), vt[a], (a, b, 0.0)))
+        for p in range(1, parts):
+            rows.append((-1, vt[a] + (vt[b] - vt[a]) * p / parts, (a, b, p / parts)))
+    rows.append((int(frames[-1]), vt[frames[-1]], (frames[-1], frames[-1], 0.0)))
+    frame = np.array([r[0] for r in rows])
+    video_t = np.array([r[1] for r in rows])
+    sim_t = np.array([st[f] if f >= 0 else _sim_at(plan, v) for f, v, _ in rows])
+    panels = []
+    for panel, tr in zip(plan.panels, tracks):
+        keys = PanelKeys(model=panel.model, q=None)
+        for key, val in tr.items():
+            q_all = val if key == "body" else val[0]
+            q = np.array([q_all[a] if tau == 0.0 else _slerp(q_all[a], q_all[b], [tau])[0] for _, _, (a, b, tau) in rows])
+            q = R.unflip(q)
+            if key == "body":
+                keys.q = q
+            else:
+                ln = val[1]
+                keys.arrows[key] = (q, np.array([ln[a] + tau * (ln[b] - ln[a]) for _, _, (a, b, tau) in rows]))
+        panels.append(keys)
+    kf = Keyframes(frame=frame, video_t=video_t, sim_t=sim_t, panels=panels, tolerance=tol)
+    kf.max_error, kf.max_length_error = measure(kf, plan)
+    kf.max_step = max((float(np.max(R.misorientation(q[:-1], q[1:]))) for q in _all_quats(kf) if len(q) > 1),
+                      default=0.0)
+    return kf
+
+
+def _sim_at(plan, v: float) -> float:
+    """Simulation time at video time ``v`` by the plan's time map."""
+    spec = plan.spec
+    s = v / spec.duration
+    t_end = plan.t_end
+    if spec.time_map == "linear":
+        return t_end * s
+    k = spec.knee(t_end)
+    return k * math.expm1(s * math.log1p(t_end / k))
+
+
+def _all_quats(kf: Keyframes):
+    for p in kf.panels:
+        if p.q is not None:
+            yield p.q
+        for q, _ in p.arrows.values():
+            yield q
+
+
+def interpolate(kf: Keyframes, video_t) -> list[dict]:
+    """What a glTF viewer draws at video times ``video_t`` (M,) from the keyframes: per panel
+    {"body": q (M, 4), arrow key: (q (M, 4), length (M,))} -- slerp of rotations and linear
+    lengths between the keyframes around each time (three.js's and the sample viewer's LINEAR)."""
+    t = np.atleast_1d(np.asarray(video_t, dtype=float))
+    kt = kf.video_t
+    i = np.clip(np.searchsorted(kt, t, side="right") - 1, 0, max(kt.size - 2, 0))
+    j = np.minimum(i + 1, kt.size - 1)
+    span = kt[j] - kt[i]
+    tau = np.clip(np.divide(t - kt[i], span, out=np.zeros_like(t), where=span > 0), 0.0, 1.0)
+
+    def slerp_rows(q):
+        return np.array([_slerp(q[a], q[b], [u])[0] for a, b, u in zip(i, j, tau)])
+
+    out = []
+    for p in kf.panels:
+        d = {}
+        if p.q is not None:
+            d["body"] = slerp_rows(p.q)
+        for key, (q, ln) in p.arrows.items():
+            d[key] = (slerp_rows(q), ln[i] + tau * (ln[j] - ln[i]))
+        out.append(d)
+    return out
+
+
+def measure(kf: Keyframes, plan) -> tuple[float, float]:
+    """(largest angle (rad), largest arrow-length error) between what a viewer interpolates
+    from ``kf`` and what ``plan`` draws, over every frame of the plan."""
+    shown = interpolate(kf, plan.video_t)
+    tracks = _tracks(plan)
+    ang, dlen = 0.0, 0.0
+    x = np.array([1.0, 0.0, 0.0])
+    for got, want in zip(shown, tracks):
+        for key, val in want.items():
+            if key == "body":
+                ang = max(ang, float(np.max(R.misorientation(got["body"], val))))
+            else:
+                q, ln = got[key]
+                ang = max(ang, float(np.max(R.angle_between(R.world_from_body(q, x), R.world_from_body(val[0], x)))))
+                dlen = max(dlen, float(np.max(np.abs(ln - val[1]))))
+    return ang, dlen

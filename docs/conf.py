@@ -6,7 +6,10 @@ The content pages are Markdown (MyST).  Pages whose numbers other commands regen
 (``docs/accuracy.md`` by ``spinviz report``, ``docs/atlas.md``) are pages of this site as
 they are, and the README's sections are *included*, never copied, so the site shows what
 the repository says today.  The API reference is generated from the docstrings by
-autosummary/autodoc.
+autosummary/autodoc.  The gallery (``examples/*.py``, by sphinx-gallery) and the tutorial
+(``docs/tutorial.md``, a MyST notebook, by myst-nb) are executed by every build, and the
+pages that show the README's pictures show the gallery's instead: what the site shows is
+what the code draws today.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from pathlib import Path
 DOCS = Path(__file__).resolve().parent
 ROOT = DOCS.parent
 sys.path.insert(0, str(ROOT))          # the checkout's spinviz, installed or not
+sys.path.insert(0, str(DOCS))          # gallery_hooks, named in sphinx_gallery_conf
 
 # Importing for autodoc must never need a display: pyvista is imported (not plotted) by
 # the rendering modules; keep it and VTK off-screen should anything ask for a window.
@@ -33,7 +37,11 @@ copyright = "spinviz developers (MIT licence)"
 version = release = spinviz.__version__
 
 extensions = [
-    "myst_parser",
+    # MyST Markdown pages, and notebooks written in MyST Markdown executed at build time
+    # (myst-nb includes myst-parser, so it replaces it in this list)
+    "myst_nb",
+    # the gallery: examples/*.py run at build time, their pictures scraped (below)
+    "sphinx_gallery.gen_gallery",
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
     # numpydoc sections (Parameters / Returns / Raises, with a line of dashes) become field
@@ -47,12 +55,18 @@ extensions = [
     "sphinx-mathjax-offline",
 ]
 
-source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+source_suffix = {".rst": "restructuredtext", ".md": "myst-nb"}      # MyST Markdown, notebooks or not
 root_doc = "index"
 exclude_patterns = [
     "_build",
     "Thumbs.db",
     ".DS_Store",
+    # sphinx-gallery writes each example beside its page as a script and a notebook to
+    # download; they are not pages of the site (myst-nb would otherwise read the notebooks)
+    "gallery/*.ipynb",
+    "gallery/*.py",
+    "gallery/*.zip",
+    "gallery/*.json",
 ]
 templates_path = ["_templates"]
 
@@ -64,6 +78,42 @@ suppress_warnings = [
     # replaces it), so its "###" subsections follow the "#" directly.
     "myst.header",
 ]
+
+# --- Executed pages: the gallery and the tutorial ------------------------------------------
+# Every picture these pages show is drawn while the site is built, by code shown on the page;
+# an exception in an example or a notebook cell fails the build.  Computations too long for a
+# build (the figure atlas, the accuracy report) are read from small committed results.
+
+# The gallery (sphinx-gallery, as pyvista builds its own): examples/*.py, each opening with a
+# docstring that becomes its page's text, run in examples/ and written to docs/gallery/.
+sphinx_gallery_conf = {
+    "examples_dirs": str(ROOT / "examples"),
+    "gallery_dirs": "gallery",
+    "filename_pattern": r"/plot_",                   # every example is run
+    "ignore_pattern": r"/data/",                     # the committed results and the script that made them
+    "within_subsection_order": "gallery_hooks.ExampleOrder",
+    # open matplotlib figures (e.g. imshow of spinviz.render_frame's RGB array), then the
+    # PNG and GIF files spinviz's own plot and render calls write (gallery_hooks)
+    "image_scrapers": ("matplotlib", "gallery_hooks.written_pictures"),
+    "reset_modules": ("matplotlib", "gallery_hooks.snapshot"),
+    "abort_on_example_error": True,                  # the first failing example stops the build
+    "remove_config_comments": True,
+    "capture_repr": ("__repr__",),                   # a block's last value is shown as print() would
+    "show_memory": False,
+    "show_signature": False,
+    "download_all_examples": False,                  # each page offers its own .py and .ipynb
+    "thumbnail_size": (400, 280),
+    "min_reported_time": 1,
+}
+
+# The tutorial (myst-nb, as heyoka.py executes its notebooks): MyST Markdown notebooks run by
+# a Jupyter kernel at build time; jupyter-cache keeps the outputs of an unchanged notebook, so
+# a rebuild reruns only what changed ("cache"; a clean build runs everything).
+nb_execution_mode = "cache"
+nb_execution_raise_on_error = True                   # a cell's exception fails the build
+nb_execution_timeout = 600                           # seconds per cell (the tutorial's atlas takes ~8 s)
+nb_execution_show_tb = True                          # a failure's traceback in the build log
+nb_merge_streams = True                              # a cell's stdout as one block, not one per print
 
 # --- API reference ------------------------------------------------------------------------
 autosummary_generate = True
@@ -153,6 +203,9 @@ def setup(app):
 html_theme = "pydata_sphinx_theme"
 html_title = f"spinviz {release}"
 html_static_path = ["_static"]
+# the web pages and models the gallery's examples write (gallery_hooks), served from the root
+(DOCS / "gallery" / "pages").mkdir(parents=True, exist_ok=True)
+html_extra_path = ["gallery/pages"]
 html_css_files = ["spinviz.css"]
 html_theme_options = {
     "navigation_with_keys": False,
@@ -165,7 +218,7 @@ html_theme_options = {
 }
 # The section navigation only where there is a section to navigate: the API reference.
 html_sidebars = {page: [] for page in
-                 ("index", "getting_started", "scenes", "gallery", "physics", "integrators", "accuracy", "atlas",
-                  "experiment")}
+                 ("index", "tutorial", "getting_started", "scenes", "gallery/**", "physics", "integrators", "accuracy",
+                  "atlas", "experiment", "design")}
 html_show_sourcelink = False
 html_copy_source = False

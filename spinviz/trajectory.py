@@ -226,7 +226,10 @@ class Trajectory:
         Between stored instants this is only as good as the storage: slerp needs neighbours
         less than half a turn apart (the renderer stores every frame for that reason), and
         for a run whose spin phase is unresolved (``phase_resolved`` False) only the nodes
-        and the slow geometry are meaningful.
+        and the slow geometry are meaningful: there Omega's slow parts -- |Omega_perp| and
+        Omega3 -- are interpolated linearly and the direction of Omega_perp along the shorter
+        arc, since Hermite steps with Omega_dot, which turns with the precession many times
+        between such nodes, would not be Omega at all.
         """
         from .inputs.trajectory import SampleRequest
 
@@ -238,6 +241,8 @@ class Trajectory:
         times = np.clip(times, lo, hi)
         if t.size == 1:
             omega = np.repeat(self.omega, times.size, axis=0)
+        elif not self.phase_resolved:
+            omega = _slow_omega(t, self.omega, times)
         else:
             i = np.clip(np.searchsorted(t, times, side="right") - 1, 0, t.size - 2)
             h = (t[i + 1] - t[i])[:, None]
@@ -456,3 +461,17 @@ def radiated_power(trajectories, times=None) -> dict[str, np.ndarray]:
     for tr in trajectories:
         out[tr.model] = (tr if times is None else tr.sample(times)).radiated_power()
     return out
+
+
+def _slow_omega(t, omega, times) -> np.ndarray:
+    """omega (body frame) at ``times`` from nodes (t, omega) whose precession phase is not
+    resolved: |omega_perp| and omega3 linear in t, the direction of omega_perp across e3 along
+    the shorter arc between the nodes' (the phase itself is not the run's)."""
+    wp = np.hypot(omega[:, 0], omega[:, 1])
+    ang = np.arctan2(omega[:, 1], omega[:, 0])
+    i = np.clip(np.searchsorted(t, times, side="right") - 1, 0, t.size - 2)
+    s = (times - t[i]) / (t[i + 1] - t[i])
+    turn = np.remainder(ang[i + 1] - ang[i] + np.pi, 2.0 * np.pi) - np.pi
+    a = ang[i] + s * turn
+    p = wp[i] + s * (wp[i + 1] - wp[i])
+    return np.stack([p * np.cos(a), p * np.sin(a), omega[i, 2] + s * (omega[i + 1, 2] - omega[i, 2])], axis=-1)

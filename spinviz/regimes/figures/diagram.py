@@ -44,7 +44,7 @@ def diagram(levels, path: str, title: str | None = None):
     _legend(fig, seen, ncol=2 if one else 3)
     s = spec_of(ds)
     w0 = s["members"]["omega"]
-    starts = f"|\u03c9\u2080| = {w0}" if w0 else "explicit starts"
+    starts = f"|\u03c9\u2080|\u00a0=\u00a0{w0}" if w0 else "explicit starts"     # one unbreakable phrase
     grid = f"{ds.sizes['delta']} \u00d7 {ds.sizes['chi']} cells"
     if len(levels) > 1:
         fine = levels[-1]

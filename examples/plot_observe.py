@@ -15,7 +15,7 @@ resolution.  The receiver, its bounds and their checks: the "Designing an experi
 # Both models of the scene over its ``[observe]`` horizon, received by its ``[observe]``
 # receiver along its line of sight.
 import spinviz
-from spinviz.analysis import observe
+from spinviz.analysis import observe, observe_plots
 from spinviz.analysis.experiment_plots import plot_receiver
 
 sc = spinviz.load_scene("../scenes/dast_cube.toml")
@@ -26,7 +26,7 @@ print(observe.format_table(obs))
 # What each model sends toward the antenna -- power, the strongest spectral line, the
 # polarization angle -- and below each the time the models part against the resolution,
 # with this receiver's 5σ marked.
-observe.plot(obs, "dast_cube_observe.png")
+observe_plots.plot(obs, "dast_cube_observe.png")
 
 # %%
 # The receiver's view: the SNR of the line over the run, the resolutions of one
@@ -37,4 +37,4 @@ plot_receiver(obs, "dast_cube_receiver.png")
 # %%
 # The detector's record: the spectrogram over the run, the signal strength, and the
 # waveform at four instants (its spin phase reconstructed, as the plot says).
-observe.plot_detector(obs, "dast_cube_detector.png")
+observe_plots.plot_detector(obs, "dast_cube_detector.png")

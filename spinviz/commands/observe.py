@@ -41,6 +41,7 @@ def add_parser(sub) -> None:
 def run(args) -> int:
     """Carry out ``spinviz observe`` with the parsed ``args``; return its exit status."""
     from ..analysis import observe as OB
+    from ..analysis import observe_plots as OP
     from ..atomic import Outputs
     from ..inputs.scene_spec import load_scene
 
@@ -60,8 +61,8 @@ def run(args) -> int:
         raise UsageError(f"{args.scene}: {e}") from None
     try:
         with group as tmps:
-            OB.plot(obs, tmps[0])
-            OB.plot_detector(obs, tmps[1])
+            OP.plot(obs, tmps[0])
+            OP.plot_detector(obs, tmps[1])
             if len(tmps) > 2:
                 from ..analysis.experiment_plots import plot_receiver
 

@@ -1,6 +1,8 @@
 """The atlas's adaptive refinement end to end: ``[refine] levels`` computes the
 children of exactly the cells ``refine.flags`` marks, keeps each level as a store of its own
-inside the atlas, resumes level by level, and ``--verify`` covers every level."""
+inside the atlas, resumes level by level, and ``--verify`` covers every level.  (The spec pins
+the brute-force engine: these are the store's mechanics, on a flagged pattern whose damaged
+chunk holds only computed runs; refinement on the limit labels: test_handover.py.)"""
 
 import os
 import shutil
@@ -24,6 +26,7 @@ count = 4
 seed = 3
 omega = 0.04
 [run]
+engine = "taylor"
 tau_end = 1e8
 rtol = 1e-8
 [refine]

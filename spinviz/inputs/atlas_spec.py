@@ -58,6 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SceneError, SpecTypeError
+from ..physics.averaged import averaging_holds
 from ..physics.bodies import MIN_INERTIA_RATIO
 from . import atlas as IA
 from .base import fields_of
@@ -74,6 +75,8 @@ class Settings:
     tau_end : horizon, tau = t/tau0.  tau_start : first sample after 0.  per_decade : samples
     a decade.  rtol : Taylor tolerance on the scaled omega sqrt(1 + tau/T) / |omega0|.
     max_steps : step budget of one run (of its SIMD batch).  window : decades the classifier analyses.
+    engine : "handover" (full integration until the averaged flow holds, then the averaged
+    flow: ``regimes.engine.handover``) or "taylor" (every run integrated to tau_end).
     """
 
     tau_end: float = 1e10
@@ -82,6 +85,7 @@ class Settings:
     rtol: float = 1e-8
     max_steps: int = 20_000_000
     window: float = 2.0
+    engine: str = "handover"
 
     def times(self) -> np.ndarray:
         """Output times [0, tau_start, ..., tau_end], ``per_decade`` log-spaced a decade."""
@@ -299,14 +303,29 @@ def directions(count: int, seed: int) -> np.ndarray:
 # --- can it finish? ------------------------------------------------------------------------------
 # What this process holds for an atlas, measured with tracemalloc around api.plan and the
 # store's predictions (64 x 64 cells x 32 members: 955 B a cell at the peak, 650 B a task),
-# with a margin; and what a run costs (docs/atlas.md, "Benchmark": 10.4 runs/s per worker on
-# the shipped atlas, tau_end = 1e10, both models).
+# with a margin; and what a run costs, one core, rtol 1e-8, classification included
+# (docs/atlas.md, "Benchmark" and "Horizons").
 BYTES_PER_CELL = 1200            # the paper's predictions at each (delta, chi), as Python lists, then float64
 BYTES_PER_TASK = 1000            # a batch (its chi tuple, omega0 view, region), its key and counters
 BYTES_PER_RUN = 16               # done mask, label codes and their copies
-CPU_S_PER_RUN = 0.096            # a run to tau_end = 1e10 at rtol 1e-8, one core
+CPU_S_PER_RUN = 0.010            # engine "taylor": a run to tau_end = 1e10, growing as sqrt(tau_end) (a spiral's steps)
+CPU_S_HANDED = 0.002             # engine "handover", a cell where the averaged flow holds: the same at any tau_end
+CPU_S_FULL = 0.005               # engine "handover", a cell integrated in full (5, 4|5, "?", TF), at 1e10: grows as tau_end^(1/4)
 MAX_DAYS = 30.0                  # an embedded atlas expected to take longer is refused: it would not finish here
 MEMORY_SHARE = 0.5               # of physical memory, for this process (the workers need the rest)
+
+
+def run_cost_s(settings: Settings, model: str, delta: float, chi: float) -> float:
+    """The estimated CPU seconds of one run of ``model`` at (delta, chi): "taylor" as
+    sqrt(tau_end); "handover" by whether the cell's runs hand over to the averaged flow
+    (``physics.averaged.averaging_holds``: then the full stage to the hand-over, ~tau = 1e6 ..
+    1e10, whatever tau_end) or stay in full (the libration's steps grow as tau^(1/4))."""
+    te = max(settings.tau_end, 1.0)
+    if settings.engine == "taylor":
+        return CPU_S_PER_RUN * math.sqrt(te / 1e10)
+    if averaging_holds(model, float(delta), float(chi))[0]:
+        return CPU_S_HANDED * min(1.0, math.sqrt(te / 1e8))
+    return CPU_S_FULL * (te / 1e10) ** 0.25
 
 
 @dataclass(frozen=True)
@@ -330,14 +349,18 @@ def physical_memory() -> float:
 
 
 def cost(spec: AtlasSpec, runs_per_task: int = 32, workers: int | None = None) -> Cost:
-    """The estimate ``check_feasible`` judges: memory of this process, CPU time (a run's cost
-    grows as sqrt(tau_end), the steps of a spiral), and wall time on ``workers``."""
+    """The estimate ``check_feasible`` judges: memory of this process, CPU time (``run_cost_s``
+    of every cell and model), and wall time on ``workers``."""
     cells = len(spec.deltas) * len(spec.chis)
     tm = min(spec.members, 256, max(1, runs_per_task))
     tc = max(1, runs_per_task // tm)
     tasks = len(spec.models) * len(spec.deltas) * math.ceil(len(spec.chis) / tc) * math.ceil(spec.members / tm)
     nbytes = BYTES_PER_CELL * cells + BYTES_PER_TASK * tasks + BYTES_PER_RUN * spec.runs
-    cpu = spec.runs * CPU_S_PER_RUN * math.sqrt(max(spec.settings.tau_end, 1.0) / 1e10)
+    if spec.settings.engine == "taylor":
+        cpu = spec.runs * run_cost_s(spec.settings, spec.models[0], 0.5, 0.5)
+    else:
+        cpu = spec.members * sum(run_cost_s(spec.settings, m, d, c) for m in spec.models for d in spec.deltas
+                                 for c in spec.chis)
     return Cost(spec.runs, tasks, nbytes, cpu, None if not workers else cpu / workers, workers)
 
 
@@ -355,7 +378,8 @@ def check_feasible(spec: AtlasSpec, arguments: IA.AtlasArguments) -> Cost:
                                               f"cells or members, or more runs per task")
     if c.wall_s is not None and c.wall_s > MAX_DAYS * 86400.0:
         raise SceneError(spec.path, "[grid]", f"{c.runs} runs to tau_end = {spec.settings.tau_end:g} would take "
-                                              f"~{c.wall_s / 86400.0:.3g} days on {workers} workers (~{CPU_S_PER_RUN:g} s a "
-                                              f"run at tau_end 1e10, growing as sqrt(tau_end)); at most {MAX_DAYS:g} days: "
-                                              f"use fewer cells or members, a shorter [run].tau_end, or a cluster (scheduler)")
+                                              f"~{c.wall_s / 86400.0:.3g} days on {workers} workers (engine "
+                                              f"{spec.settings.engine!r}: ~{c.cpu_s / max(1, c.runs):.3g} s a run); at most "
+                                              f"{MAX_DAYS:g} days: use fewer cells or members, a shorter [run].tau_end, "
+                                              f"or a cluster (scheduler)")
     return c

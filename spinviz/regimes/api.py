@@ -35,6 +35,15 @@ from .store import dataset as ST
 from .store import integrity as IN
 
 RUNS_PER_TASK = 32          # a task of ~32 runs lasts ~0.2-10 s: scheduling (~ms) stays below 1 %
+SMALL_WORK_S = 20.0         # estimated CPU seconds below which no cluster is started (docs/atlas.md, "Where it runs")
+
+
+def work_s(spec: AtlasSpec, batch) -> float:
+    """The estimated CPU seconds of a batch (``inputs.atlas_spec.run_cost_s`` per cell)."""
+    from ..inputs.atlas_spec import run_cost_s
+
+    n = len(batch.omega0)
+    return sum(n * run_cost_s(spec.settings, batch.model, d, c) for d in batch.deltas for c in batch.chis)
 
 
 @dataclass
@@ -293,7 +302,7 @@ def level_types(path: str, model_index: int):
     from .engine import refine as RF
 
     g = zarr.open_group(path, mode="r", zarr_format=2)
-    codes = np.asarray(g["regime"][model_index])
+    codes = np.asarray(g["label_inf" if "label_inf" in g else "regime"][model_index])   # the type as tau -> oo
     types = RF.type_of(codes, np.asarray(g["candidate"][model_index]))
     return types, (np.asarray(g["done"][model_index]) == 1).all(axis=-1)
 
@@ -304,9 +313,19 @@ class _LazyCluster:
     def __init__(self, stack, scheduler, workers, processes):
         self.stack, self.args, self.cl, self.where = stack, (scheduler, workers, processes), None, "nothing to compute"
 
-    def get(self):
-        from .cluster import Cluster
+    def get(self, small: bool = False):
+        """The cluster; with ``small`` (little work, no scheduler or worker count asked for) this
+        process instead, in threads (``cluster.InProcess``), unless a cluster is already up."""
+        from .cluster import Cluster, InProcess
 
+        scheduler, workers, _ = self.args
+        if small and self.cl is None and scheduler is None and workers is None:
+            from ..inputs.render import usable_cores
+
+            here = InProcess(usable_cores())
+            if self.where == "nothing to compute":
+                self.where = here.describe
+            return here
         if self.cl is None:
             scheduler, workers, processes = self.args
             self.cl = self.stack.enter_context(Cluster(scheduler, workers, processes=processes))
@@ -352,7 +371,7 @@ def _run_level(lv: Level, cluster: _LazyCluster, runs_per_task, flush_s, retry_f
         if not exists and lv.wanted is None:       # an empty plan and no store: cannot happen
             raise UsageError(f"{spec.path}: the spec holds no runs")
         return None
-    cl = cluster.get()
+    cl = cluster.get(small=sum(work_s(spec, b) for b in batches) < SMALL_WORK_S)
     if not exists:
         ST.create(spec, out, chunks)
     writer = ST.Writer(out, expected, flush_s=flush_s)

@@ -370,15 +370,6 @@ def _decades(dist: float, rate: float) -> float:
     return 0.0 if dist < SETTLED else math.log(dist / SETTLED) / (rate * math.log(10.0))
 
 
-def label_at(flow, state, lnA: float, lnB: float, s: float) -> str:
-    """The label of a handed-over run at s = ln tau: its attractor's class; on the reduced
-    axial state "1", "2" or "1|2" by the free/forced ratio (``R_ONE``, ``R_TWO``)."""
-    if state.name == "axial" and flow.model == "reduced" and flow.F != 0.0:
-        lr = ln_ratio(flow, lnA, lnB, s)
-        return "1" if lr < math.log(R_ONE) else "2" if lr > math.log(R_TWO) else "1|2"
-    return state.label
-
-
 def crossing(flow, r: dict, tau: np.ndarray) -> float:
     """tau at which a handed-over run's free/forced ratio crosses 1 -- found along its averaged
     run (``averaged_stage``'s dict ``r``), else extrapolated beyond the end as tau^(alpha + 1);
@@ -386,7 +377,7 @@ def crossing(flow, r: dict, tau: np.ndarray) -> float:
     if flow.F == 0.0 or flow.delta == 0.0:
         return math.nan
     s = np.log(tau[r["idx"]])
-    lr = 0.5 * r["lnA"] + math.log(abs(flow.delta) / abs(flow.F)) + 0.5 * s - r["lnB"]
+    lr = ln_ratio(flow, r["lnA"], r["lnB"], s)
     ch = np.flatnonzero(np.sign(lr[1:]) != np.sign(lr[:-1]))
     if ch.size:
         k = int(ch[-1])
@@ -406,8 +397,7 @@ def limit_of(flow, state, lnA: float, lnB: float, s: float, unresolved_factor: f
     bound (a free spiral below the noise floor)."""
     dist, rate = _distance(state, lnA, lnB)
     decades = _decades(dist, rate)
-    label, inf = label_at(flow, state, lnA, lnB, s), state.label
-    ratio = math.nan
+    label, inf, ratio = state.label, state.label, math.nan
     if state.name == "axial" and flow.model == "reduced" and flow.F != 0.0:
         lr = ln_ratio(flow, lnA, lnB, s) + math.log(unresolved_factor)
         ratio = math.exp(min(lr, 700.0))

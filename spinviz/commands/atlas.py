@@ -17,7 +17,7 @@ from ..errors import UsageError, printable
 from ..interrupt import Interrupted, check
 from .shared import positive, real
 
-EVIDENCE = ("validate", "crosscheck", "physical", "convergence", "tolerance")
+EVIDENCE = ("validate", "crosscheck", "physical", "convergence", "tolerance", "handover")
 
 
 def add_parser(sub) -> None:
@@ -52,11 +52,13 @@ def add_parser(sub) -> None:
     ev.add_argument("--evidence", metavar="KIND", choices=EVIDENCE,
                     help="validate (every domain against the paper's formulas), crosscheck (the disputed points with "
                          "SciPy), physical (against physical-unit simulate runs), convergence (horizon x 100, x 1e4 "
-                         "and 4x members; --out STORE keeps the rows in that atlas), tolerance (labels against rtol)")
+                         "and 4x members; --out STORE keeps the rows in that atlas), tolerance (labels against rtol), handover "
+                         "(the hand-over engine against brute force at 1e12 and 1e14; --out STORE keeps the rows)")
     ev.add_argument("--members", type=positive, help="starts per point (default: validate 32, crosscheck 3, physical 4, "
-                                                     "convergence 32, tolerance 8)")
+                                                     "convergence 32, tolerance 8, handover 16)")
     ev.add_argument("--tau-end", type=real, help="physical: the horizon (default 1e10)")
-    ev.add_argument("--horizons", metavar="LIST", help="convergence: the horizons (default 1e10,1e12,1e14)")
+    ev.add_argument("--horizons", metavar="LIST", help="convergence: the horizons (default 1e10,1e12,1e14,1e16,1e20); "
+                                                       "handover: (default 1e12,1e14)")
 
 
 def run(args) -> int:

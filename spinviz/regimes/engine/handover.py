@@ -682,3 +682,12 @@ def limit_inf(model: str, state, rec: RN.Record) -> tuple[str, float]:
         if lean[state.name]:
             return state.label, math.nan
     return rec.label, (0.0 if rec.label not in UNSETTLED else math.nan)
+
+
+def cell_records(model: str, delta: float, chi: float, starts, settings) -> list:
+    """The ``runs.Record`` of each start at one cell through this engine (one batch; the
+    evidence commands compare them with brute force)."""
+    starts = np.asarray(starts, dtype=float)
+    b = RN.Batch(model, (float(delta),), (float(chi),), starts, settings, (0, (0, 1), (0, 1), (0, len(starts))), 0)
+    cells, omega0 = RN.flat_runs(b)
+    return _records(b, cells, omega0)[0]

@@ -10,6 +10,9 @@
 ``convergence``           labels against horizon (x 100, x 1e4) and 4x members (``convergence``);
                           ``--out STORE`` keeps the rows in that atlas store
 ``tolerance``             labels and end states against rtol on the quick atlas's grid
+``handover``              the hand-over engine against brute-force runs of the same starts at
+                          1e12 and 1e14, tighter references where they differ (``handover``);
+                          ``--out STORE`` keeps the rows in that atlas store
 ========================  ======================================================================
 
 Each prints a table (``--json``: the rows as JSON instead) and its progress on stderr.
@@ -34,7 +37,7 @@ class Kind:
 
 KINDS = {"validate": Kind(32, frozenset({"workers"})), "crosscheck": Kind(3),
          "physical": Kind(4, frozenset({"tau_end"})), "convergence": Kind(32, frozenset({"horizons", "out"})),
-         "tolerance": Kind(8)}
+         "tolerance": Kind(8), "handover": Kind(16, frozenset({"horizons", "out"}))}
 OPTIONS = {"workers": "--workers", "tau_end": "--tau-end", "horizons": "--horizons", "out": "--out"}
 
 
@@ -82,6 +85,10 @@ def _compute(kind: str, n: int, given: dict) -> tuple:
         rows = CV.tolerance(n, progress=_say)
         return rows, CV.format_tolerance(rows), 0
     horizons = CV.HORIZONS
+    if kind == "handover":
+        from . import handover as HV
+
+        horizons = HV.HORIZONS
     if given["horizons"]:
         try:
             horizons = tuple(float(x) for x in given["horizons"].split(","))
@@ -97,6 +104,11 @@ def _compute(kind: str, n: int, given: dict) -> tuple:
 
         if not os.path.exists(os.path.join(given["out"], ".zgroup")) or verify_skeleton(given["out"]) is None:
             raise UsageError(f"--out {printable(given['out'], 200)}: not an atlas store to keep the rows in")
+    if kind == "handover":
+        rows = HV.run(n, horizons, progress=_say)
+        if given["out"]:
+            CV.record(given["out"], rows, key="handover_validation")
+        return rows, HV.format_table(rows), 0
     rows = CV.study(n, horizons, progress=_say)
     if given["out"]:
         CV.record(given["out"], rows)

@@ -45,6 +45,10 @@ def add_parser(sub) -> None:
     a.add_argument("--bench", action="store_true",
                    help="instead: measure runs per second on 1 and 2 workers, the scheduling overhead and the memory "
                         "per worker on this spec (temporary stores), and project a 64 x 64 x 32 atlas")
+    a.add_argument("--peer", metavar="SCRIPT",
+                   help="with --bench, on a one-cell spec: the whole command against the standalone heyoka script "
+                        "SCRIPT (benchmarks/peer_heyoka_atlas.py) as a whole process, 256 starts to tau 1e10, 1e12, "
+                        "1e14 and the spec's starts to 1e10, with the end states compared")
     a.add_argument("--write-path", action="store_true",
                    help="with --bench: only the store's write path at the spec's size (chunk writes, checksums, "
                         "verification; no runs)")
@@ -83,6 +87,8 @@ def run(args) -> int:
         raise UsageError("--members, --tau-end and --horizons go with --evidence")
     if args.write_path and not args.bench:
         raise UsageError("--write-path goes with --bench")
+    if args.peer is not None and not args.bench:
+        raise UsageError("--peer goes with --bench")
     if args.spec is None:
         raise UsageError("atlas: the spec is missing (spinviz atlas SPEC.toml, spinviz atlas --verify STORE, or "
                          "spinviz atlas --evidence KIND)")
@@ -127,6 +133,15 @@ def _bench(spec, args) -> int:
     if args.out or args.scheduler or args.plot:
         raise UsageError("--bench: measures on temporary stores and the embedded cluster; drop --out, --scheduler "
                          "and --plot")
+    if args.peer is not None:
+        import os
+
+        if not os.path.isfile(args.peer):
+            raise UsageError(f"--peer: {printable(args.peer, 200)}: no such file")
+        rows = bench.against_peer(spec, args.peer, progress=None if args.quiet else
+                                  lambda m: print(f"  {m}", file=sys.stderr, flush=True))
+        print(bench.format_peer(rows) if not args.json else json.dumps(rows, indent=2, default=float))
+        return 0
     if args.write_path:
         rows = bench.store_cost(spec)
         print(bench.format_store_cost(rows) if not args.json else json.dumps(rows, indent=2, default=float))

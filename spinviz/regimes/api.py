@@ -316,17 +316,18 @@ class _LazyCluster:
     def get(self, small: bool = False):
         """The cluster; with ``small`` (little work, no scheduler or worker count asked for) this
         process instead, in threads (``cluster.InProcess``), unless a cluster is already up."""
-        from .cluster import Cluster, InProcess
-
         scheduler, workers, _ = self.args
         if small and self.cl is None and scheduler is None and workers is None:
             from ..inputs.render import usable_cores
+            from .inprocess import InProcess
 
             here = InProcess(usable_cores())
             if self.where == "nothing to compute":
                 self.where = here.describe
             return here
         if self.cl is None:
+            from .cluster import Cluster
+
             scheduler, workers, processes = self.args
             self.cl = self.stack.enter_context(Cluster(scheduler, workers, processes=processes))
             self.where = self.cl.describe          # asked now: a cluster lost later cannot answer
@@ -346,7 +347,6 @@ def _run_level(lv: Level, cluster: _LazyCluster, runs_per_task, flush_s, retry_f
     """Compute what level ``lv`` lacks (its wanted cells): the store created or verified and
     resumed, the batches planned, executed and written.  Returns the execution's stats or None."""
     from ..progress import Progress
-    from .cluster import execute
 
     spec, out = lv.spec, lv.out
     exists = os.path.exists(os.path.join(out, ".zgroup")) if lv.wanted is not None else os.path.exists(out)
@@ -380,7 +380,14 @@ def _run_level(lv: Level, cluster: _LazyCluster, runs_per_task, flush_s, retry_f
     bar = Progress(todo, f"atlas {printable(label, 80)}", enabled=progress)
     stats = None
     try:
-        stats = execute(cl, batches, keys, writer, bar, on_result=on_result)
+        from . import inprocess
+
+        if isinstance(cl, inprocess.InProcess):
+            stats = inprocess.execute(cl, batches, keys, writer, bar, on_result=on_result)
+        else:
+            from .cluster import execute
+
+            stats = execute(cl, batches, keys, writer, bar, on_result=on_result)
     finally:
         writer.close()
         bar.finish()

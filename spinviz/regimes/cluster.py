@@ -31,13 +31,11 @@ from __future__ import annotations
 
 import contextlib
 import logging
-import math
 import os
 import queue
 import signal
 import threading
 import time
-from dataclasses import dataclass, field
 
 from distributed.diagnostics.plugin import WorkerPlugin
 
@@ -47,6 +45,7 @@ from ..interrupt import SIGNALS, check
 from ..progress import Progress
 from .engine import runs as RN
 from .faults import OptionError
+from .stats import Incomplete, Stats
 
 CONNECT_TIMEOUT_S = 10.0
 START_TIMEOUT_S = 120.0          # LocalCluster workers (spawned Python, imports, the Taylor integrators loaded)
@@ -360,73 +359,6 @@ class _Monitor:
 
 
 # --- execution -------------------------------------------------------------------------------
-@dataclass
-class Incomplete:
-    """Runs an execution did not compute (none of them written): why, and how many."""
-
-    cause: str                   # one phrase: the first reason met
-    runs: int                    # runs not computed (tasks failed or lost, and batches never submitted)
-    cluster_lost: bool           # the cluster itself failed (not only some tasks)
-
-
-@dataclass
-class Stats:
-    """What an execution measured (for the benchmark and the summary line)."""
-
-    runs: int = 0
-    tasks: int = 0
-    failed_tasks: int = 0
-    wall_s: float = 0.0
-    compute_s: float = 0.0
-    classify_s: float = 0.0                               # of compute_s: the classifier
-    cpu_s: float = 0.0
-    threads: int = 0
-    max_rss_mb: dict = field(default_factory=dict)        # worker pid -> peak RSS, MiB
-    task_compute_s: list = field(default_factory=list)
-    incomplete: Incomplete | None = None
-    write_s: float = 0.0                                  # the client writing the store (data, done, checksums)
-    checksum_s: float = 0.0                               # of which: hashing the chunk files, recording the sums
-    chunk_writes: int = 0
-
-    def merged(self, other: Stats | None) -> Stats:
-        """The measurements of two executions one after the other (refinement levels on one
-        cluster): counts and times added, the later one's incomplete state kept."""
-        if other is None:
-            return self
-        out = Stats(threads=max(self.threads, other.threads), incomplete=other.incomplete)
-        for name in ("runs", "tasks", "failed_tasks", "wall_s", "compute_s", "classify_s", "cpu_s", "write_s", "checksum_s",
-                     "chunk_writes"):
-            setattr(out, name, getattr(self, name) + getattr(other, name))
-        out.task_compute_s = self.task_compute_s + other.task_compute_s
-        out.max_rss_mb = {pid: max(self.max_rss_mb.get(pid, 0), other.max_rss_mb.get(pid, 0))
-                          for pid in {*self.max_rss_mb, *other.max_rss_mb}}
-        return out
-
-    def breakdown(self) -> dict:
-        """Where the time went: shares of the workers' time (wall x threads) spent integrating,
-        classifying, and in neither (scheduling, transfer, start-up, the idle tail), and the
-        client's store writes (seconds, and as a share of the wall time)."""
-        cap = self.wall_s * max(1, self.threads)
-        if cap <= 0:
-            return {}
-        return {"integrate_share": (self.compute_s - self.classify_s) / cap, "classify_share": self.classify_s / cap,
-                "overhead_share": self.overhead_share, "write_s": self.write_s,
-                "write_share_of_wall": self.write_s / self.wall_s}
-
-    @property
-    def overhead_share(self) -> float:
-        """1 - (time inside the tasks) / (wall time x threads): scheduling, transfer, writing,
-        start-up and the idle tail together."""
-        cap = self.wall_s * max(1, self.threads)
-        return 1.0 - self.compute_s / cap if cap > 0 else math.nan
-
-    @property
-    def cpu_share(self) -> float:
-        """CPU time / wall time inside the tasks: 1 when the workers had their cores to
-        themselves, less when other work on the machine took them."""
-        return self.cpu_s / self.compute_s if self.compute_s > 0 else math.nan
-
-
 def _why_not_finished(f) -> str:
     """One phrase for a task that did not finish: its workers killed, cancelled (by the
     scheduler's loss), or the exception it raised outside the runs."""
@@ -444,83 +376,8 @@ def _why_not_finished(f) -> str:
     return f"a task was {f.status}"
 
 
-class InProcess:
-    """Small work in this process: the batches run in ``threads`` threads of the client, no
-    cluster started (a LocalCluster costs ~3.5 s to start and stop: more than a small atlas's
-    work).  The same writes, progress and stop signals as on a cluster."""
-
-    def __init__(self, threads: int):
-        self.threads = max(1, int(threads))
-        self.nthreads = self.threads
-
-    @property
-    def describe(self) -> str:
-        """Where it runs."""
-        return f"this process, {self.threads} thread{'s' if self.threads != 1 else ''} (small work: no cluster started)"
-
-    def problem(self) -> str | None:
-        """Nothing to lose: always None."""
-        return None
-
-    def close(self, fast: bool = False) -> None:
-        """Nothing to stop."""
-
-
-def _execute_here(cluster: InProcess, batches: list, keys: list, writer, progress: Progress, on_result=None) -> Stats:
-    """``execute`` in this process: the batches in a thread pool, results written in this
-    (the main) thread as they arrive; a stop signal stops at once (a running batch, well under
-    a second of small work, finishes in its thread and is not written)."""
-    from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
-
-    stats = Stats(threads=cluster.threads)
-    t0 = time.perf_counter()
-    todo = list(range(len(batches)))[::-1]
-    in_flight: dict = {}
-    not_done, cause = 0, None
-    pool = ThreadPoolExecutor(cluster.threads, thread_name_prefix="spinviz-atlas")
-    try:
-        for _ in range(min(2 * cluster.threads + 2, len(todo))):
-            i = todo.pop()
-            in_flight[pool.submit(RN.run_batch, batches[i])] = i
-        while in_flight:
-            check()
-            done, _ = wait(list(in_flight), timeout=POLL_S, return_when=FIRST_COMPLETED)
-            for f in done:
-                i = in_flight.pop(f)
-                try:
-                    res = f.result()
-                except Exception as e:             # a task raising outside its runs: as on a cluster
-                    cause = cause or f"a task raised {type(e).__name__}: {printable(str(e), 160)}"
-                    not_done += batches[i].runs
-                    stats.failed_tasks += 1
-                    res = None
-                if res is not None:
-                    stats.compute_s += res["compute_s"]
-                    stats.classify_s += res.get("classify_s", 0.0)
-                    stats.cpu_s += res.get("cpu_s", 0.0)
-                    stats.task_compute_s.append(res["compute_s"])
-                    stats.max_rss_mb[res["worker_pid"]] = max(stats.max_rss_mb.get(res["worker_pid"], 0.0),
-                                                              res["max_rss_mb"])
-                    writer.add(keys[i], res)
-                    stats.runs += batches[i].runs
-                stats.tasks += 1
-                progress.update(stats.runs + not_done)
-                if on_result is not None and res is not None:
-                    on_result(stats.tasks, res)
-                if todo:
-                    j = todo.pop()
-                    in_flight[pool.submit(RN.run_batch, batches[j])] = j
-    finally:
-        pool.shutdown(wait=False, cancel_futures=True)
-        stats.wall_s = time.perf_counter() - t0
-    if cause is not None:
-        stats.incomplete = Incomplete(cause, not_done + sum(batches[i].runs for i in todo), False)
-    return stats
-
-
 def execute(cluster: Cluster, batches: list, keys: list, writer, progress: Progress, on_result=None) -> Stats:
-    """Run ``batches`` (``keys[i]``: the storage chunk of batch i) and write each result
-    (``InProcess``: here, in threads).
+    """Run ``batches`` (``keys[i]``: the storage chunk of batch i) and write each result.
 
     Only finished results are written.  A task that did not finish is counted in
     ``Stats.incomplete`` (its runs stay "not computed") and the others go on; when the
@@ -530,8 +387,6 @@ def execute(cluster: Cluster, batches: list, keys: list, writer, progress: Progr
     (tests use it to interrupt, or to kill the worker that ran it)."""
     # Long on purpose: the client's one loop (submit, receive, write, watch the cluster and the
     # stop flag) reads as one story; its pieces share a dozen counters
-    if isinstance(cluster, InProcess):
-        return _execute_here(cluster, batches, keys, writer, progress, on_result)
     client = cluster.client
     stats = Stats(threads=cluster.nthreads)
     t0 = time.perf_counter()

@@ -652,9 +652,10 @@ def limit_inf(model: str, state, rec: RN.Record) -> tuple[str, float]:
 
     * Where the cell's stable averaged state is transverse and averaging cannot last there
       (reduced beta < -3/4, the domain "?"; truncated beta_T < -1): a run in its basin --
-      labelled 4 / T4, or not yet labelled with omega_perp dominant and falling as tau^-1/2
-      -- ends in the libration "5" (its rotating phase is captured, ``lock_to_5_at_tau``) or
-      with the frozen phase "TF" (its remaining phase falls as tau^(1 + beta_T)).
+      labelled 4 / T4, or not yet labelled with omega_perp dominant (reduced: and falling as
+      tau^-1/2) -- ends in the libration "5" (its rotating phase is captured,
+      ``lock_to_5_at_tau``) or with the frozen phase "TF" (its remaining phase falls as
+      tau^(1 + beta_T)).
     * Where averaging holds and the stable state is the only attractor (every such cell but
       the reduced transverse ones, where the libration competes): a run not yet labelled whose
       amplitudes already lean to that state ends there ((LV) has one stable state, attracting
@@ -664,7 +665,7 @@ def limit_inf(model: str, state, rec: RN.Record) -> tuple[str, float]:
     X, Y, p = ev.get("X2", math.nan), ev.get("Y2", math.nan), ev.get("slope_perp", math.nan)
     if state is None or rec.label == "failed" or not (math.isfinite(X) and math.isfinite(Y)):
         return rec.label, math.nan
-    transverse = X > 4.0 * Y and abs(p + 0.5) < 0.1
+    transverse = X > 4.0 * Y and (model == "truncated" or abs(p + 0.5) < 0.1)
     if state.name == "transverse" and not state.holds:
         end = "5" if model == "reduced" else "TF"
         if rec.label == end:
@@ -684,10 +685,12 @@ def limit_inf(model: str, state, rec: RN.Record) -> tuple[str, float]:
     return rec.label, (0.0 if rec.label not in UNSETTLED else math.nan)
 
 
-def cell_records(model: str, delta: float, chi: float, starts, settings) -> list:
+def cell_records(model: str, delta: float, chi: float, starts, settings, series: bool = False) -> list:
     """The ``runs.Record`` of each start at one cell through this engine (one batch; the
-    evidence commands compare them with brute force)."""
+    evidence commands compare them with brute force; ``series``: with every run's omega
+    series on the output grid, as the store keeps them)."""
     starts = np.asarray(starts, dtype=float)
-    b = RN.Batch(model, (float(delta),), (float(chi),), starts, settings, (0, (0, 1), (0, 1), (0, len(starts))), 0)
+    b = RN.Batch(model, (float(delta),), (float(chi),), starts, settings, (0, (0, 1), (0, 1), (0, len(starts))),
+                 len(starts) if series else 0)
     cells, omega0 = RN.flat_runs(b)
     return _records(b, cells, omega0)[0]

@@ -229,6 +229,9 @@ def page_of(levels: list) -> str:
                 if w is not None and np.isfinite(w[i, j]).any():
                     where = (f"{model} model, \u03b4 = {float(ds['delta'][i]):+.3f}, "
                              f"\u03c7 = {math.degrees(float(ds['chi'][j])):.2f}\u00b0")
-                    series[cid] = {"tau": tau, "omega": w[i, j], "label": str(lab[i, j, 0]), "where": where}
+                    t_h = float(sub["tau_handover"].values[i, j, 0]) if "tau_handover" in sub else math.nan
+                    after = (f" (averaged flow from \u03c4 = {t_h:.0e}: the amplitudes the run's, the phase the "
+                             f"averaged one)") if math.isfinite(t_h) else ""
+                    series[cid] = {"tau": tau, "omega": w[i, j], "label": str(lab[i, j, 0]) + after, "where": where}
     return page(levels, series, lambda model, c: {q: v for q, v in medians.get(c["id"], {}).items()
                                                    if np.isfinite(v)})

@@ -17,7 +17,7 @@ from ..errors import UsageError, printable
 from ..interrupt import Interrupted, check
 from .shared import positive, real
 
-EVIDENCE = ("validate", "crosscheck", "physical", "convergence", "tolerance", "handover")
+EVIDENCE = ("validate", "crosscheck", "physical", "convergence", "tolerance", "handover", "basins")
 
 
 def add_parser(sub) -> None:
@@ -57,10 +57,11 @@ def add_parser(sub) -> None:
                     help="validate (every domain against the paper's formulas), crosscheck (the disputed points with "
                          "SciPy), physical (against physical-unit simulate runs), convergence (horizon x 100, x 1e4 "
                          "and 4x members; --out STORE keeps the rows in that atlas), tolerance (labels against rtol), handover "
-                         "(the hand-over engine against brute force at 1e12 and 1e14; --out STORE keeps the rows)")
+                         "(the hand-over engine against brute force at 1e12 and 1e14; --out STORE keeps the rows), basins (the "
+                         "4|5 band: shares ending in 4 and 5 against beta)")
     ev.add_argument("--members", type=positive, help="starts per point (default: validate 32, crosscheck 3, physical 4, "
-                                                     "convergence 32, tolerance 8, handover 16)")
-    ev.add_argument("--tau-end", type=real, help="physical: the horizon (default 1e10)")
+                                                     "convergence 32, tolerance 8, handover 16, basins 32)")
+    ev.add_argument("--tau-end", type=real, help="physical: the horizon (default 1e10); basins: (default 1e16)")
     ev.add_argument("--horizons", metavar="LIST", help="convergence: the horizons (default 1e10,1e12,1e14,1e16,1e20); "
                                                        "handover: (default 1e12,1e14)")
 

@@ -13,6 +13,8 @@
 ``handover``              the hand-over engine against brute-force runs of the same starts at
                           1e12 and 1e14, tighter references where they differ (``handover``);
                           ``--out STORE`` keeps the rows in that atlas store
+``basins``                the 4|5 band at delta = 0.5: the shares of the starts ending in 4 and
+                          in 5 against beta of (4.18) (``handover.basins``)
 ========================  ======================================================================
 
 Each prints a table (``--json``: the rows as JSON instead) and its progress on stderr.
@@ -37,7 +39,8 @@ class Kind:
 
 KINDS = {"validate": Kind(32, frozenset({"workers"})), "crosscheck": Kind(3),
          "physical": Kind(4, frozenset({"tau_end"})), "convergence": Kind(32, frozenset({"horizons", "out"})),
-         "tolerance": Kind(8), "handover": Kind(16, frozenset({"horizons", "out"}))}
+         "tolerance": Kind(8), "handover": Kind(16, frozenset({"horizons", "out"})),
+         "basins": Kind(32, frozenset({"tau_end"}))}
 OPTIONS = {"workers": "--workers", "tau_end": "--tau-end", "horizons": "--horizons", "out": "--out"}
 
 
@@ -74,6 +77,11 @@ def _compute(kind: str, n: int, given: dict) -> tuple:
         rows = X.run(n, progress=lambda r: _say(f"{r['point']} member {r['member']}: {r['label']} "
                                                 f"({r['seconds']:.1f} s)"))
         return rows, X.format_rows(rows), 0
+    if kind == "basins":
+        from . import handover as HV
+
+        rows = HV.basins(members=n, tau_end=given["tau_end"] or 1e16, progress=_say)
+        return rows, HV.format_basins(rows), 0
     if kind == "physical":
         from . import physical as P
 

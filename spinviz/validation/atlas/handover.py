@@ -172,3 +172,46 @@ def format_table(rows: list[dict]) -> str:
                         f"{f['ratio_ref']:.4g}, engine {f['ratio_engine']:.4g}, brute {f['ratio_brute']:.4g} "
                         f"({f['seconds']:.0f} s)")
     return "\n".join(out + ([""] + refs if refs else []))
+
+
+# --- the 4|5 band: basin fractions against beta -------------------------------------------------
+BAND_CHI_DEG = tuple(float(c) for c in np.arange(36.0, 47.01, 1.0))     # delta = 0.5: beta from -0.55 to -0.88
+
+
+def basins(delta: float = 0.5, chis_deg=BAND_CHI_DEG, members: int = 32,
+           tau_end: float = 1e16, rtol: float = 1e-8, seed: int = 1, omega: float = 0.1, progress=None) -> list[dict]:
+    """Across the 4|5 band at one delta: per chi, beta of (4.18) and the shares of the starts
+    whose limit is type 4 and type 5 (the hand-over engine: beyond beta = -3/4 the spiral is
+    captured, a type-4 run counting as 5 with its ``lock_to_5_at_tau``; before it both are
+    attractors and the fractions are the basins'), and what is still unsettled."""
+    from ...physics import asymptotics as FM
+
+    say = progress or (lambda m: None)
+    rows = []
+    starts = directions(members, seed) * omega
+    for cdeg in chis_deg:
+        chi = math.radians(float(cdeg))
+        say(f"basins: delta {delta:g}, chi {cdeg:g} deg")
+        recs = HO.cell_records("reduced", delta, chi, starts, Settings(tau_end=tau_end, rtol=rtol))
+        lim = Counter(_limit(r) for r in recs)
+        end = Counter(_shown(r) for r in recs)
+        lock = [r.evidence[RN.C.EVIDENCE.index("lock_to_5_at_tau")] for r in recs if _limit(r) == "5" and r.label == "4"]
+        rows.append({"delta": delta, "chi_deg": float(cdeg), "beta": FM.type4_eq4_18(delta, chi)["beta"],
+                     "members": members, "tau_end": tau_end, "limit": dict(lim), "at_tau_end": dict(end),
+                     "share_4": lim.get("4", 0) / members, "share_5": lim.get("5", 0) / members,
+                     "captured_later": len(lock),
+                     "median_lock_tau": float(np.nanmedian(lock)) if lock else math.nan})
+    return rows
+
+
+def format_basins(rows: list[dict]) -> str:
+    """The basin rows as a Markdown table."""
+    out = ["| chi | beta (4.18) | limit: 4 / 5 / other | at tau_end | type 4 at tau_end captured later (median tau) |",
+           "|---|---|---|---|---|"]
+    for r in rows:
+        other = r["members"] - round(r["share_4"] * r["members"]) - round(r["share_5"] * r["members"])
+        at = ", ".join(f"{k} {v}" for k, v in sorted(r["at_tau_end"].items(), key=lambda kv: -kv[1]))
+        lock = f"{r['captured_later']} ({r['median_lock_tau']:.1e})" if r["captured_later"] else "0"
+        out.append(f"| {r['chi_deg']:.1f}° | {r['beta']:.3f} | {100 * r['share_4']:.0f} % / {100 * r['share_5']:.0f} % / "
+                   f"{other} | {at} | {lock} |")
+    return "\n".join(out)

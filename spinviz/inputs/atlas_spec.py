@@ -18,7 +18,8 @@ how far and how finely to integrate, and how to classify::
     # or: list = [[0.0, 0.1, 0.0], ...]   explicit omega(0) vectors, body frame
 
     [run]
-    tau_end = 1e10                        # horizon, tau = t/tau0
+    engine = "handover"                   # or "taylor": every run integrated to tau_end (brute force)
+    tau_end = 1e10                        # horizon, tau = t/tau0 (at most 1e20; 1e16 with "taylor")
     tau_start = 1e-2                      # first sample after 0
     samples_per_decade = 20
     rtol = 1e-8                           # Taylor tolerance on omega sqrt(1 + tau/T) / |omega0| (T = 1/|omega0|^2)
@@ -31,12 +32,11 @@ Every member uses the same omega(0) at every cell and in both models, so that ce
 models are compared on the same starts (paired), and the store records them.
 
 Defaults and why: the asymptotic laws of section 4 need tau |omega0|^2 >> 1 (T = 1/|omega0|^2
-is the braking time); with |omega0| = 0.1 the default horizon 1e10 is 1e8 T.  The slowest
-regimes need it: near (delta, chi) = (0.3, 0.72) type 3's amplitudes still drift ~9 % a
-decade after 10 decades, and a type-4 phase with beta just below -3/4 is captured into type
-5 only at tau ~ 1e16.  Spirals cost ~ sqrt(tau_end) steps (~0.005-0.4 s a run at 1e10, up
-to ~3 s in the worst cells), so 1e10 is where the labels of the prototype's studies stopped
-changing while a 12 x 12 x 8 atlas still runs in minutes on two cores.  rtol 1e-8: Taylor's
+is the braking time); with |omega0| = 0.1 the default horizon 1e10 is 1e8 T.  The hand-over
+engine labels a spiral by the attractor of the averaged flow it is in, whatever tau_end, and
+its cost does not grow with tau_end; the regimes it integrates in full (the libration "5",
+TF) settle by 1e10 .. 1e16 and cost ~tau_end^(1/4) (the shipped atlases use 1e16).  With
+engine = "taylor" spirals cost ~ sqrt(tau_end) steps (~0.005-0.4 s a run at 1e10).  rtol 1e-8: Taylor's
 method on the scaled omega sqrt(1 + tau/T) / |omega0|, so the tolerance holds relative to the
 braking law to the end of the run (docs/atlas.md: labels and amplitudes against rtol).
 20 samples a decade and a 2-decade window: 41 samples, the labels are the same at 10-50.

@@ -281,12 +281,22 @@ def max_rss_mb() -> float:
 
 
 def warm(settings: Settings | None = None) -> float:
-    """Load (or compile, once, into heyoka's on-disk cache) the batch integrator of both models
-    at the atlas's tolerance; returns the seconds it took."""
+    """Load (or compile, once, into heyoka's on-disk cache) the batch integrators of both models
+    at the atlas's tolerance -- and for the hand-over engine at a hundredth of it (the noise
+    floor's reruns) and the averaged stage's -- returns the seconds it took."""
     from ...integrators.taylor import template, tolerance, width
 
     t0 = time.perf_counter()
-    tol, _ = tolerance((settings or Settings()).rtol, (settings or Settings()).rtol)
+    st = settings or Settings()
+    tol, _ = tolerance(st.rtol, st.rtol)
     for model in ("reduced", "truncated"):
         template(model, "none", tol, "double", width())
+    if st.engine == "handover":
+        from . import handover
+
+        tight, _ = tolerance(st.rtol / 100.0, st.rtol / 100.0)
+        for model in ("reduced", "truncated"):
+            for t in (tol, tight):
+                template(model, "none", t, "double", width(), symmetric=True, residual=False, runaway=False)
+        handover.lv_template(width())
     return time.perf_counter() - t0

@@ -35,7 +35,7 @@ tau_end = 1e6
     ("convergence", {"out": "/nonexistent/a.zarr"}, "--out /nonexistent/a.zarr: not an atlas store"),
     ("handover", {"workers": 2}, "--evidence handover: does not use --workers"),
     ("nonsense", {}, "--evidence: nonsense is not one of validate, crosscheck, physical, convergence, tolerance, "
-                     "handover, basins"),
+                     "handover, basins, flows"),
 ])
 def test_options_a_kind_does_not_take_are_refused_before_work(kind, options, message):
     with pytest.raises(UsageError) as e:

@@ -17,7 +17,7 @@ from ..errors import UsageError, printable
 from ..interrupt import Interrupted, check
 from .shared import positive, real
 
-EVIDENCE = ("validate", "crosscheck", "physical", "convergence", "tolerance", "handover", "basins")
+EVIDENCE = ("validate", "crosscheck", "physical", "convergence", "tolerance", "handover", "basins", "flows")
 
 
 def add_parser(sub) -> None:
@@ -58,7 +58,8 @@ def add_parser(sub) -> None:
                          "SciPy), physical (against physical-unit simulate runs), convergence (horizon x 100, x 1e4 "
                          "and 4x members; --out STORE keeps the rows in that atlas), tolerance (labels against rtol), handover "
                          "(the hand-over engine against brute force at 1e12 and 1e14; --out STORE keeps the rows), basins (the "
-                         "4|5 band: shares ending in 4 and 5 against beta)")
+                         "4|5 band: shares ending in 4 and 5 against beta), flows (the averaged flows against full "
+                         "integration: error, bound, order in mu)")
     ev.add_argument("--members", type=positive, help="starts per point (default: validate 32, crosscheck 3, physical 4, "
                                                      "convergence 32, tolerance 8, handover 16, basins 32)")
     ev.add_argument("--tau-end", type=real, help="physical: the horizon (default 1e10); basins: (default 1e16)")

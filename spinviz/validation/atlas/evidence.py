@@ -15,6 +15,9 @@
                           ``--out STORE`` keeps the rows in that atlas store
 ``basins``                the 4|5 band at delta = 0.5: the shares of the starts ending in 4 and
                           in 5 against beta of (4.18) (``handover.basins``)
+``flows``                 the averaged flows against full integration at tol 1e-15: the error
+                          of the averaged amplitudes against the stated bound and its order
+                          in mu (``handover.flows``)
 ========================  ======================================================================
 
 Each prints a table (``--json``: the rows as JSON instead) and its progress on stderr.
@@ -40,7 +43,7 @@ class Kind:
 KINDS = {"validate": Kind(32, frozenset({"workers"})), "crosscheck": Kind(3),
          "physical": Kind(4, frozenset({"tau_end"})), "convergence": Kind(32, frozenset({"horizons", "out"})),
          "tolerance": Kind(8), "handover": Kind(16, frozenset({"horizons", "out"})),
-         "basins": Kind(32, frozenset({"tau_end"}))}
+         "basins": Kind(32, frozenset({"tau_end"})), "flows": Kind(1)}
 OPTIONS = {"workers": "--workers", "tau_end": "--tau-end", "horizons": "--horizons", "out": "--out"}
 
 
@@ -82,6 +85,11 @@ def _compute(kind: str, n: int, given: dict) -> tuple:
 
         rows = HV.basins(members=n, tau_end=given["tau_end"] or 1e16, progress=_say)
         return rows, HV.format_basins(rows), 0
+    if kind == "flows":
+        from . import handover as HV
+
+        rows = HV.flows(progress=_say)
+        return rows, HV.format_flows(rows), 0 if all(r["within_bound"] for r in rows) else 1
     if kind == "physical":
         from . import physical as P
 

@@ -247,3 +247,16 @@ def test_averaged_flow_against_full_integration_within_its_bound_and_second_orde
         mus.append(mu[k])
     order = np.polyfit(np.log(mus), np.log(errs), 1)[0]
     assert order > 1.5, (order, errs)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("chi_deg", [14.0, 16.5])
+def test_free_forced_ratio_of_full_runs_goes_as_tau_to_alpha_plus_one(chi_deg):
+    """The same from full integration (tol 1e-14, one start): the full run's free/forced ratio,
+    read through the transform, falls or grows as tau^(alpha + 1) over 1e8 .. 1e11."""
+    f = AV.Flow("reduced", 0.5, math.radians(chi_deg))
+    tau = np.logspace(8, 11, 13)
+    w = full_run("reduced", 0.5, math.radians(chi_deg), np.array([0.06, -0.05, 0.05]), tau, tol=1e-14)
+    a, b = AV.scaled_amplitudes(f, w[:, 0] + 1j * w[:, 1], w[:, 2], tau)
+    slope = np.polyfit(np.log(tau), np.log(f.free_forced_ratio(a * a, b * b, np.log(tau))), 1)[0]
+    assert slope == pytest.approx(f.ratio_exponent, abs=2e-3)

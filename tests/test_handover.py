@@ -229,3 +229,21 @@ def test_labels_and_end_states_equal_brute_force_at_1e12(model, delta, chi):
         a, b = AV.scaled_amplitudes(f, w[0] + 1j * w[1], w[2], 1e12)
         bound = eng["bound"][0, 0, k]
         assert abs(eng["abar_end"][0, 0, k] - a) <= bound and abs(abs(eng["bbar_end"][0, 0, k]) - b) <= bound
+
+
+@pytest.mark.slow
+def test_bench_against_the_peer_script(tmp_path):
+    """``--bench --peer``: the one-cell atlas as a whole command and the standalone heyoka
+    script as a whole process, timed one after the other, with the same end state: every
+    handed-over run within its bound of the peer's, the same labels."""
+    from pathlib import Path
+
+    from spinviz.regimes import bench
+
+    root = Path(__file__).resolve().parents[1]
+    rows = bench.against_peer(root / "benchmarks" / "atlas_cell.toml", str(root / "benchmarks" / "peer_heyoka_atlas.py"),
+                              cases=((8, 1e8),))
+    r = rows[0]
+    assert r["starts"] == 8 and r["tau_end"] == 1e8 and r["spinviz"]["wall_s"] > 0 and r["peer"]["cpu_s"] > 0
+    assert r["handed_over"] >= 6 and r["beyond_bound"] == 0 and r["d_abar_max"] < r["bound_median"]
+    assert "| 8 | 1e+08 |" in bench.format_peer(rows)

@@ -35,7 +35,7 @@ from .store import dataset as ST
 from .store import integrity as IN
 
 RUNS_PER_TASK = 32          # a task of ~32 runs lasts ~0.2-10 s: scheduling (~ms) stays below 1 %
-SMALL_WORK_S = 20.0         # estimated CPU seconds below which no cluster is started (docs/atlas.md, "Where it runs")
+SMALL_WORK_S = 15.0         # estimated CPU seconds below which no cluster is started (docs/atlas.md, "Where it runs")
 
 
 def work_s(spec: AtlasSpec, batch) -> float:

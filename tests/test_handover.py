@@ -247,3 +247,13 @@ def test_bench_against_the_peer_script(tmp_path):
     assert r["starts"] == 8 and r["tau_end"] == 1e8 and r["spinviz"]["wall_s"] > 0 and r["peer"]["cpu_s"] > 0
     assert r["handed_over"] >= 6 and r["beyond_bound"] == 0 and r["d_abar_max"] < r["bound_median"]
     assert "| 8 | 1e+08 |" in bench.format_peer(rows)
+
+
+def test_lanes_idle_and_busy_to_tau_1e20():
+    """At tau = 1e20 (t = 4e18 in spin units) a lane whose run is done idles at rest while the
+    others go on (its grid is its own, from 0: t + 1 would be t in float64): truncated T4 next
+    to TF, where runs hand over anywhere from 1e7 to 1e19 and one stays in full to the end."""
+    recs = HO.cell_records("truncated", 0.6, 1.0, directions(8, 1) * 0.04, Settings(tau_end=1e20, rtol=1e-8))
+    assert [r.label for r in recs] == ["T4"] * 8
+    tau_h = np.array([r.limit.get("tau_handover", np.nan) for r in recs])
+    assert np.isnan(tau_h).sum() >= 1 and np.nanmax(tau_h) > 1e17 and np.nanmin(tau_h) < 1e8

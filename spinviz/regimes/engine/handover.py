@@ -203,7 +203,7 @@ def integrate(jobs: list, model: str, tol: float, max_steps: int, mu_star: float
         grid = np.empty((M, n))
         for j in range(n):
             if lane[j] is None:
-                grid[:, j] = times[j] + np.arange(M)          # idle: at rest (a fixed point), any increasing grid
+                grid[:, j] = np.arange(M, dtype=float)         # idle: at rest from t = 0 (a fixed point)
                 continue
             job, k = lane[j], ks[j]
             col = np.concatenate([[times[j]], job.t[job.nxt:job.nxt + k]])
@@ -230,7 +230,7 @@ def integrate(jobs: list, model: str, tol: float, max_steps: int, mu_star: float
                 job.status, job.t_stop, done = ST.TOO_MANY_STEPS, float(job.tau[job.nxt - 1]), True
             if done:
                 lane[j] = None
-                state[:, j], times[j] = 0.0, times[j] + 1.0
+                state[:, j], times[j] = 0.0, 0.0
             else:                                      # restart from its own last sample
                 times[j], state[:, j] = job.t[job.nxt - 1], rows[m - 1]
 

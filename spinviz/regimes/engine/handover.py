@@ -597,7 +597,7 @@ def handed_record(job: _Job, r: dict, state, floor: float, st, series: bool = Tr
         omega[-1] = reconstruct(flow, r, tau, last_only=True)[-1]
     limit = {"tau_handover": float(t[0]), "mu_handover": job.mu_h, "bound": bound, "abar_end": math.sqrt(A),
              "bbar_end": r["sign_b"] * math.sqrt(B), "free_forced_ratio": lim["ratio"], "tau_1_2": crossing(flow, r, tau),
-             "limit_settled": int(lim["settled"] and not unresolved), "decades_to_settle": lim["decades"],
+             "limit_settled": int(lim["settled"] and lim["label_inf"] != "other"), "decades_to_settle": lim["decades"],
              "label_inf": RN.code(lim["label_inf"]), "noise_floor": floor, "spiral_unresolved": int(unresolved)}
     return RN.Record(lim["label"], early["label"], lim["label_inf"], confidence, 0, reason, C.Verdict(
         lim["label"], confidence, lim["label_inf"], reason, ev).vector(), omega[-1].copy(), tau_end, job.nsteps, 0, 0.0,

@@ -310,7 +310,7 @@ BYTES_PER_TASK = 1000            # a batch (its chi tuple, omega0 view, region),
 BYTES_PER_RUN = 16               # done mask, label codes and their copies
 CPU_S_PER_RUN = 0.010            # engine "taylor": a run to tau_end = 1e10, growing as sqrt(tau_end) (a spiral's steps)
 CPU_S_HANDED = 0.002             # engine "handover", a cell where the averaged flow holds: the same at any tau_end
-CPU_S_FULL = 0.005               # engine "handover", a cell integrated in full (5, 4|5, "?", TF), at 1e10: grows as tau_end^(1/4)
+CPU_S_FULL = (0.002, 0.021)      # engine "handover", a cell integrated in full (5, 4|5, "?"): a + b (tau_end/1e16)^(1/4)
 MAX_DAYS = 30.0                  # an embedded atlas expected to take longer is refused: it would not finish here
 MEMORY_SHARE = 0.5               # of physical memory, for this process (the workers need the rest)
 
@@ -319,13 +319,15 @@ def run_cost_s(settings: Settings, model: str, delta: float, chi: float) -> floa
     """The estimated CPU seconds of one run of ``model`` at (delta, chi): "taylor" as
     sqrt(tau_end); "handover" by whether the cell's runs hand over to the averaged flow
     (``physics.averaged.averaging_holds``: then the full stage to the hand-over, ~tau = 1e6 ..
-    1e10, whatever tau_end) or stay in full (the libration's steps grow as tau^(1/4))."""
+    1e10, whatever tau_end) or stay in full (the libration's steps grow as tau^(1/4): measured
+    2.8, 21, 179 ms a run at 1e10, 1e16, 1e20; docs/atlas.md, "Horizons")."""
     te = max(settings.tau_end, 1.0)
     if settings.engine == "taylor":
         return CPU_S_PER_RUN * math.sqrt(te / 1e10)
     if averaging_holds(model, float(delta), float(chi))[0]:
         return CPU_S_HANDED * min(1.0, math.sqrt(te / 1e8))
-    return CPU_S_FULL * (te / 1e10) ** 0.25
+    a, b = CPU_S_FULL
+    return a + b * (te / 1e16) ** 0.25
 
 
 @dataclass(frozen=True)

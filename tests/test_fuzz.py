@@ -142,7 +142,8 @@ def test_hostile_atlas_spec_gets_a_spec_or_one_line(doc, tmp_path_factory):
     starts and settings) or one ``SceneError`` line naming the file and the key."""
     from spinviz.errors import SceneError
     from spinviz.inputs.atlas import AtlasArguments
-    from spinviz.inputs.atlas_spec import check_feasible, load_spec
+    from spinviz.inputs.atlas_spec import load_spec
+    from spinviz.regimes.engine.cost import check_feasible
 
     path = tmp_path_factory.mktemp("atlas") / "a.toml"
     path.write_text(dumps(doc))

@@ -161,8 +161,8 @@ def test_an_atlas_that_cannot_finish_is_refused_before_any_work(tmp_path, monkey
     take months (the runs the averaged flow cannot carry are integrated in full: ~0.5 s each
     at 1e20).  The memory of this process and the time on its workers are estimated from the
     spec and the machine (here a 16 GB machine, one worker), and refused in one line naming the key."""
-    from spinviz.inputs import atlas_spec as SP
     from spinviz.regimes import api
+    from spinviz.regimes.engine import cost as SP
 
     def work(*a, **k):
         raise AssertionError("the atlas started working")

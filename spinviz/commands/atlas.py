@@ -69,7 +69,7 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     """Carry out ``spinviz atlas`` with the parsed ``args``; return its exit status."""
-    from ..regimes.api import RUNS_PER_TASK, atlas, default_out
+    from ..regimes.api import RUNS_PER_TASK, atlas
     from ..regimes.faults import AtlasIncomplete
 
     if args.verify is not None:
@@ -94,7 +94,7 @@ def run(args) -> int:
     if args.spec is None:
         raise UsageError("atlas: the spec is missing (spinviz atlas SPEC.toml, spinviz atlas --verify STORE, or "
                          "spinviz atlas --evidence KIND)")
-    from ..inputs.atlas_spec import load_spec
+    from ..inputs.atlas_spec import default_out, load_spec
 
     spec = load_spec(args.spec)                       # SceneError: file, key, reason
     if args.bench:

@@ -29,14 +29,14 @@ naming the field -- never pydantic's ``ValidationError``.  The name is the calle
 
 Limits that depend on more than a value -- the spin scale, the number of turns a horizon
 means, memory, an atlas's run time -- are checked by the request that knows them
-(``SimulationRequest``, ``regimes.spec.check_feasible``), before any work.
+(``SimulationRequest``, ``regimes.engine.cost.check_feasible``), before any work.
 
 To add a key: one annotated field in the request class of its table (type, range with the
 reason, default, a line in the class docstring).  The TOML key, the keyword argument, the
 error messages and -- for an atlas spec -- the spec's identity follow from it
-(``inputs.atlas`` says how ``[run]`` keys reach ``regimes.runs.Settings``).  A command-line
-option for it is one ``add_argument`` in ``spinviz.cli`` and one entry in that command's map
-of options to argument names.
+(``inputs.atlas`` says how ``[run]`` keys reach ``inputs.atlas_spec.Settings``).  A command-line
+option for it is one ``add_argument`` in its subcommand's module of ``spinviz.commands``, whose
+parser names the argument after the option.
 
 Importing this package loads nothing; its modules load pydantic when a scene, a spec or a
 call is first validated (~65 ms once per process with the schema's classes, measured on this

@@ -57,13 +57,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SceneError, SpecTypeError
-from ..physics.averaged import averaging_holds
+from ..atomic import check_parent_writable
+from ..errors import SceneError, SpecTypeError, UsageError
 from ..physics.bodies import MIN_INERTIA_RATIO
 from . import atlas as IA
 from .base import fields_of
-from .render import usable_cores
-from .toml import document, read_toml, table
+from .toml import document, read_document
 
 FORMAT = 2                       # the store's version (identity): 2 = Taylor's method (heyoka), no atol
 
@@ -202,26 +201,34 @@ def load_spec(path) -> AtlasSpec:
     if not isinstance(path, str | os.PathLike):
         raise SpecTypeError("spec", f"must be the path of an atlas spec (TOML) or an AtlasSpec, got {type(path).__name__}")
     path = os.fspath(path)
-    return parse_spec(read_toml(path, kind="atlas spec"), path)
+    return _build(path, *read_document(path, IA.AtlasFile, _TABLES, _EMPTY, "atlas spec", _NESTED))
 
 
 # every table of a spec, validated in one place (inputs.toml.document) before anything is computed
 _TABLES = {"grid": IA.GridTable, "members": IA.MembersTable, "run": IA.RunTable, "classify": IA.ClassifyTable,
            "refine": IA.RefineTable, "output": IA.OutputTable}
+_EMPTY = ("run", "classify", "refine", "output")
+_NESTED = {"grid.delta": IA.AxisRange, "grid.chi": IA.AxisRange, "grid.chi_deg": IA.AxisRange}
 
 
 def parse_spec(data: dict, path: str = "<atlas spec>") -> AtlasSpec:
     """Validate a parsed TOML document (see the module docstring for every key)."""
     path = os.fspath(path)
-    top, tables = document(IA.AtlasFile, data, path, _TABLES, ("run", "classify", "refine", "output"))
+    return _build(path, *document(IA.AtlasFile, data, path, _TABLES, _EMPTY, _NESTED))
+
+
+def _build(path: str, top, tables: dict) -> AtlasSpec:
+    """The ``AtlasSpec`` of a validated document: the axes resolved, the starts drawn, the
+    rules across tables (inertia limit, refinement needs ranges, horizon, run cap) checked."""
     grid, members, run, classify, refine, output = (tables[k] for k in _TABLES)
-    deltas = _axis(path, "delta", grid.delta, (-1.0, 1.0), open_ends=True, unit="")
+    deltas = _axis(path, "delta", tables["grid.delta"] or grid.delta, (-1.0, 1.0), open_ends=True, unit="")
     if grid.chi_deg is not None:
-        chis_deg = _axis(path, "chi_deg", grid.chi_deg, (0.0, 90.0), open_ends=False, unit=" deg")
+        chis_deg = _axis(path, "chi_deg", tables["grid.chi_deg"] or grid.chi_deg, (0.0, 90.0), open_ends=False,
+                         unit=" deg")
         chis = np.radians(chis_deg)
         chis[chis_deg == 90.0] = 0.5 * math.pi             # exactly pi/2: the transverse case (5.5)
     else:
-        chis = _axis(path, "chi", grid.chi, (0.0, 0.5 * math.pi), open_ends=False, unit=" rad")
+        chis = _axis(path, "chi", tables["grid.chi"] or grid.chi, (0.0, 0.5 * math.pi), open_ends=False, unit=" rad")
     for d in deltas:
         if 1.0 - d < MIN_INERTIA_RATIO:
             raise SceneError(path, "[grid].delta", f"delta = {d:g}: 1 - delta = I3/I1 is below {MIN_INERTIA_RATIO:g}, "
@@ -257,17 +264,16 @@ def _ranges(grid) -> dict | None:
 
 
 def _axis(path, k: str, v, bounds: tuple, open_ends: bool, unit: str) -> np.ndarray:
-    """A grid axis: a list of values, or ``{min, max, cells}`` (the centres of ``cells``
-    equal cells, so never an end of the range)."""
+    """A grid axis: a list of values, or an ``AxisRange`` (validated by ``document``: the
+    centres of ``cells`` equal cells, so never an end of the range)."""
     lo, hi = bounds
     ends = f"({lo:g}, {hi:g})" if open_ends else f"[{lo:g}, {hi:g}]"
-    if isinstance(v, dict):
-        r = table(IA.AxisRange, v, f"grid.{k}", path)
-        if r.min < lo or r.max > hi:
-            raise SceneError(path, f"[grid.{k}].{'min' if r.min < lo else 'max'}",
-                             f"the range must lie within {ends}{unit}, got [{r.min:g}, {r.max:g}]")
-        out = r.min + (np.arange(r.cells) + 0.5) * (r.max - r.min) / r.cells
-        out[np.abs(out) < 1e-12 * (r.max - r.min)] = 0.0     # an odd count centred on 0 hits it exactly (delta = 0: (5.2))
+    if isinstance(v, IA.AxisRange):
+        if v.min < lo or v.max > hi:
+            raise SceneError(path, f"[grid.{k}].{'min' if v.min < lo else 'max'}",
+                             f"the range must lie within {ends}{unit}, got [{v.min:g}, {v.max:g}]")
+        out = v.min + (np.arange(v.cells) + 0.5) * (v.max - v.min) / v.cells
+        out[np.abs(out) < 1e-12 * (v.max - v.min)] = 0.0     # an odd count centred on 0 hits it exactly (delta = 0: (5.2))
         return out
     for x in v:
         if not (lo < x < hi if open_ends else lo <= x <= hi):
@@ -294,94 +300,26 @@ def _check_horizon(path, s: Settings, omega0) -> None:
                                                 f"least {IA.MIN_BRAKING_TIMES:g}")
 
 
+def default_out(spec: AtlasSpec) -> str:
+    """``<spec stem>.zarr`` in the current directory."""
+    stem = os.path.splitext(os.path.basename(spec.path))[0] or "atlas"
+    return f"{stem}.zarr"
+
+
+def store_path(spec: AtlasSpec, out: str | None) -> str:
+    """The store of ``spec``: ``out``, or ``default_out``; a directory to be created or an
+    existing atlas store (checked later), not a file, not the spec itself, in a writable
+    directory (``UsageError`` naming it)."""
+    path = out if out is not None else default_out(spec)
+    if os.path.exists(path) and not os.path.isdir(path):
+        raise UsageError(f"{path}: exists and is a file; an atlas store is a directory (e.g. atlas.zarr)")
+    if spec.path and os.path.exists(path) and os.path.exists(spec.path) and os.path.samefile(path, spec.path):
+        raise UsageError(f"{path}: is the spec itself")
+    check_parent_writable(path)
+    return path
+
+
 def directions(count: int, seed: int) -> np.ndarray:
     """``count`` unit vectors uniform on the sphere (normalized Gaussians), from ``seed``; shape (count, 3)."""
     v = np.random.default_rng(seed).normal(size=(count, 3))
     return v / np.linalg.norm(v, axis=1, keepdims=True)
-
-
-# --- can it finish? ------------------------------------------------------------------------------
-# What this process holds for an atlas, measured with tracemalloc around api.plan and the
-# store's predictions (64 x 64 cells x 32 members: 955 B a cell at the peak, 650 B a task),
-# with a margin; and what a run costs, one core, rtol 1e-8, classification included
-# (docs/atlas.md, "Benchmark" and "Horizons").
-BYTES_PER_CELL = 1200            # the paper's predictions at each (delta, chi), as Python lists, then float64
-BYTES_PER_TASK = 1000            # a batch (its chi tuple, omega0 view, region), its key and counters
-BYTES_PER_RUN = 16               # done mask, label codes and their copies
-CPU_S_PER_RUN = 0.010            # engine "taylor": a run to tau_end = 1e10, growing as sqrt(tau_end) (a spiral's steps)
-CPU_S_HANDED = 0.002             # engine "handover", a cell where the averaged flow holds: the same at any tau_end
-CPU_S_FULL = (0.002, 0.021)      # engine "handover", a cell integrated in full (5, 4|5, "?"): a + b (tau_end/1e16)^(1/4)
-MAX_DAYS = 30.0                  # an embedded atlas expected to take longer is refused: it would not finish here
-MEMORY_SHARE = 0.5               # of physical memory, for this process (the workers need the rest)
-
-
-def run_cost_s(settings: Settings, model: str, delta: float, chi: float) -> float:
-    """The estimated CPU seconds of one run of ``model`` at (delta, chi): "taylor" as
-    sqrt(tau_end); "handover" by whether the cell's runs hand over to the averaged flow
-    (``physics.averaged.averaging_holds``: then the full stage to the hand-over, ~tau = 1e6 ..
-    1e10, whatever tau_end) or stay in full (the libration's steps grow as tau^(1/4): measured
-    2.8, 21, 179 ms a run at 1e10, 1e16, 1e20; docs/atlas.md, "Horizons")."""
-    te = max(settings.tau_end, 1.0)
-    if settings.engine == "taylor":
-        return CPU_S_PER_RUN * math.sqrt(te / 1e10)
-    if averaging_holds(model, float(delta), float(chi))[0]:
-        return CPU_S_HANDED * min(1.0, math.sqrt(te / 1e8))
-    a, b = CPU_S_FULL
-    return a + b * (te / 1e16) ** 0.25
-
-
-@dataclass(frozen=True)
-class Cost:
-    """What an atlas needs: ``bytes`` in this process, ``cpu_s`` of integration, ``wall_s`` on ``workers``."""
-
-    runs: int
-    tasks: int
-    bytes: float
-    cpu_s: float
-    wall_s: float | None
-    workers: int | None
-
-
-def physical_memory() -> float:
-    """Bytes of physical memory (0 if unknown)."""
-    try:
-        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (ValueError, OSError, AttributeError):
-        return 0.0
-
-
-def cost(spec: AtlasSpec, runs_per_task: int = 32, workers: int | None = None) -> Cost:
-    """The estimate ``check_feasible`` judges: memory of this process, CPU time (``run_cost_s``
-    of every cell and model), and wall time on ``workers``."""
-    cells = len(spec.deltas) * len(spec.chis)
-    tm = min(spec.members, 256, max(1, runs_per_task))
-    tc = max(1, runs_per_task // tm)
-    tasks = len(spec.models) * len(spec.deltas) * math.ceil(len(spec.chis) / tc) * math.ceil(spec.members / tm)
-    nbytes = BYTES_PER_CELL * cells + BYTES_PER_TASK * tasks + BYTES_PER_RUN * spec.runs
-    if spec.settings.engine == "taylor":
-        cpu = spec.runs * run_cost_s(spec.settings, spec.models[0], 0.5, 0.5)
-    else:
-        cpu = spec.members * sum(run_cost_s(spec.settings, m, d, c) for m in spec.models for d in spec.deltas
-                                 for c in spec.chis)
-    return Cost(spec.runs, tasks, nbytes, cpu, None if not workers else cpu / workers, workers)
-
-
-def check_feasible(spec: AtlasSpec, arguments: IA.AtlasArguments) -> Cost:
-    """Refuse, before any work, an atlas that cannot finish here: more memory in this process
-    than half the machine's, or (on the embedded cluster) more than ``MAX_DAYS`` of work on
-    its workers.  ``SceneError`` names the spec and the key to change; returns the estimate."""
-    workers = None if arguments.scheduler is not None else (arguments.workers or usable_cores())
-    c = cost(spec, arguments.runs_per_task, workers)
-    mem = physical_memory()
-    if mem and c.bytes > MEMORY_SHARE * mem:
-        raise SceneError(spec.path, "[grid]", f"{c.runs} runs in {c.tasks} tasks would need ~{c.bytes / 1e9:.3g} GB in this "
-                                              f"process (~{BYTES_PER_CELL} B a cell, {BYTES_PER_TASK} B a task); this "
-                                              f"machine has {mem / 1e9:.3g} GB (limit {MEMORY_SHARE:g} of it): use fewer "
-                                              f"cells or members, or more runs per task")
-    if c.wall_s is not None and c.wall_s > MAX_DAYS * 86400.0:
-        raise SceneError(spec.path, "[grid]", f"{c.runs} runs to tau_end = {spec.settings.tau_end:g} would take "
-                                              f"~{c.wall_s / 86400.0:.3g} days on {workers} workers (engine "
-                                              f"{spec.settings.engine!r}: ~{c.cpu_s / max(1, c.runs):.3g} s a run); at most "
-                                              f"{MAX_DAYS:g} days: use fewer cells or members, a shorter [run].tau_end, "
-                                              f"or a cluster (scheduler)")
-    return c

@@ -24,23 +24,23 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..atomic import check_parent_writable
 from ..errors import SpecTypeError, UsageError, printable
 from ..inputs.atlas import AtlasArguments
-from ..inputs.atlas_spec import AtlasSpec, check_feasible, load_spec
+from ..inputs.atlas_spec import AtlasSpec, load_spec, store_path
 from ..interrupt import check, deferred
 from .engine import runs as RN
+from .engine.cost import check_feasible, run_cost_s
 from .faults import AtlasIncomplete, StoreDamaged
 from .store import dataset as ST
 from .store import integrity as IN
+from .store import levels as LV
 
 RUNS_PER_TASK = 32          # a task of ~32 runs lasts ~0.2-10 s: scheduling (~ms) stays below 1 %
 SMALL_WORK_S = 15.0         # estimated CPU seconds below which no cluster is started (docs/atlas.md, "Where it runs")
 
 
 def work_s(spec: AtlasSpec, batch) -> float:
-    """The estimated CPU seconds of a batch (``inputs.atlas_spec.run_cost_s`` per cell)."""
-    from ..inputs.atlas_spec import run_cost_s
+    """The estimated CPU seconds of a batch (``engine.cost.run_cost_s`` per cell)."""
 
     n = len(batch.omega0)
     return sum(n * run_cost_s(spec.settings, batch.model, d, c) for d in batch.deltas for c in batch.chis)
@@ -91,12 +91,6 @@ class AtlasResult:
                   f"{b['overhead_share']:.0f} % overhead; writing the store {st.write_s:.1f} s "
                   f"({b['write_share_of_wall']:.1f} % of the wall time)")
         return s
-
-
-def default_out(spec: AtlasSpec) -> str:
-    """``<spec stem>.zarr`` in the current directory."""
-    stem = os.path.splitext(os.path.basename(spec.path))[0] or "atlas"
-    return f"{stem}.zarr"
 
 
 def plan(spec: AtlasSpec, chunks: tuple, done: np.ndarray, runs_per_task: int = RUNS_PER_TASK):
@@ -151,15 +145,6 @@ def _runs_of(mask: np.ndarray) -> list[tuple[int, int]]:
     return out
 
 
-def check_out(path: str, spec_path: str | None = None) -> None:
-    """The store path: a directory to be created, or an existing atlas store (checked later)."""
-    if os.path.exists(path) and not os.path.isdir(path):
-        raise UsageError(f"{path}: exists and is a file; an atlas store is a directory (e.g. atlas.zarr)")
-    if spec_path and os.path.exists(path) and os.path.exists(spec_path) and os.path.samefile(path, spec_path):
-        raise UsageError(f"{path}: is the spec itself")
-    check_parent_writable(path)
-
-
 def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers: int | None = None,
           plot: str | None = None, progress: bool = True, runs_per_task: int = RUNS_PER_TASK,
           processes: bool = True, flush_s: float = 30.0, retry_failed: bool = False, on_result=None,
@@ -198,9 +183,8 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
                           runs_per_task=runs_per_task, processes=processes, flush_s=flush_s, retry_failed=retry_failed,
                           on_result=on_result)
     spec = spec if isinstance(spec, AtlasSpec) else load_spec(spec)
+    out = store_path(spec, args.out)
     check_feasible(spec, args)
-    out = args.out if args.out is not None else default_out(spec)
-    check_out(out, spec.path)
     if notify is not None and not callable(notify):
         raise SpecTypeError("notify", f"must be callable (line) or None, got {type(notify).__name__}")
     say = notify if notify is not None else _say
@@ -210,7 +194,7 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
 
         plots = check_plot_paths(plot, out, spec)
     t0 = time.perf_counter()
-    levels = [Level(spec, out, None)]
+    levels = [LV.Level(spec, out, None)]
     totals = {"todo": 0, "reused": 0, "repaired": 0, "failed": 0, "runs": 0}
     notices: list = []
     stats = None
@@ -221,7 +205,7 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
         cluster = _LazyCluster(stack, scheduler, workers, processes)
         for k in range(spec.refine_levels + 1):
             if k:
-                levels.append(refined_level(spec, out, levels, k))
+                levels.append(LV.refined_level(spec, out, levels, k))
                 if not levels[-1].wanted.any():
                     levels.pop()
                     break
@@ -245,66 +229,6 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
 
         res.plots = draw(out, plots)
     return res
-
-
-@dataclass
-class Level:
-    """One level of the quadtree (``refine``): its spec (level 0: the spec itself; level k: the
-    grid cut 2^k times finer), its store (level 0: ``out``; level k: ``out/levelK``, an atlas
-    store of its own), and the cells to compute (model, delta, chi) -- None: all."""
-
-    spec: AtlasSpec
-    out: str
-    wanted: np.ndarray | None
-
-    @property
-    def runs(self) -> int:
-        """Runs this level holds: all of its spec's, or its wanted cells' members."""
-        return self.spec.runs if self.wanted is None else int(self.wanted.sum()) * self.spec.members
-
-
-def level_spec(spec: AtlasSpec, k: int) -> AtlasSpec:
-    """The spec of refinement level ``k``: every axis cut 2^k times finer, the rest unchanged."""
-    from dataclasses import replace
-
-    from .engine import refine as RF
-
-    (d0, d1, nd), (c0, c1, nc) = spec.axes["delta"], spec.axes["chi"]
-    return replace(spec, title=f"{spec.title or os.path.basename(spec.path)}: refinement level {k}",
-                   deltas=RF.centres(d0, d1, nd, k), chis=RF.centres(c0, c1, nc, k), refine_levels=0,
-                   axes={"delta": (d0, d1, nd * 2**k), "chi": (c0, c1, nc * 2**k)})
-
-
-def refined_level(spec: AtlasSpec, out: str, levels: list, k: int) -> Level:
-    """Level ``k``: the children of the level-(k - 1) cells that ``refine.flags`` marks, from
-    the types the levels below computed (a cell counts as computed when all its members are)."""
-    from .engine import refine as RF
-
-    sub = level_spec(spec, k)
-    wanted = np.zeros((len(spec.models), len(sub.deltas), len(sub.chis)), dtype=bool)
-    for mi in range(len(spec.models)):
-        maj, share, comp = [], None, []
-        for lv in levels:
-            types, done = level_types(lv.out, mi)
-            m, share = RF.majority(types)
-            maj.append(m)
-            comp.append(done)
-        eff = RF.effective(maj, comp)
-        wanted[mi] = RF.children(RF.flags(maj[-1], share, comp[-1], eff, spec.refine_agree))
-    return Level(sub, ST.level_path(out, k), wanted)
-
-
-def level_types(path: str, model_index: int):
-    """(types (delta, chi, member) int, computed (delta, chi) bool) of one model of a level's
-    store: an approaching run counts for the type it approaches (``refine.type_of``)."""
-    import zarr
-
-    from .engine import refine as RF
-
-    g = zarr.open_group(path, mode="r", zarr_format=2)
-    codes = np.asarray(g["label_inf" if "label_inf" in g else "regime"][model_index])   # the type as tau -> oo
-    types = RF.type_of(codes, np.asarray(g["candidate"][model_index]))
-    return types, (np.asarray(g["done"][model_index]) == 1).all(axis=-1)
 
 
 class _LazyCluster:
@@ -342,7 +266,7 @@ class _LazyCluster:
             self.cl.close(fast=True)           # no point waiting for a cluster that is gone
 
 
-def _run_level(lv: Level, cluster: _LazyCluster, runs_per_task, flush_s, retry_failed, on_result, progress, say,
+def _run_level(lv: LV.Level, cluster: _LazyCluster, runs_per_task, flush_s, retry_failed, on_result, progress, say,
                notices: list, totals: dict):
     """Compute what level ``lv`` lacks (its wanted cells): the store created or verified and
     resumed, the batches planned, executed and written.  Returns the execution's stats or None."""

@@ -1,16 +1,17 @@
-"""Standalone peer of one atlas cell: heyoka's batch integrator on 2 threads, no spinviz.
+"""Standalone peer of one atlas cell: heyoka's batch integrator on both cores, no spinviz.
 
-    python benchmarks/peer_heyoka_atlas.py --runs 2048 --out peer.npz [--threads 2]
+    python benchmarks/peer_heyoka_atlas.py --runs 2048 --tau-end 1e10 --out peer.npz [--threads 2]
 
-The same work as ``spinviz atlas`` does for a one-cell spec (delta = 0.3, chi = 41.25 deg,
-|omega0| = 0.04, starts uniform on the sphere from seed 12, tau to 1e10, tol 1e-8, 20 samples
-a decade), written from the paper independently of spinviz's code: the dimensionless
-symmetric-top system (4.2)-(4.4), integrated in the scaled variable
-u = omega sqrt(1 + tau/T) / |omega0| (T = 1/|omega0|^2) with time s = |omega0| tau, so that
-heyoka's tolerance stays relative as omega ~ 1/sqrt(tau) falls; output on the same log grid.
-The batches (width heyoka.recommended_simd_size()) are spread over threads by
+The same work as ``spinviz atlas`` does for a one-cell spec (by default delta = 0.3,
+chi = 41.25 deg, |omega0| = 0.04, starts uniform on the sphere from seed 12, tol 1e-8, 20
+samples a decade from tau = 1e-2 to --tau-end), written from the paper independently of
+spinviz's code: the dimensionless symmetric-top system (4.2)-(4.4), integrated in the scaled
+variable u = omega sqrt(1 + tau/T) / |omega0| (T = 1/|omega0|^2) with time s = |omega0| tau, so
+that heyoka's tolerance stays relative as omega ~ 1/sqrt(tau) falls; output on the same log
+grid.  The batches (width heyoka.recommended_simd_size()) are spread over --threads threads by
 ``ensemble_propagate_grid_batch``.  It writes omega (runs, samples, 3) and tau; labels are
-compared afterwards with spinviz's classifier (not timed here).
+compared afterwards with spinviz's classifier (not timed here).  Every run is integrated to
+--tau-end: brute force, whose cost grows as sqrt(tau_end).
 """
 
 import argparse
@@ -24,18 +25,23 @@ import numpy as np
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--runs", type=int, default=2048)
+    ap.add_argument("--tau-end", type=float, default=1e10)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--tol", type=float, default=1e-8)
+    ap.add_argument("--delta", type=float, default=0.3)
+    ap.add_argument("--chi-deg", type=float, default=41.25)
+    ap.add_argument("--omega", type=float, default=0.04)
+    ap.add_argument("--seed", type=int, default=12)
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
     t_start = time.perf_counter()
-    delta, chi, w0 = 0.3, math.radians(41.25), 0.04
+    delta, chi, w0 = a.delta, math.radians(a.chi_deg), a.omega
     n1, n3 = math.sin(chi), math.cos(chi)
-    v = np.random.default_rng(12).normal(size=(a.runs, 3))
+    v = np.random.default_rng(a.seed).normal(size=(a.runs, 3))
     starts = v / np.linalg.norm(v, axis=1, keepdims=True)          # u(0) = omega(0) / |omega0|
     per = 20
-    n = int(round(per * math.log10(1e10 / 1e-2))) + 1
-    tau = np.concatenate([[0.0], np.logspace(-2, 10, n)])
+    n = int(round(per * math.log10(a.tau_end / 1e-2))) + 1
+    tau = np.concatenate([[0.0], np.logspace(-2, math.log10(a.tau_end), n)])
     s = tau * w0                                                     # time in units of 1/|omega0|
 
     # (4.2)-(4.4) in omega = w0 u / sigma, sigma = sqrt(1 + w0 s): d/ds = (1/w0) d/dtau
@@ -64,8 +70,7 @@ def main():
         return tc
 
     t_int = time.perf_counter()
-    res = hy.ensemble_propagate_grid_batch(ta, grid, nb, gen, algorithm="thread",
-                                           max_workers=a.threads)
+    res = hy.ensemble_propagate_grid_batch(ta, grid, nb, gen, algorithm="thread", max_workers=a.threads)
     t_done = time.perf_counter()
     out = np.empty((nb * B, len(tau), 3))
     for i, r in enumerate(res):
@@ -75,7 +80,7 @@ def main():
     omega = out[:a.runs] * (w0 / sig)[None, :, None]
     if a.out:
         np.savez(a.out, tau=tau, omega=omega)
-    print(f"{a.runs} runs, batch {B}, {a.threads} threads: integration {t_done - t_int:.3f} s "
+    print(f"{a.runs} runs to tau {a.tau_end:g}, batch {B}, {a.threads} threads: integration {t_done - t_int:.3f} s "
           f"({1e3 * (t_done - t_int) / a.runs:.2f} ms a run), build {t_int - t_start:.3f} s")
 
 

@@ -32,12 +32,15 @@ tau_end = 1e6
     ("validate", {"horizons": (1e10, 1e12)}, SpecError, "horizons: not used by --evidence validate"),
     ("convergence", {"horizons": (1e12, 1e10)}, SpecError, "horizons: must increase"),
     ("convergence", {"horizons": "1e10,x"}, SpecTypeError, "horizons: must be a list of horizons tau"),
-    ("convergence", {"horizons": (1e10, 1e300)}, SpecError, "horizons: each must lie in [100000, 1e+16]"),
+    ("convergence", {"horizons": (1e10, 1e300)}, SpecError, "horizons: each must lie in [100000, 1e+20]"),
+    ("handover", {"horizons": (1e12, 1e18)}, SpecError, "horizons: each must be at most 1e+16 for handover"),
+    ("handover", {"workers": 2}, SpecError, "workers: not used by --evidence handover"),
+    ("basins", {"tau_end": float("inf")}, SpecError, "tau_end: must be finite"),
     ("physical", {"tau_end": 0.0}, SpecError, "tau_end: must lie in [100000, 1e+16]"),
     ("physical", {"tau_end": float("nan")}, SpecError, "tau_end: must be finite"),
     ("convergence", {"out": "/nonexistent/a.zarr"}, UsageError, "--out /nonexistent/a.zarr: not an atlas store"),
     ("nonsense", {}, UsageError, "--evidence: nonsense is not one of validate, crosscheck, physical, convergence, "
-                                 "tolerance"),
+                                 "tolerance, handover, basins, flows"),
 ])
 def test_options_a_kind_does_not_take_are_refused_before_work(kind, options, error, message, monkeypatch):
     """Each refused before any work: the computation itself raises if reached."""
@@ -59,6 +62,18 @@ def test_tolerance_rows_against_the_tightest_rtol():
         assert all(r["runs"] == 18 and r["reference_rtol"] == 1e-11 for r in by.values())
         assert by[1e-5]["end_state_median"] > by[1e-8]["end_state_median"] > 0
     assert "| reduced | 1e-05 |" in CV.format_tolerance(rows)
+
+
+def test_handover_evidence_row_against_brute_force():
+    """One point of the hand-over evidence: engine and brute force on the same starts, the
+    labels compared, every handed-over end state within its bound of brute force's."""
+    from spinviz.validation.atlas import handover as HV
+
+    row = HV.compare_point("3 deep", "reduced", 0.8, 11.4, 0.1, 4, 1e10, 1e-10)
+    assert row["agreement"] == {"same": 4} and row["engine"] == {"3": 4} and row["handed_over"] == 4
+    assert row["beyond_bound"] == 0 and row["max_diff_over_bound"] < 1.0 and row["references"] == []
+    assert "| 3 deep | reduced | 1e+10 | 3 4 | 3 4 (3 4) | same 4 |" in HV.format_table([row])
+    assert HV.agreement("other", "3") == "undecided" and HV.agreement("1|2", "1") == "compatible"
 
 
 def test_convergence_rows_kept_in_the_store_which_stays_verifiable(tmp_path):

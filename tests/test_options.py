@@ -38,7 +38,7 @@ REFUSED = [
     # unbounded work, values a raw Python/NumPy message would meet, a zero that is not the default,
     # a count the kind's own atlas would refuse under its key
     (["atlas", "--evidence", "physical", "--tau-end", "1e300"], "--tau-end: must lie in [100000, 1e+16]"),
-    (["atlas", "--evidence", "convergence", "--horizons", "1e10,1e300"], "--horizons: each must lie in [100000, 1e+16]"),
+    (["atlas", "--evidence", "convergence", "--horizons", "1e10,1e300"], "--horizons: each must lie in [100000, 1e+20]"),
     (["atlas", "--evidence", "physical", "--tau-end", "nan"], "--tau-end: must be finite, got nan"),
     (["atlas", "--evidence", "physical", "--tau-end", "inf"], "--tau-end: must be finite, got inf"),
     (["atlas", "--evidence", "physical", "--tau-end", "-1"], "--tau-end: must lie in [100000, 1e+16]"),

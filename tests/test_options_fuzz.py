@@ -28,7 +28,7 @@ BASE = {                         # a valid invocation of each command, before th
 }
 STATUSES = {0, 1, 2, 75}         # success, a failed run, bad input, a busy store or lost cluster
 NUMBER_TYPES = {shared.whole, shared.real, shared.positive}
-# what no numeric option takes (the largest legitimate values are 1e16 horizons and 1e30 cm)
+# what no numeric option takes (the largest legitimate values are 1e20 horizons and 1e30 cm)
 MUST_REFUSE = ["nan", "inf", "-inf", "NaN", "1e300", "1" + "0" * 40]
 NUMBERS = ["nan", "inf", "-inf", "-1", "0", "1", "2", "3", "0.5", "1e-300", "1e300", "1e16", "-0", "5e-324",
            "1" + "0" * 40, "1e10", "100000"]

@@ -44,6 +44,16 @@ def same_atlas(a, b) -> None:
         assert dict(zarr.open_group(pa, mode="r").attrs) == dict(zarr.open_group(pb, mode="r").attrs)
 
 
+def counts(atlas) -> tuple[int, int, int]:
+    """(level-0 runs, level-1 cells, level-1 runs) the spec implies: level 0 the whole grid,
+    level 1 the children of the cells level 0's labels flag (``levels.wanted``)."""
+    from spinviz.inputs.atlas_spec import load_spec
+
+    spec = load_spec(atlas.spec)
+    cells = int(LV.wanted(spec, [str(atlas.store)], 1).sum())
+    return spec.runs, cells, cells * spec.members
+
+
 def verify(path, capsys):
     code = main(["atlas", "--verify", str(path)])
     return code, capsys.readouterr().out.strip().splitlines()
@@ -61,21 +71,24 @@ def copy(refined_atlas, tmp_path):
 
 
 def test_the_reference_verifies_ok_over_both_levels(refined_atlas, capsys):
+    n0, _, n1 = counts(refined_atlas)
+    assert n1 > 0
     code, lines = verify(refined_atlas.store, capsys)
-    assert code == 0 and lines[-1] == f"{refined_atlas.store}: ok: 104 runs verified over 2 refinement levels"
-    assert "level 1: runs: all 80 computed" in lines
+    assert code == 0 and lines[-1] == f"{refined_atlas.store}: ok: {n0 + n1} runs verified over 2 refinement levels"
+    assert f"level 1: runs: all {n1} computed" in lines
 
 
 def test_a_deleted_level_is_missing_not_ok_and_the_resume_computes_it(refined_atlas, copy, capsys):
-    """``rm -r STORE/level1``: 80 of the 104 runs gone is not "ok" -- the spec implies level 1,
+    """``rm -r STORE/level1``: the level's runs gone is not "ok" -- the spec implies level 1,
     so it is named missing, exit 1; the resume computes it, and only it."""
+    n0, cells, n1 = counts(refined_atlas)
     shutil.rmtree(copy / "level1")
     code, lines = verify(copy, capsys)
     assert code == 1, lines
-    assert "level 1: MISSING: the labels of level 0 call for 40 of its cells ([refine] levels = 1)" in lines
+    assert f"level 1: MISSING: the labels of level 0 call for {cells} of its cells ([refine] levels = 1)" in lines
     assert lines[-1] == f"{copy}: MISSING LEVEL: level1 missing (the same atlas command computes it)"
     res = resume(refined_atlas, copy)
-    assert (res.reused, res.computed) == (24, 80)
+    assert (res.reused, res.computed) == (n0, n1)
     same_atlas(copy, refined_atlas.store)
     assert verify(copy, capsys)[0] == 0
 
@@ -89,7 +102,7 @@ def test_a_level_without_its_zgroup_is_computed_again(refined_atlas, copy, capsy
     assert code == 1 and "level 1: DAMAGED: no .zgroup: not a whole Zarr store" in lines, lines
     assert lines[-1] == f"{copy}: DAMAGED LEVEL: level1 not a whole store (the same atlas command computes it again)"
     res = resume(refined_atlas, copy)
-    assert res.computed == 80
+    assert res.computed == counts(refined_atlas)[2]
     assert capsys.readouterr().err.strip() == (f"spinviz: {copy / 'level1'}: no .zgroup: not a whole Zarr store; the "
                                                f"level is computed again")
     same_atlas(copy, refined_atlas.store)
@@ -169,9 +182,10 @@ def test_an_incomplete_store_is_not_ok(refined_atlas, tmp_path, capsys):
         resume(refined_atlas, out, on_result=stop)
     done = int(ST.done_mask(str(out)).sum())
     code, lines = verify(out, capsys)
-    assert code == 1 and 0 < done < 24
-    assert f"runs: INCOMPLETE ({24 - done} of 24 not computed yet)" in lines
-    assert lines[-1] == f"{out}: INCOMPLETE: {24 - done} run(s) not computed yet; the same atlas command computes them"
+    n0 = counts(refined_atlas)[0]
+    assert code == 1 and 0 < done < n0
+    assert f"runs: INCOMPLETE ({n0 - done} of {n0} not computed yet)" in lines
+    assert lines[-1] == f"{out}: INCOMPLETE: {n0 - done} run(s) not computed yet; the same atlas command computes them"
 
 
 def test_a_changed_record_of_the_spec_is_damage(refined_atlas, copy, capsys):

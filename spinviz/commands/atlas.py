@@ -20,7 +20,7 @@ from ..errors import UsageError, printable
 from ..interrupt import check
 from .shared import positive, real, reals
 
-EVIDENCE = ("validate", "crosscheck", "physical", "convergence", "tolerance")
+EVIDENCE = ("validate", "crosscheck", "physical", "convergence", "tolerance", "handover", "basins", "flows")
 
 
 def add_parser(sub) -> None:
@@ -48,6 +48,10 @@ def add_parser(sub) -> None:
     a.add_argument("--bench", action="store_true",
                    help="instead: measure runs per second on 1 and 2 workers, the scheduling overhead and the memory "
                         "per worker on this spec (temporary stores), and project a 64 x 64 x 32 atlas")
+    a.add_argument("--peer", metavar="SCRIPT",
+                   help="with --bench, on a one-cell spec: the whole command against the standalone heyoka script "
+                        "SCRIPT (benchmarks/peer_heyoka_atlas.py) as a whole process, 256 starts to tau 1e10, 1e12, "
+                        "1e14 and the spec's starts to 1e10, with the end states compared")
     a.add_argument("--write-path", action="store_true",
                    help="with --bench: only the store's write path at the spec's size (chunk writes, checksums, "
                         "verification; no runs)")
@@ -55,11 +59,15 @@ def add_parser(sub) -> None:
     ev.add_argument("--evidence", metavar="KIND", choices=EVIDENCE,
                     help="validate (every domain against the paper's formulas), crosscheck (the disputed points with "
                          "SciPy), physical (against physical-unit simulate runs), convergence (horizon x 100, x 1e4 "
-                         "and 4x members; --out STORE keeps the rows in that atlas), tolerance (labels against rtol)")
+                         "and 4x members; --out STORE keeps the rows in that atlas), tolerance (labels against rtol), handover "
+                         "(the hand-over engine against brute force at 1e12 and 1e14; --out STORE keeps the rows), basins (the "
+                         "4|5 band: shares ending in 4 and 5 against beta), flows (the averaged flows against full "
+                         "integration: error, bound, order in mu)")
     ev.add_argument("--members", type=positive, help="starts per point (default: validate 32, crosscheck 3, physical 4, "
-                                                     "convergence 32, tolerance 8)")
-    ev.add_argument("--tau-end", type=real, help="physical: the horizon (default 1e10)")
-    ev.add_argument("--horizons", metavar="LIST", type=reals, help="convergence: the horizons (default 1e10,1e12,1e14)")
+                                                     "convergence 32, tolerance 8, handover 16, basins 32)")
+    ev.add_argument("--tau-end", type=real, help="physical: the horizon (default 1e10); basins: (default 1e16)")
+    ev.add_argument("--horizons", metavar="LIST", type=reals, help="convergence: the horizons (default "
+                                                                   "1e10,1e12,1e14,1e16,1e20); handover: (default 1e12,1e14)")
 
 
 def run(args) -> int:
@@ -84,6 +92,8 @@ def run(args) -> int:
         raise UsageError("--members, --tau-end and --horizons go with --evidence")
     if args.write_path and not args.bench:
         raise UsageError("--write-path goes with --bench")
+    if args.peer is not None and not args.bench:
+        raise UsageError("--peer goes with --bench")
     if args.spec is None:
         raise UsageError("atlas: the spec is missing (spinviz atlas SPEC.toml, spinviz atlas --verify STORE, or "
                          "spinviz atlas --evidence KIND)")
@@ -139,6 +149,15 @@ def _bench(spec, args) -> int:
                              ("--workers", args.workers if args.write_path else None)) if v]
     if unused:                                        # never ignored in silence
         raise UsageError(f"{unused[0]}: not used by --bench{' --write-path' if args.write_path else ''}")
+    if args.peer is not None:
+        import os
+
+        if not os.path.isfile(args.peer):
+            raise UsageError(f"--peer: {printable(args.peer, 200)}: no such file")
+        rows = bench.against_peer(spec, args.peer, progress=None if args.quiet else
+                                  lambda m: print(f"  {m}", file=sys.stderr, flush=True))
+        print(bench.format_peer(rows) if not args.json else json.dumps(rows, indent=2, default=float))
+        return 0
     if args.write_path:
         rows = bench.store_cost(spec)
         print(bench.format_store_cost(rows) if not args.json else json.dumps(rows, indent=2, default=float))

@@ -32,12 +32,12 @@ naming the field -- never pydantic's ``ValidationError``.  The name is the calle
 
 Limits that depend on more than a value -- the spin scale, the number of turns a horizon
 means, memory, an atlas's run time -- are checked by the request that knows them
-(``SimulationRequest``, ``regimes.spec.check_feasible``), before any work.
+(``SimulationRequest``, ``regimes.engine.cost.check_feasible``), before any work.
 
 To add a key: one annotated field in the request class of its table (type, range with the
 reason, default, a line in the class docstring).  The TOML key, the keyword argument, the
 error messages and -- for an atlas spec -- the spec's identity follow from it
-(``inputs.atlas`` says how ``[run]`` keys reach ``regimes.runs.Settings``).  A command-line
+(``inputs.atlas`` says how ``[run]`` keys reach ``inputs.atlas_spec.Settings``).  A command-line
 option for it is one ``add_argument`` in its command's module (``spinviz.commands.<name>``)
 whose ``dest`` is the argument's name: the dispatcher names a schema error by that option,
 and ``tests/test_options_fuzz.py`` fuzzes it from the parser.

@@ -18,7 +18,8 @@ how far and how finely to integrate, and how to classify::
     # or: list = [[0.0, 0.1, 0.0], ...]   explicit omega(0) vectors, body frame
 
     [run]
-    tau_end = 1e10                        # horizon, tau = t/tau0
+    engine = "handover"                   # or "taylor": every run integrated to tau_end (brute force)
+    tau_end = 1e10                        # horizon, tau = t/tau0 (at most 1e20; 1e16 with "taylor")
     tau_start = 1e-2                      # first sample after 0
     samples_per_decade = 20
     rtol = 1e-8                           # Taylor tolerance on omega sqrt(1 + tau/T) / |omega0| (T = 1/|omega0|^2)
@@ -31,12 +32,11 @@ Every member uses the same omega(0) at every cell and in both models, so that ce
 models are compared on the same starts (paired), and the store records them.
 
 Defaults and why: the asymptotic laws of section 4 need tau |omega0|^2 >> 1 (T = 1/|omega0|^2
-is the braking time); with |omega0| = 0.1 the default horizon 1e10 is 1e8 T.  The slowest
-regimes need it: near (delta, chi) = (0.3, 0.72) type 3's amplitudes still drift ~9 % a
-decade after 10 decades, and a type-4 phase with beta just below -3/4 is captured into type
-5 only at tau ~ 1e16.  Spirals cost ~ sqrt(tau_end) steps (~0.005-0.4 s a run at 1e10, up
-to ~3 s in the worst cells), so 1e10 is where the labels of the prototype's studies stopped
-changing while a 12 x 12 x 8 atlas still runs in minutes on two cores.  rtol 1e-8: Taylor's
+is the braking time); with |omega0| = 0.1 the default horizon 1e10 is 1e8 T.  The hand-over
+engine labels a spiral by the attractor of the averaged flow it is in, whatever tau_end, and
+its cost does not grow with tau_end; the regimes it integrates in full (the libration "5",
+TF) settle by 1e10 .. 1e16 and cost ~tau_end^(1/4) (the shipped atlases use 1e16).  With
+engine = "taylor" spirals cost ~ sqrt(tau_end) steps (~0.005-0.4 s a run at 1e10).  rtol 1e-8: Taylor's
 method on the scaled omega sqrt(1 + tau/T) / |omega0|, so the tolerance holds relative to the
 braking law to the end of the run (docs/atlas.md: labels and amplitudes against rtol).
 20 samples a decade and a 2-decade window: 41 samples, the labels are the same at 10-50.
@@ -44,8 +44,9 @@ braking law to the end of the run (docs/atlas.md: labels and amplitudes against 
 Every table is declared in ``spinviz.inputs.atlas`` (how to add a key is said there); this
 module builds the ``AtlasSpec`` from the validated tables -- every rule joining keys (the
 axes, the inertia limit, the horizon, the run cap) is checked here, once, and the spec is
-trusted after -- and says, before any work, whether the atlas can finish on this machine
-(``check_feasible``: memory, run count, time).
+trusted after -- and where its store goes (``store_path``).  Whether the atlas can finish on
+this machine (memory, time) is the engine's to say, from its measured costs
+(``regimes.engine.cost.check_feasible``), before any work.
 """
 
 from __future__ import annotations
@@ -57,13 +58,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SceneError, SpecTypeError
+from ..atomic import check_parent_writable, special_kind
+from ..errors import SceneError, SpecTypeError, UsageError
 from ..physics.bodies import MIN_INERTIA_RATIO
 from . import atlas as IA
 from .base import fields_of
-from .options import MAX_DAYS_ENV, max_days
-from .render import usable_cores
-from .toml import document, read_toml, table
+from .toml import document, read_document, table
 
 FORMAT = 2                       # the store's version (identity): 2 = Taylor's method (heyoka), no atol
 
@@ -75,6 +75,8 @@ class Settings:
     tau_end : horizon, tau = t/tau0.  tau_start : first sample after 0.  per_decade : samples
     a decade.  rtol : Taylor tolerance on the scaled omega sqrt(1 + tau/T) / |omega0|.
     max_steps : step budget of one run (of its SIMD batch).  window : decades the classifier analyses.
+    engine : "handover" (full integration until the averaged flow holds, then the averaged
+    flow: ``regimes.engine.handover``) or "taylor" (every run integrated to tau_end).
     """
 
     tau_end: float = 1e10
@@ -83,6 +85,7 @@ class Settings:
     rtol: float = 1e-8
     max_steps: int = 20_000_000
     window: float = 2.0
+    engine: str = "handover"
 
     def times(self) -> np.ndarray:
         """Output times [0, tau_start, ..., tau_end], ``per_decade`` log-spaced a decade."""
@@ -243,26 +246,34 @@ def load_spec(path) -> AtlasSpec:
     if not isinstance(path, str | os.PathLike):
         raise SpecTypeError("spec", f"must be the path of an atlas spec (TOML) or an AtlasSpec, got {type(path).__name__}")
     path = os.fspath(path)
-    return parse_spec(read_toml(path, kind="atlas spec"), path)
+    return _build(path, *read_document(path, IA.AtlasFile, _TABLES, _EMPTY, "atlas spec", _NESTED))
 
 
 # every table of a spec, validated in one place (inputs.toml.document) before anything is computed
 _TABLES = {"grid": IA.GridTable, "members": IA.MembersTable, "run": IA.RunTable, "classify": IA.ClassifyTable,
            "refine": IA.RefineTable, "output": IA.OutputTable}
+_EMPTY = ("run", "classify", "refine", "output")
+_NESTED = {"grid.delta": IA.AxisRange, "grid.chi": IA.AxisRange, "grid.chi_deg": IA.AxisRange}
 
 
 def parse_spec(data: dict, path: str = "<atlas spec>") -> AtlasSpec:
     """Validate a parsed TOML document (see the module docstring for every key)."""
     path = os.fspath(path)
-    top, tables = document(IA.AtlasFile, data, path, _TABLES, ("run", "classify", "refine", "output"))
+    return _build(path, *document(IA.AtlasFile, data, path, _TABLES, _EMPTY, _NESTED))
+
+
+def _build(path: str, top, tables: dict) -> AtlasSpec:
+    """The ``AtlasSpec`` of a validated document: the axes resolved, the starts drawn, the
+    rules across tables (inertia limit, refinement needs ranges, horizon, run cap) checked."""
     grid, members, run, classify, refine, output = (tables[k] for k in _TABLES)
-    deltas = _axis(path, "delta", grid.delta, (-1.0, 1.0), open_ends=True, unit="")
+    deltas = _axis(path, "delta", tables["grid.delta"] or grid.delta, (-1.0, 1.0), open_ends=True, unit="")
     if grid.chi_deg is not None:
-        chis_deg = _axis(path, "chi_deg", grid.chi_deg, (0.0, 90.0), open_ends=False, unit=" deg")
+        chis_deg = _axis(path, "chi_deg", tables["grid.chi_deg"] or grid.chi_deg, (0.0, 90.0), open_ends=False,
+                         unit=" deg")
         chis = np.radians(chis_deg)
         chis[chis_deg == 90.0] = 0.5 * math.pi             # exactly pi/2: the transverse case (5.5)
     else:
-        chis = _axis(path, "chi", grid.chi, (0.0, 0.5 * math.pi), open_ends=False, unit=" rad")
+        chis = _axis(path, "chi", tables["grid.chi"] or grid.chi, (0.0, 0.5 * math.pi), open_ends=False, unit=" rad")
     for d in deltas:
         if 1.0 - d < MIN_INERTIA_RATIO:
             raise SceneError(path, "[grid].delta", f"delta = {d:g}: 1 - delta = I3/I1 is below {MIN_INERTIA_RATIO:g}, "
@@ -298,17 +309,16 @@ def _ranges(grid) -> dict | None:
 
 
 def _axis(path, k: str, v, bounds: tuple, open_ends: bool, unit: str) -> np.ndarray:
-    """A grid axis: a list of values, or ``{min, max, cells}`` (the centres of ``cells``
-    equal cells, so never an end of the range)."""
+    """A grid axis: a list of values, or an ``AxisRange`` (validated by ``document``: the
+    centres of ``cells`` equal cells, so never an end of the range)."""
     lo, hi = bounds
     ends = f"({lo:g}, {hi:g})" if open_ends else f"[{lo:g}, {hi:g}]"
-    if isinstance(v, dict):
-        r = table(IA.AxisRange, v, f"grid.{k}", path)
-        if r.min < lo or r.max > hi:
-            raise SceneError(path, f"[grid.{k}].{'min' if r.min < lo else 'max'}",
-                             f"the range must lie within {ends}{unit}, got [{r.min:g}, {r.max:g}]")
-        out = r.min + (np.arange(r.cells) + 0.5) * (r.max - r.min) / r.cells
-        out[np.abs(out) < 1e-12 * (r.max - r.min)] = 0.0     # an odd count centred on 0 hits it exactly (delta = 0: (5.2))
+    if isinstance(v, IA.AxisRange):
+        if v.min < lo or v.max > hi:
+            raise SceneError(path, f"[grid.{k}].{'min' if v.min < lo else 'max'}",
+                             f"the range must lie within {ends}{unit}, got [{v.min:g}, {v.max:g}]")
+        out = v.min + (np.arange(v.cells) + 0.5) * (v.max - v.min) / v.cells
+        out[np.abs(out) < 1e-12 * (v.max - v.min)] = 0.0     # an odd count centred on 0 hits it exactly (delta = 0: (5.2))
         return out
     for x in v:
         if not (lo < x < hi if open_ends else lo <= x <= hi):
@@ -335,74 +345,28 @@ def _check_horizon(path, s: Settings, omega0) -> None:
                                                 f"least {IA.MIN_BRAKING_TIMES:g}")
 
 
+def default_out(spec) -> str:
+    """``<spec stem>.zarr`` in the current directory (``spec``: an ``AtlasSpec`` or its path)."""
+    path = spec if isinstance(spec, str | os.PathLike) else spec.path
+    stem = os.path.splitext(os.path.basename(os.fspath(path)))[0] or "atlas"
+    return f"{stem}.zarr"
+
+
+def store_path(spec: AtlasSpec, out: str | None) -> str:
+    """The store of ``spec``: ``out``, or ``default_out``; a directory to be created or an
+    existing atlas store (checked later), not a file or a special file, not the spec itself,
+    in a writable directory (``UsageError`` naming it)."""
+    path = out if out is not None else default_out(spec)
+    if os.path.exists(path) and not os.path.isdir(path):
+        kind = special_kind(os.stat(path).st_mode) or "a file"
+        raise UsageError(f"{path}: exists and is {kind}; an atlas store is a directory (e.g. atlas.zarr)")
+    if spec.path and os.path.exists(path) and os.path.exists(spec.path) and os.path.samefile(path, spec.path):
+        raise UsageError(f"{path}: is the spec itself")
+    check_parent_writable(path)
+    return path
+
+
 def directions(count: int, seed: int) -> np.ndarray:
     """``count`` unit vectors uniform on the sphere (normalized Gaussians), from ``seed``; shape (count, 3)."""
     v = np.random.default_rng(seed).normal(size=(count, 3))
     return v / np.linalg.norm(v, axis=1, keepdims=True)
-
-
-# --- can it finish? ------------------------------------------------------------------------------
-# What this process holds for an atlas, measured with tracemalloc around api.plan and the
-# store's predictions (64 x 64 cells x 32 members: 955 B a cell at the peak, 650 B a task),
-# with a margin; and what a run costs (docs/atlas.md, "Benchmark": 10.4 runs/s per worker on
-# the shipped atlas, tau_end = 1e10, both models).
-BYTES_PER_CELL = 1200            # the paper's predictions at each (delta, chi), as Python lists, then float64
-BYTES_PER_TASK = 1000            # a batch (its chi tuple, omega0 view, region), its key and counters
-BYTES_PER_RUN = 16               # done mask, label codes and their copies
-CPU_S_PER_RUN = 0.096            # a run to tau_end = 1e10 at rtol 1e-8, one core
-MAX_DAYS = 30.0                  # an embedded atlas expected to take longer is refused (options.max_days: SPINVIZ_MAX_DAYS)
-MEMORY_SHARE = 0.5               # of physical memory, for this process (the workers need the rest)
-
-
-@dataclass(frozen=True)
-class Cost:
-    """What an atlas needs: ``bytes`` in this process, ``cpu_s`` of integration, ``wall_s`` on ``workers``."""
-
-    runs: int
-    tasks: int
-    bytes: float
-    cpu_s: float
-    wall_s: float | None
-    workers: int | None
-
-
-def physical_memory() -> float:
-    """Bytes of physical memory (0 if unknown)."""
-    try:
-        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (ValueError, OSError, AttributeError):
-        return 0.0
-
-
-def cost(spec: AtlasSpec, runs_per_task: int = 32, workers: int | None = None) -> Cost:
-    """The estimate ``check_feasible`` judges: memory of this process, CPU time (a run's cost
-    grows as sqrt(tau_end), the steps of a spiral), and wall time on ``workers``."""
-    cells = len(spec.deltas) * len(spec.chis)
-    tm = min(spec.members, 256, max(1, runs_per_task))
-    tc = max(1, runs_per_task // tm)
-    tasks = len(spec.models) * len(spec.deltas) * math.ceil(len(spec.chis) / tc) * math.ceil(spec.members / tm)
-    nbytes = BYTES_PER_CELL * cells + BYTES_PER_TASK * tasks + BYTES_PER_RUN * spec.runs
-    cpu = spec.runs * CPU_S_PER_RUN * math.sqrt(max(spec.settings.tau_end, 1.0) / 1e10)
-    return Cost(spec.runs, tasks, nbytes, cpu, None if not workers else cpu / workers, workers)
-
-
-def check_feasible(spec: AtlasSpec, arguments: IA.AtlasArguments) -> Cost:
-    """Refuse, before any work, an atlas that cannot finish here: more memory in this process
-    than half the machine's, or (on the embedded cluster) more than ``MAX_DAYS`` of work on
-    its workers.  ``SceneError`` names the spec and the key to change; returns the estimate."""
-    workers = None if arguments.scheduler is not None else (arguments.workers or usable_cores())
-    c = cost(spec, arguments.runs_per_task, workers)
-    mem = physical_memory()
-    if mem and c.bytes > MEMORY_SHARE * mem:
-        raise SceneError(spec.path, "[grid]", f"{c.runs} runs in {c.tasks} tasks would need ~{c.bytes / 1e9:.3g} GB in this "
-                                              f"process (~{BYTES_PER_CELL} B a cell, {BYTES_PER_TASK} B a task); this "
-                                              f"machine has {mem / 1e9:.3g} GB (limit {MEMORY_SHARE:g} of it): use fewer "
-                                              f"cells or members, or more runs per task")
-    days = max_days()
-    if c.wall_s is not None and c.wall_s > days * 86400.0:
-        raise SceneError(spec.path, "[grid]", f"{c.runs} runs to tau_end = {spec.settings.tau_end:g} would take "
-                                              f"~{c.wall_s / 86400.0:.3g} days on {workers} workers (~{CPU_S_PER_RUN:g} s a "
-                                              f"run at tau_end 1e10, growing as sqrt(tau_end)); at most {days:g} days: "
-                                              f"use fewer cells or members, a shorter [run].tau_end, or a cluster "
-                                              f"(scheduler); someone who means it raises the cap with {MAX_DAYS_ENV}=DAYS")
-    return c

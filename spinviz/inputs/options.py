@@ -11,7 +11,7 @@ estimates the time its work takes on this machine from measured costs (below) an
 above ``max_days()`` -- 30 days unless the environment variable ``SPINVIZ_MAX_DAYS`` says
 otherwise, which is how someone who means it (on a machine or cluster that can take it)
 raises the cap; the message says so.  The atlas's own feasibility check
-(``atlas_spec.check_feasible``) reads the same cap.
+(``regimes.engine.cost.check_feasible``) reads the same cap.
 """
 
 from __future__ import annotations
@@ -157,7 +157,8 @@ class BenchRequest:
 
 # --- atlas --evidence KIND ------------------------------------------------------------------
 TAU_END_RANGE = (1e5, 1e16)      # below: the classifier's two 2-decade windows and 100 braking times of |omega0|
-#                                  = 0.04 do not fit; above: float64 time steps (the atlas's own limit)
+#                                  = 0.04 do not fit; above: float64 time steps (the limit of integration in full)
+HANDOVER_TAU_MAX = 1e20          # the hand-over engine's horizons (convergence, basins): where it was measured to hold
 MAX_HORIZONS = 8
 # Measured costs at tau = 1e10 (docs/atlas.md), growing as sqrt(tau / 1e10) -- the steps of a spiral:
 ATLAS_S_PER_RUN = 0.096          # a run of the atlas (one core; atlas_spec.CPU_S_PER_RUN)
@@ -165,9 +166,16 @@ PHYSICAL_S_PER_RUN = 0.094       # an atlas run and its physical-unit simulate r
 CROSSCHECK_S_PER_RUN = 25.0      # a SciPy DOP853 run of (4.2)-(4.4) at rtol 1e-10
 CONVERGENCE_S_PER_RUN = 0.0102   # a run of the study, per unit of sqrt(tau / 1e10) (8 min 46 s at its defaults)
 TOLERANCE_S_PER_RUN = 0.009      # a run of the 12 x 12 grid at one rtol (82 s for 9216)
-EVIDENCE_MEMBERS = {"validate": 32, "crosscheck": 3, "physical": 4, "convergence": 32, "tolerance": 8}
+# The hand-over engine (regimes.engine.cost): a run kept in full costs a + b (tau/1e16)^(1/4) s,
+# a handed-over one a; brute force in the handover kind 0.7 s per start and unit of sqrt(tau/1e10)
+# over its 19 points (1 222 s for 16 starts at 1e12 and 1e14, the machine shared)
+ENGINE_S_PER_RUN = (0.002, 0.021)
+HANDOVER_S_PER_START = 0.7
+EVIDENCE_MEMBERS = {"validate": 32, "crosscheck": 3, "physical": 4, "convergence": 32, "tolerance": 8, "handover": 16,
+                    "basins": 32, "flows": 1}
 ACCEPTS = {"validate": {"workers"}, "crosscheck": set(), "physical": {"tau_end"}, "convergence": {"horizons", "out"},
-           "tolerance": set()}             # what each kind takes on the command line beyond --members
+           "tolerance": set(), "handover": {"horizons", "out"}, "basins": {"tau_end"},
+           "flows": set()}         # what each kind takes on the command line beyond --members
 
 
 def check_accepts(kind: str, given: dict) -> None:
@@ -188,10 +196,10 @@ def _horizons(v):
         x = float(x)
         if not math.isfinite(x):
             raise ValueError(f"must be finite, got {brief(v)}")
-        lo, hi = TAU_END_RANGE
+        lo, hi = TAU_END_RANGE[0], HANDOVER_TAU_MAX
         if not lo <= x <= hi:
             raise ValueError(f"each must lie in [{lo:g}, {hi:g}] (the classifier's windows and 100 braking times below, "
-                             f"float64 time steps above), got {x:g}")
+                             f"where the hand-over engine was measured to hold above), got {x:g}")
         out.append(x)
     if not 2 <= len(out) <= MAX_HORIZONS:
         raise ValueError(f"give 2 to {MAX_HORIZONS} horizons, got {len(out)}")
@@ -205,11 +213,11 @@ class EvidenceRequest:
     """``spinviz atlas --evidence KIND``'s arguments (``validation.atlas.evidence.run``): the
     kind, the starts per point, and what the kind takes beyond them."""
 
-    kind: Literal["validate", "crosscheck", "physical", "convergence", "tolerance"]
+    kind: Literal["validate", "crosscheck", "physical", "convergence", "tolerance", "handover", "basins", "flows"]
     members: _count(10**9, "starts per point") | None = None
     workers: Annotated[Int, Field(ge=1)] | None = None
     tau_end: Annotated[Real, between(*TAU_END_RANGE, "the classifier's windows and 100 braking times below, float64 "
-                                                    "time steps above")] | None = None
+                                                    "time steps of integration in full above")] | None = None
     horizons: Annotated[Any, PlainValidator(_horizons)] | None = None
     out: Path = None
 
@@ -221,9 +229,13 @@ class EvidenceRequest:
             cores = usable_cores()
             if self.workers > cores:
                 raise SpecError("workers", f"must be at most {cores}, the cores this process may use, got {self.workers}")
+        if self.kind == "handover" and self.horizons and max(self.horizons) > TAU_END_RANGE[1]:
+            raise SpecError("horizons", f"each must be at most {TAU_END_RANGE[1]:g} for handover (brute force integrates "
+                                        f"in full to each), got {max(self.horizons):g}")
         n = self.n_members
-        key = "members" if self.members is not None else {"physical": "tau_end", "convergence": "horizons"}.get(
-            self.kind, "members")
+        key = "members" if self.members is not None else {"physical": "tau_end", "convergence": "horizons",
+                                                          "handover": "horizons", "basins": "tau_end"}.get(self.kind,
+                                                                                                           "members")
         check_work(key, self.seconds(), f"--evidence {self.kind} with {n} member(s) per point")
         return self
 
@@ -246,9 +258,17 @@ class EvidenceRequest:
             return 8 * n * PHYSICAL_S_PER_RUN * grows
         if self.kind == "tolerance":
             return 144 * n * 2 * 4 * TOLERANCE_S_PER_RUN * grows
-        horizons = self.horizons or (1e10, 1e12, 1e14)
-        units = sum(math.sqrt(h / horizons[0]) for h in horizons) + 4
-        return 14 * n * units * CONVERGENCE_S_PER_RUN * math.sqrt(horizons[0] / 1e10)
+        a, b = ENGINE_S_PER_RUN
+        full = lambda tau: a + b * (tau / 1e16) ** 0.25          # noqa: E731 -- an upper bound: every run in full
+        if self.kind == "basins":
+            return 12 * n * full(self.tau_end or 1e16)
+        if self.kind == "flows":
+            return 60.0                                           # eight starts to 1e10 at tol 1e-15 (measured 25-50 s)
+        if self.kind == "handover":
+            horizons = self.horizons or (1e12, 1e14)
+            return n * HANDOVER_S_PER_START * sum(math.sqrt(h / 1e10) for h in horizons)
+        horizons = self.horizons or (1e10, 1e12, 1e14, 1e16, 1e20)
+        return 15 * n * (sum(full(h) for h in horizons) + 4 * full(horizons[0]))
 
 
 # --- listen ------------------------------------------------------------------------------------

@@ -83,20 +83,27 @@ def read_toml(path, kind: str = "scene") -> dict:
         raise SceneError(path, "(file)", f"values nested too deeply to be a {kind}") from None
 
 
-def document(cls, data, path: str, tables: dict, empty: tuple = ()) -> tuple:
+def document(cls, data, path: str, tables: dict, empty: tuple = (), nested: dict | None = None) -> tuple:
     """A whole parsed document validated in one place: its top level as ``cls`` (every field
-    named in ``tables`` a sub-table), then each sub-table ``name`` as ``tables[name]``.
+    named in ``tables`` a sub-table), then each sub-table ``name`` as ``tables[name]``, then
+    each field ``"name.key"`` of ``nested`` that holds a table as ``nested["name.key"]`` (a
+    field that may be a list or a table: ``[grid].delta = {min, max, cells}``).
 
     Returns ``(top, {name: validated})``; an absent sub-table is None, or validated from ``{}``
-    (its defaults) when its name is in ``empty``.  Errors as ``table``'s."""
+    (its defaults) when its name is in ``empty``; a nested field that is not a table is None.
+    Errors as ``table``'s."""
     top = table(cls, data, "", path, tuple(tables))
     subs = {}
     for name, sub in tables.items():
         value = getattr(top, name)
         subs[name] = None if value is None and name not in empty else table(sub, {} if value is None else value, name, path)
+    for name, sub in (nested or {}).items():
+        outer, key = name.split(".")
+        value = getattr(subs[outer], key, None) if subs.get(outer) is not None else None
+        subs[name] = table(sub, value, name, path) if isinstance(value, dict) else None
     return top, subs
 
 
-def read_document(path, cls, tables: dict, empty: tuple = (), kind: str = "scene") -> tuple:
+def read_document(path, cls, tables: dict, empty: tuple = (), kind: str = "scene", nested: dict | None = None) -> tuple:
     """``document`` of the file at ``path`` (``read_toml``)."""
-    return document(cls, read_toml(path, kind), os.fspath(path), tables, empty)
+    return document(cls, read_toml(path, kind), os.fspath(path), tables, empty, nested)

@@ -168,8 +168,14 @@ def chi_of_xi(xi):
 
 def boundaries(model: str = "reduced", n: int = 801) -> list[dict]:
     """The lines of the delta-chi diagram: each a dict with ``name``, ``label`` (what the
-    diagram writes beside it), ``source`` ("paper" or "spinviz"), ``delta`` and ``chi`` (rad,
-    NaN where the line does not exist).
+    diagram writes beside it), ``source`` ("paper" or "spinviz"), ``kind`` -- what the line is
+    for the types as tau -> oo: "sharp" (the averaged flow's one stable state changes there, so
+    every start on each side ends in that side's type: (4.15) is where the axial state loses
+    its stability, alpha = -1/2; (4.17) for delta > -1/2 the transverse one, beta = -1/2;
+    alpha = -1 where the free spiral and the forced response trade places; truncated delta = 0
+    and beta_T = -1), "band" (beta = -3/4: beyond it type 4 is captured into 5, before it the
+    two coexist among the starts over a band) or "none" (the paper's (4.20) and (4.43), with
+    type 5 on both sides) -- ``delta`` and ``chi`` (rad, NaN where the line does not exist).
 
     Reduced: (4.15), (4.17) (= the lower bound of (4.19)), (4.20) (= its upper bound), (4.43)
     as printed and corrected (7 delta - 4, where (4.42)'s B is real), and spinviz's alpha = -1
@@ -185,26 +191,28 @@ def boundaries(model: str = "reduced", n: int = 801) -> list[dict]:
             d47 = np.where(d > 4.0 / 7.0, d, np.nan)
             db = np.where(d > -0.2, d, np.nan)
             lines += [
-                {"name": "(4.15): 2 | 3", "label": "(4.15)", "source": "paper", "delta": d, "chi": chi_of_xi(xi_eq4_15(d))},
-                {"name": "(4.17), (4.19): 3 | 4", "label": "(4.17), (4.19)", "source": "paper", "delta": dm,
+                {"name": "(4.15): 2 | 3", "label": "(4.15)", "source": "paper", "kind": "sharp", "delta": d,
+                 "chi": chi_of_xi(xi_eq4_15(d))},
+                {"name": "(4.17), (4.19): 3 | 4", "label": "(4.17), (4.19)", "source": "paper", "kind": "sharp", "delta": dm,
                  "chi": chi_of_xi(xi_eq4_17(dm))},
-                {"name": "(4.20), (4.19): 4 | ?", "label": "(4.20), (4.19)", "source": "paper", "delta": dp,
+                {"name": "(4.20), (4.19): 4 | ?", "label": "(4.20), (4.19)", "source": "paper", "kind": "none", "delta": dp,
                  "chi": chi_of_xi(xi_eq4_20(dp))},
-                {"name": "(4.43) as printed: 5", "label": "(4.43) printed", "source": "paper", "delta": d43,
+                {"name": "(4.43) as printed: 5", "label": "(4.43) printed", "source": "paper", "kind": "none", "delta": d43,
                  "chi": chi_of_xi(xi_eq4_43(d43))},
-                {"name": "(4.43) corrected: 7 delta - 4", "label": "(4.43) corrected", "source": "spinviz",
+                {"name": "(4.43) corrected: 7 delta - 4", "label": "(4.43) corrected", "source": "spinviz", "kind": "none",
                  "delta": d47, "chi": chi_of_xi(xi_spinviz_type5_real(d47))},
-                {"name": "alpha = -1 of (4.14): 1 | 2", "label": "(4.14) \u03b1 = \u22121", "source": "spinviz",
+                {"name": "alpha = -1 of (4.14): 1 | 2", "label": "(4.14) \u03b1 = \u22121", "source": "spinviz", "kind": "sharp",
                  "delta": d, "chi": chi_of_xi(xi_spinviz_alpha_minus_one(d))},
                 {"name": "beta = -3/4 of (4.18): 4 | 5", "label": "(4.18) \u03b2 = \u2212\u00be", "source": "spinviz",
-                 "delta": db, "chi": chi_of_xi(xi_spinviz_beta_minus_three_quarters(db))},
+                 "kind": "band", "delta": db, "chi": chi_of_xi(xi_spinviz_beta_minus_three_quarters(db))},
             ]
         else:
             dt = np.where(d > 0.5, d, np.nan)
             lines += [
-                {"name": "delta = 0: T2 | T4", "label": "\u03b4 = 0", "source": "spinviz", "delta": np.array([0.0, 0.0]),
+                {"name": "delta = 0: T2 | T4", "label": "\u03b4 = 0", "source": "spinviz", "kind": "sharp",
+                 "delta": np.array([0.0, 0.0]),
                  "chi": np.array([0.0, 0.5 * math.pi])},
-                {"name": "beta_T = -1: T4 | TF", "label": "\u03b2_T = \u22121", "source": "spinviz", "delta": dt,
+                {"name": "beta_T = -1: T4 | TF", "label": "\u03b2_T = \u22121", "source": "spinviz", "kind": "sharp", "delta": dt,
                  "chi": chi_of_xi(2.0 * (1.0 - dt) / (2.0 * dt - 1.0))},
             ]
     return lines

@@ -24,12 +24,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..atomic import check_parent_writable, special_kind
 from ..errors import SpecTypeError, UsageError, printable
 from ..inputs.atlas import AtlasArguments
-from ..inputs.atlas_spec import AtlasSpec, check_feasible, load_spec
+from ..inputs.atlas_spec import AtlasSpec, load_spec, store_path
 from ..interrupt import check, deferred
 from .engine import runs as RN
+from .engine.cost import check_feasible, run_cost_s
 from .faults import AtlasIncomplete, ForeignLevel, StoreDamaged
 from .store import dataset as ST
 from .store import integrity as IN
@@ -37,6 +37,14 @@ from .store import levels as LV
 from .store.lock import StoreLock
 
 RUNS_PER_TASK = 32          # a task of ~32 runs lasts ~0.2-10 s: scheduling (~ms) stays below 1 %
+SMALL_WORK_S = 15.0         # estimated CPU seconds below which no cluster is started (docs/atlas.md, "Where it runs")
+
+
+def work_s(spec: AtlasSpec, batch) -> float:
+    """The estimated CPU seconds of a batch (``engine.cost.run_cost_s`` per cell)."""
+
+    n = len(batch.omega0)
+    return sum(n * run_cost_s(spec.settings, batch.model, d, c) for d in batch.deltas for c in batch.chis)
 
 
 @dataclass
@@ -84,13 +92,6 @@ class AtlasResult:
                   f"{b['overhead_share']:.0f} % overhead; writing the store {st.write_s:.1f} s "
                   f"({b['write_share_of_wall']:.1f} % of the wall time)")
         return s
-
-
-def default_out(spec) -> str:
-    """``<spec stem>.zarr`` in the current directory (``spec``: an ``AtlasSpec`` or its path)."""
-    path = spec if isinstance(spec, str | os.PathLike) else spec.path
-    stem = os.path.splitext(os.path.basename(os.fspath(path)))[0] or "atlas"
-    return f"{stem}.zarr"
 
 
 def plan(spec: AtlasSpec, chunks: tuple, done: np.ndarray, runs_per_task: int = RUNS_PER_TASK):
@@ -145,16 +146,6 @@ def _runs_of(mask: np.ndarray) -> list[tuple[int, int]]:
     return out
 
 
-def check_out(path: str, spec_path: str | None = None) -> None:
-    """The store path: a directory to be created, or an existing atlas store (checked later)."""
-    if os.path.exists(path) and not os.path.isdir(path):
-        kind = special_kind(os.stat(path).st_mode) or "a file"
-        raise UsageError(f"{path}: exists and is {kind}; an atlas store is a directory (e.g. atlas.zarr)")
-    if spec_path and os.path.exists(path) and os.path.exists(spec_path) and os.path.samefile(path, spec_path):
-        raise UsageError(f"{path}: is the spec itself")
-    check_parent_writable(path)
-
-
 def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers: int | None = None,
           plot: str | None = None, progress: bool = True, runs_per_task: int = RUNS_PER_TASK,
           processes: bool = True, flush_s: float = 30.0, retry_failed: bool = False, on_result=None,
@@ -193,9 +184,8 @@ def atlas(spec, out: str | None = None, *, scheduler: str | None = None, workers
                           runs_per_task=runs_per_task, processes=processes, flush_s=flush_s, retry_failed=retry_failed,
                           on_result=on_result)
     spec = spec if isinstance(spec, AtlasSpec) else load_spec(spec)
+    out = store_path(spec, args.out)
     check_feasible(spec, args)
-    out = args.out if args.out is not None else default_out(spec)
-    check_out(out, spec.path)
     if notify is not None and not callable(notify):
         raise SpecTypeError("notify", f"must be callable (line) or None, got {type(notify).__name__}")
     say = notify if notify is not None else _say
@@ -271,7 +261,7 @@ def _check_store(spec: AtlasSpec, out: str) -> None:
     command that removes it (``ForeignLevel``), never mixed in and never deleted.  (A level
     that is damaged or missing is recomputed when its turn comes, ``_prepare_level``.)"""
     if not os.path.isdir(out):
-        return                                       # check_out has said what it is
+        return                                       # store_path has said what it is
     skeleton = IN.verify_skeleton(out)
     if skeleton is None:
         if not os.path.exists(os.path.join(out, ".zgroup")):
@@ -353,10 +343,21 @@ class _LazyCluster:
     def __init__(self, stack, scheduler, workers, processes):
         self.stack, self.args, self.cl, self.where = stack, (scheduler, workers, processes), None, "nothing to compute"
 
-    def get(self):
-        from .cluster import Cluster
+    def get(self, small: bool = False):
+        """The cluster; with ``small`` (little work, no scheduler or worker count asked for) this
+        process instead, in threads (``cluster.InProcess``), unless a cluster is already up."""
+        scheduler, workers, _ = self.args
+        if small and self.cl is None and scheduler is None and workers is None:
+            from ..inputs.render import usable_cores
+            from .inprocess import InProcess
 
+            here = InProcess(usable_cores())
+            if self.where == "nothing to compute":
+                self.where = here.describe
+            return here
         if self.cl is None:
+            from .cluster import Cluster
+
             scheduler, workers, processes = self.args
             self.cl = self.stack.enter_context(Cluster(scheduler, workers, processes=processes))
             self.where = self.cl.describe          # asked now: a cluster lost later cannot answer
@@ -371,12 +372,11 @@ class _LazyCluster:
             self.cl.close(fast=True)           # no point waiting for a cluster that is gone
 
 
-def _run_level(lv: Level, cluster: _LazyCluster, runs_per_task, flush_s, retry_failed, on_result, progress, say,
+def _run_level(lv: LV.Level, cluster: _LazyCluster, runs_per_task, flush_s, retry_failed, on_result, progress, say,
                notices: list, totals: dict):
     """Compute what level ``lv`` lacks (its wanted cells): the store created or verified and
     resumed, the batches planned, executed and written.  Returns the execution's stats or None."""
     from ..progress import Progress
-    from .cluster import execute
 
     spec, out = lv.spec, lv.out
     exists = os.path.exists(out)                     # a level's damaged or foreign store never gets here
@@ -401,7 +401,7 @@ def _run_level(lv: Level, cluster: _LazyCluster, runs_per_task, flush_s, retry_f
         if not exists and lv.wanted is None:       # an empty plan and no store: cannot happen
             raise UsageError(f"{spec.path}: the spec holds no runs")
         return None
-    cl = cluster.get()
+    cl = cluster.get(small=sum(work_s(spec, b) for b in batches) < SMALL_WORK_S)
     if not exists:
         ST.create(spec, out, chunks)
     writer = ST.Writer(out, expected, flush_s=flush_s)
@@ -410,7 +410,14 @@ def _run_level(lv: Level, cluster: _LazyCluster, runs_per_task, flush_s, retry_f
     bar = Progress(todo, f"atlas {printable(label, 80)}", enabled=progress)
     stats = None
     try:
-        stats = execute(cl, batches, keys, writer, bar, on_result=on_result)
+        from . import inprocess
+
+        if isinstance(cl, inprocess.InProcess):
+            stats = inprocess.execute(cl, batches, keys, writer, bar, on_result=on_result)
+        else:
+            from .cluster import execute
+
+            stats = execute(cl, batches, keys, writer, bar, on_result=on_result)
     finally:
         writer.close()
         bar.finish()

@@ -21,6 +21,7 @@ Measured on the spec as given, each time into a fresh temporary store, one after
 
 from __future__ import annotations
 
+import math
 import os
 import shutil
 import tempfile
@@ -54,7 +55,7 @@ def run(spec, workers: int | None = None, progress: bool = True) -> dict:
     larger of the two measurements) is checked first, by the atlas's own schema, and the spec's
     atlas must be feasible on it -- before the first measurement."""
     from ..inputs.atlas import AtlasArguments
-    from ..inputs.atlas_spec import check_feasible
+    from .engine.cost import check_feasible
 
     args = AtlasArguments(workers=workers, progress=progress)
     spec = spec if isinstance(spec, AtlasSpec) else load_spec(spec)
@@ -213,3 +214,118 @@ def format_table(r: dict) -> str:
         f"{max(p['max_task_s'] for p in r['by_workers'].values()):.0f} s, as the tail)",
     ]
     return "\n".join(lines)
+
+
+# --- against the standalone peer ----------------------------------------------------------------
+PEER_CASES = ((256, 1e10), (256, 1e12), (256, 1e14), (None, 1e10))   # (starts, tau_end); None: the spec's
+
+
+def against_peer(spec, script: str, cases=PEER_CASES, progress=None) -> list[dict]:
+    """The spec's one cell, ``spinviz atlas`` as a whole command, against the standalone heyoka
+    script ``script`` (``benchmarks/peer_heyoka_atlas.py``: the same cell, starts, tolerance and
+    output grid, every run integrated to tau_end on both cores) as a whole process, one after
+    the other in this one run, for each (starts, tau_end) of ``cases``: wall and CPU seconds
+    (the child processes' user + system), the machine's load before each, the ratio; and the
+    same end state (``_end_state``)."""
+    import json
+    import sys
+
+    from ..errors import UsageError
+
+    spec = spec if isinstance(spec, AtlasSpec) else load_spec(spec)
+    if len(spec.models) != 1 or len(spec.deltas) != 1 or len(spec.chis) != 1 or spec.seed is None:
+        raise UsageError(f"--peer: {spec.path}: needs a one-cell spec of one model with [members] count, seed and omega")
+    say = progress or (lambda m: None)
+    model, d, chi = spec.models[0], float(spec.deltas[0]), float(spec.chis[0])
+    run = json.loads(spec.canonical_json())["run"]
+    rows = []
+    tmp = tempfile.mkdtemp(prefix="spinviz-atlas-peer-")
+    try:
+        for n, te in cases:
+            n = n or spec.members
+            toml = os.path.join(tmp, f"cell_{n}_{te:.0e}.toml")
+            with open(toml, "w") as f:
+                f.write(f'title = "peer cell"\nmodel = "{model}"\n[grid]\ndelta = [{d!r}]\nchi = [{chi!r}]\n'
+                        f'[members]\ncount = {n}\nseed = {spec.seed}\nomega = {spec.omega_magnitude!r}\n[run]\n'
+                        + "".join(f"{k} = {json.dumps(v)}\n" for k, v in dict(run, tau_end=te).items())
+                        + "[output]\nseries = 0\n")
+            out, npz = os.path.join(tmp, f"s{n}_{te:.0e}.zarr"), os.path.join(tmp, f"p{n}_{te:.0e}.npz")
+            say(f"spinviz atlas: {n} starts to tau {te:g}")
+            mine = _timed([sys.executable, "-m", "spinviz", "atlas", toml, "--out", out, "--quiet"])
+            say(f"peer: {n} starts to tau {te:g}")
+            peer = _timed([sys.executable, script, "--runs", str(n), "--tau-end", repr(te), "--tol",
+                           repr(spec.settings.rtol), "--delta", repr(d), "--chi-deg", repr(math.degrees(chi)),
+                           "--omega", repr(spec.omega_magnitude), "--seed", str(spec.seed), "--out", npz])
+            rows.append({"starts": n, "tau_end": te, "spinviz": mine, "peer": peer,
+                         "ratio_wall": mine["wall_s"] / peer["wall_s"], "ratio_cpu": mine["cpu_s"] / peer["cpu_s"],
+                         **_end_state(model, d, chi, te, spec.settings.window, out, npz)})
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return rows
+
+
+def _timed(argv: list) -> dict:
+    """Run ``argv`` as a whole process: its wall and CPU seconds (children's user + system) and
+    the machine's load average before it."""
+    import resource
+    import subprocess
+
+    load = os.getloadavg()[0]
+    c0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    p = subprocess.run(argv, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    c1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if p.returncode != 0:
+        raise RuntimeError(f"{' '.join(argv[:4])}... failed ({p.returncode}): {p.stderr.strip()[-400:]}")
+    return {"wall_s": wall, "cpu_s": (c1.ru_utime - c0.ru_utime) + (c1.ru_stime - c0.ru_stime), "load": load}
+
+
+def _end_state(model: str, d: float, chi: float, tau_end: float, window: float, out: str, npz: str) -> dict:
+    """The store's runs against the peer's: every handed-over run's averaged end amplitudes
+    (``abar_end``, ``bbar_end``) against the peer's last sample read through the same transform
+    (``physics.averaged.scaled_amplitudes``), against the stated bound; and the labels (the
+    peer's samples through spinviz's classifier, not timed)."""
+    from collections import Counter
+
+    from ..physics import averaged as AV
+    from .engine import classify as C
+    from .store.dataset import open_atlas
+
+    ds = open_atlas(out).isel(model=0, delta=0, chi=0)
+    peer = np.load(npz)
+    w = peer["omega"][:, -1]
+    a, b = AV.scaled_amplitudes(AV.Flow(model, d, chi), w[:, 0] + 1j * w[:, 1], w[:, 2], tau_end)
+    handed = np.isfinite(ds["tau_handover"].values)
+    da = np.abs(ds["abar_end"].values - a)[handed]
+    db = np.abs(np.abs(ds["bbar_end"].values) - b)[handed]
+    bound = ds["bound"].values[handed]
+    labels = []
+    for x in peer["omega"]:
+        v = C.classify(peer["tau"], x, d, chi, model, window)
+        labels.append(f"->{v.candidate}" if v.label == "approaching" else v.label)
+
+    def stat(x, f):
+        return float(f(x)) if x.size else math.nan
+
+    return {"handed_over": int(handed.sum()), "beyond_bound": int(np.sum((da > bound) | (db > bound))),
+            "d_abar_median": stat(da, np.median), "d_abar_max": stat(da, np.max),
+            "d_bbar_median": stat(db, np.median), "d_bbar_max": stat(db, np.max),
+            "bound_median": stat(bound, np.median),
+            "labels_spinviz": dict(Counter(str(x) for x in ds["label"].values)), "labels_peer": dict(Counter(labels))}
+
+
+def format_peer(rows: list[dict]) -> str:
+    """The comparison with the peer as a Markdown table."""
+    lab = lambda c: ", ".join(f"{k} {v}" for k, v in sorted(c.items(), key=lambda kv: -kv[1]))  # noqa: E731
+    out = ["| starts | tau_end | spinviz atlas, whole command | peer, whole process | ratio (wall, CPU) | load | "
+           "same end state: |d abar|, |d bbar| median (max), beyond bound | labels spinviz / peer |",
+           "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        s, p = r["spinviz"], r["peer"]
+        out.append(f"| {r['starts']} | {r['tau_end']:.0e} | {s['wall_s']:.2f} s ({s['cpu_s']:.2f} s CPU) | "
+                   f"{p['wall_s']:.2f} s ({p['cpu_s']:.2f} s CPU) | {r['ratio_wall']:.3g}, {r['ratio_cpu']:.3g} | "
+                   f"{s['load']:.1f}, {p['load']:.1f} | {r['d_abar_median']:.1e} ({r['d_abar_max']:.1e}), "
+                   f"{r['d_bbar_median']:.1e} ({r['d_bbar_max']:.1e}); {r['beyond_bound']} of {r['handed_over']} "
+                   f"(bound median {r['bound_median']:.1e}) | {lab(r['labels_spinviz'])} / {lab(r['labels_peer'])} |")
+    return "\n".join(out)

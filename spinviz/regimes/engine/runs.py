@@ -30,6 +30,7 @@ import numpy as np
 from ...inputs.atlas_spec import Settings
 from ...integrators import status as ST
 from . import classify as C
+from . import limit as LM
 
 STOPPED_RESIDUAL = ST.STOPPED_RESIDUAL   # stopped early: residual rotation about d reached where it is the exact end state
 SINGULAR_START = ST.SINGULAR_START       # truncated (2.5) singular or nearly so at omega(0)
@@ -38,8 +39,9 @@ STATUS_TEXT = {ST.OK: "ok", ST.TOO_MANY_STEPS: "step budget exhausted", ST.STEP_
                ST.NOT_FINITE: "not finite", ST.STIFF: "stiff", ST.TURN_TOO_LARGE: "turn too large",
                ST.INTERRUPTED: "interrupted", ST.RUNAWAY: "runaway", STOPPED_RESIDUAL: "stopped: residual rotation reached",
                SINGULAR_START: "singular start", ERROR: "error"}
-METHOD = "taylor"          # the one method used (the store's ``method`` variable names it per run)
-METHOD_CODE = {METHOD: 0}
+METHOD = "taylor"          # brute force: Taylor's method to tau_end (the store's ``method`` names it per run)
+HANDED_OVER = "taylor+averaged"   # the hand-over engine's runs: Taylor's method, then the averaged flow
+METHOD_CODE = {METHOD: 0, HANDED_OVER: 1}
 SINGULAR_MARGIN = 0.5      # truncated: refuse a start where 1 + (g x omega).J^-1 g < this
 RESIDUAL_ETA = 1e-9        # rad: |d x omega|/(|d||omega|) at which a run in an exact-residual cell stops
 
@@ -89,6 +91,9 @@ class Record:
     nsteps: int
     nfev: int
     seconds: float
+    limit: dict | None = None     # ``limit.RECORDS`` the run fills (the rest stay blank)
+    method: str = METHOD
+    series: np.ndarray | None = None   # (N, 3) on the spec's grid, when the engine made it another way than a Run
 
 
 def classify_run(r, model: str, delta: float, chi: float, settings: Settings) -> Record:
@@ -173,27 +178,21 @@ class Batch:
 def run_batch(batch: Batch) -> dict:
     """Run and classify every run of ``batch``; arrays shaped (n_delta, n_chi, n_member[, k]).
 
+    The spec's ``[run].engine`` chooses how: "handover" (``handover.run_batch``: full
+    integration until the averaged flow holds, then the averaged flow) or "taylor" (brute
+    force: every run integrated to tau_end, here).
+
     Also returns where and how it ran: ``worker_pid``, ``compute_s`` (wall time inside this
     function), ``classify_s`` (of which: classifying the runs), ``cpu_s`` (the process's CPU
     time meanwhile: below ``compute_s`` when other work on the machine took the core) and
     ``max_rss_mb`` (the worker process's peak resident memory so far)."""
+    if batch.settings.engine == "handover":
+        from . import handover
+
+        return handover.run_batch(batch)
     start, cpu0 = time.perf_counter(), time.process_time()
-    nd, nc, nm = len(batch.deltas), len(batch.chis), len(batch.omega0)
-    shape = (nd, nc, nm)
-    out = {
-        "regime": np.empty(shape, dtype=np.int8), "regime_early": np.empty(shape, dtype=np.int8),
-        "candidate": np.empty(shape, dtype=np.int8), "status": np.empty(shape, dtype=np.int8),
-        "method": np.full(shape, METHOD_CODE[METHOD], dtype=np.int8),
-        "confidence": np.empty(shape), "tau_reached": np.empty(shape), "run_seconds": np.empty(shape),
-        "nsteps": np.empty(shape, dtype=np.int64), "nfev": np.empty(shape, dtype=np.int64),
-        "evidence": np.empty(shape + (len(C.EVIDENCE),)), "omega_final": np.empty(shape + (3,)),
-        "reason": np.empty(shape, dtype=f"<U{REASON_CHARS}"),
-    }
-    cells = [(float(d), float(c)) for d in batch.deltas for c in batch.chis for _ in range(nm)]
-    starts = [np.asarray(batch.omega0[k], dtype=float) for _ in batch.deltas for _ in batch.chis for k in range(nm)]
-    ks = batch.series_members
-    if ks:
-        out["series"] = np.full((nd, nc, ks, len(batch.settings.times()), 3), np.nan, dtype=np.float32)
+    out = outputs(batch)
+    cells, starts = flat_runs(batch)
     classify_s = 0.0
     try:
         runs = integrate_many(batch.model, cells, starts, batch.settings)
@@ -205,27 +204,63 @@ def run_batch(batch: Batch) -> dict:
     except Exception as e:                        # the whole batch failed: every run says why
         runs, records = [], [_error_record(e)] * len(cells)
     for n, run in enumerate(runs):
-        i, rest = divmod(n, nc * nm)
-        j, k = divmod(rest, nm)
-        if k < ks:
-            out["series"][i, j, k] = run.omega
+        records[n].series = run.omega
     for n, r in enumerate(records):
-        i, rest = divmod(n, nc * nm)
-        j, k = divmod(rest, nm)
-        out["regime"][i, j, k] = code(r.label)
-        out["regime_early"][i, j, k] = code(r.label_early)
-        out["candidate"][i, j, k] = code(r.candidate)
-        out["status"][i, j, k] = r.status
-        out["confidence"][i, j, k] = r.confidence
-        out["tau_reached"][i, j, k] = r.tau_reached
-        out["run_seconds"][i, j, k] = r.seconds
-        out["nsteps"][i, j, k] = r.nsteps
-        out["nfev"][i, j, k] = r.nfev
-        out["evidence"][i, j, k] = r.evidence
-        out["omega_final"][i, j, k] = r.omega_final
-        out["reason"][i, j, k] = r.reason[:REASON_CHARS]
+        put(out, batch, n, r)
     return {"region": batch.region, "data": out, "worker_pid": os.getpid(), "compute_s": time.perf_counter() - start,
             "classify_s": classify_s, "cpu_s": time.process_time() - cpu0, "max_rss_mb": max_rss_mb()}
+
+
+def flat_runs(batch: Batch) -> tuple[list, list]:
+    """The batch's runs in store order (delta, chi, member): ([(delta, chi)], [omega0])."""
+    nm = len(batch.omega0)
+    cells = [(float(d), float(c)) for d in batch.deltas for c in batch.chis for _ in range(nm)]
+    starts = [np.asarray(batch.omega0[k], dtype=float) for _ in batch.deltas for _ in batch.chis for k in range(nm)]
+    return cells, starts
+
+
+def outputs(batch: Batch) -> dict:
+    """The arrays a batch returns, shaped (n_delta, n_chi, n_member[, k]), before any run."""
+    shape = (len(batch.deltas), len(batch.chis), len(batch.omega0))
+    out = {
+        "regime": np.empty(shape, dtype=np.int8), "regime_early": np.empty(shape, dtype=np.int8),
+        "candidate": np.empty(shape, dtype=np.int8), "status": np.empty(shape, dtype=np.int8),
+        "method": np.full(shape, METHOD_CODE[METHOD], dtype=np.int8),
+        "confidence": np.empty(shape), "tau_reached": np.empty(shape), "run_seconds": np.empty(shape),
+        "nsteps": np.empty(shape, dtype=np.int64), "nfev": np.empty(shape, dtype=np.int64),
+        "evidence": np.empty(shape + (len(C.EVIDENCE),)), "omega_final": np.empty(shape + (3,)),
+        "reason": np.empty(shape, dtype=f"<U{REASON_CHARS}"),
+        **LM.blank(shape),
+    }
+    if batch.series_members:
+        out["series"] = np.full(shape[:2] + (batch.series_members, len(batch.settings.times()), 3), np.nan,
+                                dtype=np.float32)
+    return out
+
+
+def put(out: dict, batch: Batch, n: int, r: Record) -> None:
+    """Run ``n`` of the batch (store order) into ``out``."""
+    nc, nm = len(batch.chis), len(batch.omega0)
+    i, rest = divmod(n, nc * nm)
+    j, k = divmod(rest, nm)
+    out["regime"][i, j, k] = code(r.label)
+    out["regime_early"][i, j, k] = code(r.label_early)
+    out["candidate"][i, j, k] = code(r.candidate)
+    out["status"][i, j, k] = r.status
+    out["method"][i, j, k] = METHOD_CODE[r.method]
+    out["confidence"][i, j, k] = r.confidence
+    out["tau_reached"][i, j, k] = r.tau_reached
+    out["run_seconds"][i, j, k] = r.seconds
+    out["nsteps"][i, j, k] = r.nsteps
+    out["nfev"][i, j, k] = r.nfev
+    out["evidence"][i, j, k] = r.evidence
+    out["omega_final"][i, j, k] = r.omega_final
+    out["reason"][i, j, k] = r.reason[:REASON_CHARS]
+    out["label_inf"][i, j, k] = code(r.label)
+    for name, value in (r.limit or {}).items():
+        out[name][i, j, k] = value
+    if "series" in out and k < out["series"].shape[2] and r.series is not None:
+        out["series"][i, j, k] = r.series
 
 
 REASON_CHARS = 96
@@ -246,12 +281,22 @@ def max_rss_mb() -> float:
 
 
 def warm(settings: Settings | None = None) -> float:
-    """Load (or compile, once, into heyoka's on-disk cache) the batch integrator of both models
-    at the atlas's tolerance; returns the seconds it took."""
+    """Load (or compile, once, into heyoka's on-disk cache) the batch integrators of both models
+    at the atlas's tolerance -- and for the hand-over engine at a hundredth of it (the noise
+    floor's reruns) and the averaged stage's -- returns the seconds it took."""
     from ...integrators.taylor import template, tolerance, width
 
     t0 = time.perf_counter()
-    tol, _ = tolerance((settings or Settings()).rtol, (settings or Settings()).rtol)
+    st = settings or Settings()
+    tol, _ = tolerance(st.rtol, st.rtol)
     for model in ("reduced", "truncated"):
         template(model, "none", tol, "double", width())
+    if st.engine == "handover":
+        from . import handover
+
+        tight, _ = tolerance(st.rtol / 100.0, st.rtol / 100.0)
+        for model in ("reduced", "truncated"):
+            for t in (tol, tight):
+                template(model, "none", t, "double", width(), symmetric=True, residual=False, runaway=False)
+        handover.lv_template(width())
     return time.perf_counter() - t0

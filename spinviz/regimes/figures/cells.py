@@ -14,8 +14,10 @@ from .style import COEXIST, ORDER, WORDS
 
 def cell_types(ds, model: str):
     """(types, approaching): per (delta, chi, member) the type a run counts for in the diagram
-    (an "approaching X" run counts for X) as label strings, and whether it is still approaching."""
-    lab = ds["label"].sel(model=model).values
+    -- its type as tau -> oo (``limit_label``) where the store has it, else its label at
+    tau_end; an "approaching X" run counts for X -- as label strings, and whether it is still
+    approaching."""
+    lab = ds["limit_label" if "limit_label" in ds else "label"].sel(model=model).values
     appr = lab == "approaching"
     if appr.any():
         names = {v: k for k, v in C.CODE.items()}
@@ -104,6 +106,11 @@ def compose_levels(levels: list, model: str) -> list[dict]:
         finer = {(c["i"], c["j"]) for c in per[k + 1]} if k + 1 < len(per) else set()
         out += [c for c in cells if (2 * c["i"], 2 * c["j"]) not in finer]
     return out
+
+
+def limit_diagram(ds) -> bool:
+    """Whether the store holds the types as tau -> oo (the hand-over engine's ``label_inf``)."""
+    return "limit_label" in ds and json.loads(ds.attrs["spec"]).get("run", {}).get("engine") == "handover"
 
 
 def spec_of(ds) -> dict:

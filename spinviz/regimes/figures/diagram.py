@@ -1,9 +1,12 @@
 """The delta-chi diagram of an atlas (the paper's figures 2, 3.D and 5), as a PNG: one panel
 per model; each cell is split into bars whose widths are the shares of the types among its
-members (computed, not yet computed, failed and "other" included), with the paper's
+members (computed, not yet computed, failed and "other" included) -- as tau -> oo where the
+store holds the limit (the hand-over engine), else at tau_end -- with the paper's
 boundaries (4.15), (4.17), (4.19), (4.20), (4.43) drawn over it (black), spinviz's derived
 lines (blue: alpha = -1, red: beta = -3/4; see ``physics.asymptotics``) and the two DAST
-families of figure 5 (grey: family 1 solid, family 2 dash-dotted).
+families of figure 5 (grey: family 1 solid, family 2 dash-dotted).  Each line says what it is
+for the limit types (``asymptotics.boundaries``' kind): sharp (thick), a coexistence band
+(a translucent band) or no boundary of a limit type (thin).
 """
 
 from __future__ import annotations
@@ -14,7 +17,7 @@ import numpy as np
 
 from ...physics import asymptotics as FM
 from ...plotting import pyplot
-from .cells import compose_levels, spec_of
+from .cells import compose_levels, limit_diagram, spec_of
 from .style import COLORS, DELTA_AXIS, LINE_STYLE, ORDER, WORDS
 
 
@@ -32,6 +35,7 @@ def diagram(levels, path: str, title: str | None = None):
     one = len(models) == 1                  # one panel: the legend in 2 columns below, taller
     fig, axes = plt.subplots(1, len(models), figsize=(9.0, 8.8) if one else (7.2 * len(models), 7.6), squeeze=False)
     seen = set()
+    limit = limit_diagram(ds)
     for ax, model in zip(axes[0], models):
         seen |= _cells(ax, compose_levels(levels, model))
         _lines(ax, model)
@@ -40,8 +44,9 @@ def diagram(levels, path: str, title: str | None = None):
         ax.set_ylim(0, 90)
         ax.set_xlabel(DELTA_AXIS)
         ax.set_ylabel("\u03c7 = angle of the dipole from the symmetry axis (deg)")
-        ax.set_title(f"{model} model: type of each of {n} starts per cell", fontsize=11)
-    _legend(fig, seen, ncol=2 if one else 3)
+        what = "type as \u03c4 \u2192 \u221e" if limit else "type at \u03c4_end"
+        ax.set_title(f"{model} model: {what} of each of {n} starts per cell", fontsize=11)
+    _legend(fig, seen, ncol=2 if one else 3, limit=limit)
     s = spec_of(ds)
     w0 = s["members"]["omega"]
     starts = f"|\u03c9\u2080|\u00a0=\u00a0{w0}" if w0 else "explicit starts"     # one unbreakable phrase
@@ -49,7 +54,8 @@ def diagram(levels, path: str, title: str | None = None):
     if len(levels) > 1:
         fine = levels[-1]
         grid += f", refined {len(levels) - 1}\u00d7 near the boundaries to {fine.sizes['delta']} \u00d7 {fine.sizes['chi']}"
-    head = title or f"{ds.attrs.get('title', 'atlas')}   ({grid}; \u03c4_end = {s['run']['tau_end']:.0e}, {starts})"
+    how = "; full integration until the averaged flow holds, then the averaged flow" if limit else ""
+    head = title or f"{ds.attrs.get('title', 'atlas')}   ({grid}; \u03c4_end = {s['run']['tau_end']:.0e}, {starts}{how})"
     fig.suptitle("\n".join(textwrap.wrap(head, 95 if one else 150)), y=0.985, fontsize=11)
     fig.tight_layout(rect=(0, 0.2 if one else 0.13, 1, 0.95))
     save_small(fig, path, dpi=110)
@@ -84,12 +90,18 @@ def _cells(ax, cells: list[dict]) -> set:
 
 
 def _lines(ax, model: str) -> None:
-    """The analytic boundaries, each labelled with its equation, and the DAST families."""
+    """The analytic boundaries, each labelled with its equation and drawn as what it is for the
+    limit types (sharp: thick; a coexistence band: a translucent band under the line; no
+    boundary of a limit type: thin), and the DAST families."""
     for line in FM.boundaries(model):
         key = next(k for k in sorted(LINE_STYLE, key=len, reverse=True) if line["name"].startswith(k))
         color, ls, at = LINE_STYLE[key]
         d, c = line["delta"], np.degrees(line["chi"])
-        ax.plot(d, c, color=color, ls=ls, lw=1.6)
+        kind = line.get("kind", "sharp")
+        if kind == "band":
+            ax.plot(d, c, color=color, lw=9.0, alpha=0.25, solid_capstyle="butt", zorder=4)
+        ax.plot(d, c, color=color, ls=ls, lw={"sharp": 2.2, "band": 1.4, "none": 1.0}[kind],
+                alpha=0.65 if kind == "none" else 1.0, zorder=4)
         ok = np.isfinite(c) & (c > 2) & (c < 88)
         if np.ptp(d) == 0.0:  # a vertical line (delta = 0): its label half way up
             ax.annotate(line["label"], (d[0], 47.0), fontsize=7.5, color=color, ha="center", va="bottom", **_BOX)
@@ -105,7 +117,7 @@ def _lines(ax, model: str) -> None:
 _BOX = {"zorder": 6, "bbox": {"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85}}
 
 
-def _legend(fig, seen: set, ncol: int = 3) -> None:
+def _legend(fig, seen: set, ncol: int = 3, limit: bool = False) -> None:
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -113,10 +125,16 @@ def _legend(fig, seen: set, ncol: int = 3) -> None:
     extra = []
     if "approaching" in seen:
         extra.append(Patch(facecolor="0.75", edgecolor="white", hatch="////",
-                           label="hatched: still approaching that type at \u03c4_end (a slow hand-over)"))
+                           label=("hatched: not yet settled, integrated in full to \u03c4_end" if limit else
+                                  "hatched: still approaching that type at \u03c4_end (a slow hand-over)")))
     if "coexisting" in seen:
         extra.append(Line2D([], [], marker="o", ls="", color="black", markersize=4,
                             label="dot: two types coexist among the cell's starts (each \u2265 10 %)"))
+    if limit:
+        extra += [Line2D([], [], color="0.2", lw=2.2, label="thick line: sharp, one type for every start on each side"),
+                  Line2D([], [], color="#a3001b", lw=9.0, alpha=0.25,
+                         label="band: 4 and 5 coexist among the starts near \u03b2 = \u2212\u00be"),
+                  Line2D([], [], color="0.2", lw=1.0, alpha=0.65, label="thin line: bounds no type as \u03c4 \u2192 \u221e")]
     if "other" in seen:
         extra.append(Patch(facecolor=COLORS["other"], edgecolor="0.5", label="other: no type fits (yet)"))
     if "failed" in seen:

@@ -274,12 +274,16 @@ def page_of(levels: list) -> str:
                 warnings.simplefilter("ignore", RuntimeWarning)        # all-NaN cells: no median
                 med_c, med_e = np.nanmedian(conf, axis=-1), np.nanmedian(ev, axis=-2)
             w = sub["series"].isel(start=0).values.astype(float) if has_series else None
+            t_hand = sub["tau_handover"].values[..., 0] if "tau_handover" in sub else None
             for i, j in zip(*np.nonzero(done)):
                 cid = f"{model}:{k}:{i}:{j}"
                 medians[cid] = {"confidence": med_c[i, j], **{q: med_e[i, j, n] for n, q in enumerate(EVIDENCE)}}
                 if w is not None and np.isfinite(w[i, j]).any():
                     where = (f"{model} model, \u03b4 = {float(ds['delta'][i]):+.3f}, "
                              f"\u03c7 = {math.degrees(float(ds['chi'][j])):.2f}\u00b0")
-                    series[cid] = {"tau": tau, "omega": w[i, j], "label": str(lab[i, j, 0]), "where": where}
+                    t_h = float(t_hand[i, j]) if t_hand is not None else math.nan
+                    after = (f" (averaged flow from \u03c4 = {t_h:.0e}: the amplitudes the run's, the phase the "
+                             f"averaged one)") if math.isfinite(t_h) else ""
+                    series[cid] = {"tau": tau, "omega": w[i, j], "label": str(lab[i, j, 0]) + after, "where": where}
     return page(levels, series, lambda model, c: {q: v for q, v in medians.get(c["id"], {}).items()
                                                    if np.isfinite(v)})

@@ -11,6 +11,8 @@ Layout (dims ``model``, ``delta``, ``chi``, ``member``; ``axis`` = 1, 2, 3; ``qu
     evidence                          float64 (..., quantity): slopes, amplitudes, phase statistics
     omega_final                       float64 (..., axis): omega at tau_reached
     done                              int8   1 once the run's results are on disk
+    tau_handover, ..., label_inf      the run's limit (``LIMIT``: hand-over, bound, averaged end amplitudes,
+                                      free/forced ratio, settling, limit label, noise flags)
     omega0                            float64 (member, axis): the starts, the same at every cell
     paper                             float64 (delta, chi, formula): the formulas' predictions
 
@@ -51,6 +53,7 @@ from ...errors import UsageError
 from ...interrupt import deferred
 from ...physics import asymptotics as FM
 from ..engine import classify as C
+from ..engine import limit as LM
 from ..engine import runs as RN
 from . import integrity as IN
 
@@ -69,6 +72,32 @@ PER_RUN = {            # name -> (dtype, description)
     "reason": (f"<U{RN.REASON_CHARS}", "why this label, or why the run failed"),
     "done": ("int8", "1 once the run's results are on disk"),
 }
+# What a run says about its limit tau -> oo (engine.limit; the hand-over engine fills them, a
+# brute-force run leaves them blank, NaN or 0, but for label_inf)
+LIMIT = {
+    "tau_handover": "tau where the run left full integration for the averaged flow (NaN: in full to tau_end)",
+    "mu_handover": "the averaged flow's small parameter mu = |omega|^2/|delta omega3| (x max(1, |omega|/|omega3|), "
+                   "reduced) at the hand-over",
+    "bound": "stated bound on the error of abar_end, bbar_end: 0.2 mu_handover^2 |(a, b)| + noise_floor "
+             "(+ type 1's ln tau drift on the reduced axial state)",
+    "abar_end": "averaged omega_perp sqrt(tau) at tau_end (through the near-identity transform; NaN where it does not hold)",
+    "bbar_end": "averaged omega3 sqrt(tau) at tau_end, signed",
+    "free_forced_ratio": "free spiral / forced response of omega_perp at tau_end (reduced axial state: type 2's part "
+                         "against type 1's); it goes as tau^(alpha + 1)",
+    "tau_1_2": "tau where the free/forced ratio crosses 1 (extrapolated as tau^(alpha + 1) beyond tau_end; inf: never "
+               "in float64; NaN: it moves away from 1 or does not apply)",
+    "limit_settled": "1: within 5 % (ln A, ln B) of the attractor and, on the reduced axial state, the ratio past 0.1 "
+                     "(limit 1) or 10 (limit 2); full runs: the label held over the last two windows",
+    "decades_to_settle": "decades beyond tau_end still needed to settle (from the attractor's eigenvalues and alpha + 1)",
+    "label_inf": "the type as tau -> oo (flag_meanings): the attractor; for runs in full their label, a type-4 run "
+                 "where beta < -3/4 counted as 5 (captured into the libration)",
+    "noise_floor": "global error of the full stage at hand-over, scaled amplitudes (the cell's first handed-over "
+                   "runs of the task rerun at rtol/100); NaN: not measured",
+    "spiral_unresolved": "1: the free spiral at hand-over is below 10 x the noise floor (or the transform's residual): "
+                         "not evidence for 1 versus 2",
+    "returned_to_full": "1: the averaged flow stopped holding (mu > 3 mu_star) before tau_end; integrated in full again",
+}
+PER_RUN.update({name: (LM.RECORDS[name][0], desc) for name, desc in LIMIT.items()})
 FORMULAS = (
     "C2 (4.9)", "B (4.9)", "A (4.9) for C > 0",
     "alpha (4.14)", "B2 (4.14)", "in (4.15)",
@@ -125,7 +154,7 @@ def template(spec, chunks: tuple):
         fill = "" if dtype.startswith("<U") else (np.nan if dtype == "float64" else 0)
         arr = da.full(shape, fill, dtype=dtype, chunks=chunks)
         attrs = {"description": desc}
-        if name in ("regime", "regime_early", "candidate"):
+        if name in ("regime", "regime_early", "candidate", "label_inf"):
             attrs.update(label_flags)
         elif name == "status":
             attrs.update(_flags(RN.STATUS_TEXT))
@@ -171,7 +200,9 @@ def template(spec, chunks: tuple):
         "seed": -1 if spec.seed is None else int(spec.seed),
         "spinviz_version": __version__,
         "classifier_version": C.VERSION,
-        "method": f"{RN.METHOD} (heyoka batch mode, Euler equation only, on omega sqrt(1 + tau/T)), rtol {s.rtol:g}",
+        "method": (f"{RN.METHOD} (heyoka batch mode, Euler equation only, on omega sqrt(1 + tau/T)), rtol {s.rtol:g}"
+                   + (", handed over to the averaged flow where it holds (engine handover)" if s.engine == "handover"
+                      else "")),
         "conventions": "dimensionless (4.1): tau = t/tau0, omega = tau0 Omega; body frame; J = (1, 1, 1 - delta), "
                        "d = (sin chi, 0, cos chi)",
     }
@@ -377,8 +408,9 @@ def verify(path: str) -> IN.Report:
 
 
 def open_atlas(path: str):
-    """The store as an xarray Dataset, with ``label`` (strings) and the evidence unpacked into
-    one variable per quantity (``slope_perp``, ``X2``, ...); runs not computed yet are masked."""
+    """The store as an xarray Dataset, with ``label`` (strings; ``limit_label`` for the label as
+    tau -> oo, where the store has it) and the evidence unpacked into one variable per quantity
+    (``slope_perp``, ``X2``, ...); runs not computed yet are masked."""
     import xarray as xr
 
     ds = xr.open_zarr(path)
@@ -386,8 +418,11 @@ def open_atlas(path: str):
     for lab, c in C.CODE.items():
         names[c % 256] = lab
     done = ds["done"] == 1
-    ds["label"] = xr.apply_ufunc(lambda a: names[a.astype(np.int64) % 256].astype(str), ds["regime"].where(done, 0)
-                                 .astype(np.int8), dask="parallelized", output_dtypes=[str])
+    width = f"<U{max(len(k) for k in C.CODE)}"          # every block as wide as the longest label
+    for name, var in (("label", "regime"), ("limit_label", "label_inf")):
+        if var in ds:
+            ds[name] = xr.apply_ufunc(lambda a: names[a.astype(np.int64) % 256].astype(width), ds[var].where(done, 0)
+                                      .astype(np.int8), dask="parallelized", output_dtypes=[width])
     for q in C.EVIDENCE:
         ds[q] = ds["evidence"].sel(quantity=q, drop=True).where(done)
     return ds

@@ -48,7 +48,7 @@ def level_types(path: str, model_index: int):
     import zarr
 
     g = zarr.open_group(path, mode="r", zarr_format=2)
-    codes = np.asarray(g["regime"][model_index])
+    codes = np.asarray(g["label_inf" if "label_inf" in g else "regime"][model_index])   # the type as tau -> oo
     types = RF.type_of(codes, np.asarray(g["candidate"][model_index]))
     return types, (np.asarray(g["done"][model_index]) == 1).all(axis=-1)
 

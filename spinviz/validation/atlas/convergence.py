@@ -1,20 +1,20 @@
 """Convergence evidence for the atlas's labels: horizon, member count and tolerance.
 
-    spinviz atlas --evidence convergence [--members 32] [--horizons 1e10,1e12,1e14] [--out STORE] [--json]
+    spinviz atlas --evidence convergence [--members 32] [--horizons 1e10,1e12,1e14,1e16,1e20] [--out STORE] [--json]
     spinviz atlas --evidence tolerance [--members 8]
 
 For a validation subset -- the points of ``validate.POINTS`` (every domain of figure 2 and
 the truncated types) and the four points where the paper is disputed -- each point's starts
-are run to tau_end, 100 tau_end and 1e4 tau_end (1e10, 1e12, 1e14 by default), and with 4x the
-members at tau_end.  Per point the table says:
+are run by the atlas's engine (the hand-over engine, rtol 1e-10) to every horizon (1e10, 1e12,
+1e14, 1e16, 1e20 by default), and with 4x the members at the first.  Per point the table says:
 
 * the label shares at each horizon, and the share of the members that keep their label from
   tau_end to 1e4 tau_end;
 * the share of the 4x members carrying the point's main label, against the base members';
 * **coexistence**: two types each held by >= 10 % of the starts at every horizon (the starts
   stay apart as tau grows);
-* **slow hand-over**: members still changing between the horizons (their label at 1e4
-  tau_end differs from tau_end's, or they are "approaching" a type at the last horizon);
+* **slow hand-over**: members still changing between the horizons (their label at the last
+  horizon differs from the first's, or they are "approaching" a type at the last horizon);
 * the "other" share per horizon and what those runs are (the classifier's reasons).
 
 The rows are written as JSON (``--json``), into an atlas store as its ``convergence``
@@ -40,7 +40,7 @@ from ...inputs.atlas_spec import Settings, directions
 from ...regimes.engine import classify as C
 from ...regimes.engine.runs import classify_run, integrate_many
 
-HORIZONS = (1e10, 1e12, 1e14)
+HORIZONS = (1e10, 1e12, 1e14, 1e16, 1e20)
 COEXIST = 0.10            # a type held by at least this share of the starts at every horizon
 
 
@@ -56,20 +56,16 @@ def points() -> list[tuple]:
 
 def run_point(model: str, delta: float, chi: float, starts: np.ndarray, horizon: float, rtol: float,
               base: float = HORIZONS[0]) -> list:
-    """Records (``runs.Record``) of every start to ``horizon``.
+    """Records (``runs.Record``) of every start to ``horizon`` by the hand-over engine
+    (``handover.cell_records``), whose cost does not grow with the horizon where the averaged
+    flow holds, and which keeps the free spiral a brute-force run at rtol 1e-10 loses past
+    ~1e12 near alpha = -1 (docs/atlas.md, "The hand-over engine against brute force")."""
+    from ...regimes.engine.handover import cell_records
 
-    Beyond ``base`` the tolerance tightens as base/horizon and the step budget grows as
-    sqrt(horizon/base) (the steps of a spiral do): heyoka holds the error of the scaled state
-    as a whole, so a component falling faster than 1/sqrt(tau) -- type 1's omega_perp ~ 1/tau --
-    sinks into the error of the dominant one (measured at (-0.6, 17.2 deg): type 1 at 1e12 is "other" at
-    rtol 1e-8, type 1 at rtol 1e-10, and at 1e14 type 1 with omega_perp^2 tau = B^2/tau at 1e-12)."""
-    scale = max(1.0, horizon / base)
-    st = Settings(tau_end=horizon, rtol=rtol / scale, max_steps=int(Settings().max_steps * math.sqrt(scale)))
-    runs = integrate_many(model, [(delta, chi)] * len(starts), list(starts), st)
-    return [classify_run(r, model, delta, chi, st) for r in runs]
+    return cell_records(model, delta, chi, starts, Settings(tau_end=horizon, rtol=rtol))
 
 
-def study(members: int = 32, horizons=HORIZONS, rtol: float = 1e-8, seed: int = 1, progress=None) -> list[dict]:
+def study(members: int = 32, horizons=HORIZONS, rtol: float = 1e-10, seed: int = 1, progress=None) -> list[dict]:
     """Per point: labels per horizon and with 4x members (see the module docstring).
     ``members`` and ``horizons`` are checked first (``inputs.options.EvidenceRequest``)."""
     from ...inputs.options import EvidenceRequest
@@ -114,12 +110,15 @@ def summarize(name, model, d, cdeg, w, per_h: dict, many: list, seconds: float) 
                      and all(Counter(types[h])[t] / n >= COEXIST for h in hs))
     reasons = Counter(r.reason.split(" (")[0] for r in per_h[hs[-1]] if r.label == "other")
     many_types = [_type(r) for r in many]
+    names = {v: k for k, v in C.CODE.items()}
+    limit = Counter(names.get((r.limit or {}).get("label_inf", C.CODE.get(r.label, 0)), r.label) for r in per_h[hs[-1]])
+    settled = sum(int((r.limit or {}).get("limit_settled", 0)) for r in per_h[hs[-1]]) / n
     return {"point": name, "model": model, "delta": d, "chi_deg": cdeg, "omega0": w, "members": n,
             "shares": {f"{h:g}": dict(shares[h]) for h in hs}, "main": main,
             "keep_label": keep, "changing": changing, "coexisting": coexist if len(coexist) > 1 else [],
             "main_share": Counter(types[hs[0]])[main] / n, "main_share_4x": Counter(many_types)[main] / len(many_types),
             "other_share": {f"{h:g}": shares[h]["other"] / n for h in hs},
-            "other_reasons": dict(reasons), "seconds": seconds,
+            "other_reasons": dict(reasons), "seconds": seconds, "limit": dict(limit), "settled_last": settled,
             "X2": {f"{h:g}": float(np.median([r.evidence[C.EVIDENCE.index("X2")] for r in per_h[h]])) for h in hs}}
 
 
@@ -128,7 +127,7 @@ def format_table(rows: list[dict]) -> str:
     hs = list(rows[0]["shares"])
     lines = [f"| point | model | delta | chi | labels at tau = {' / '.join(hs)} | keep label {hs[0]} -> {hs[-1]} | "
              f"changing | coexisting | main type share, {rows[0]['members']} / {4 * rows[0]['members']} members | "
-             f"\"other\" |", "|---|---|---|---|---|---|---|---|---|---|"]
+             f"\"other\" | as tau -> oo (settled at {hs[-1]}) |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lab = " / ".join(", ".join(f"{k} {v}" for k, v in sorted(r["shares"][h].items(), key=lambda kv: -kv[1]))
                          for h in hs)
@@ -136,12 +135,14 @@ def format_table(rows: list[dict]) -> str:
         co = " + ".join(r["coexisting"]) or "no"
         lines.append(f"| {r['point']} | {r['model']} | {r['delta']:g} | {r['chi_deg']:.1f} | {lab} | "
                      f"{100 * r['keep_label']:.0f} % | {100 * r['changing']:.0f} % | {co} | "
-                     f"{r['main']}: {100 * r['main_share']:.0f} % / {100 * r['main_share_4x']:.0f} % | {oth} |")
+                     f"{r['main']}: {100 * r['main_share']:.0f} % / {100 * r['main_share_4x']:.0f} % | {oth} | "
+                     f"{', '.join(f'{k} {v}' for k, v in sorted(r.get('limit', {}).items(), key=lambda kv: -kv[1]))} "
+                     f"({100 * r.get('settled_last', 0.0):.0f} %) |")
     return "\n".join(lines)
 
 
-def record(store: str, rows: list[dict]) -> None:
-    """Keep the rows in an atlas store (root attribute ``convergence``, JSON), its metadata's
+def record(store: str, rows: list[dict], key: str = "convergence") -> None:
+    """Keep the rows in an atlas store (root attribute ``key``, JSON), its metadata's
     checksums recorded again (the store stays verifiable)."""
     import json
 
@@ -151,7 +152,7 @@ def record(store: str, rows: list[dict]) -> None:
 
     def write():
         g = zarr.open_group(store, mode="r+", zarr_format=2)
-        g.attrs["convergence"] = json.dumps(rows, default=float)
+        g.attrs[key] = json.dumps(rows, default=float)
         with warnings.catch_warnings():
             warnings.filterwarnings("ignore", message=".*checksums is not recognized")   # our record, not Zarr's
             zarr.consolidate_metadata(store)

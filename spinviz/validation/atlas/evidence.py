@@ -10,6 +10,14 @@
 ``convergence``           labels against horizon (x 100, x 1e4) and 4x members (``convergence``);
                           ``--out STORE`` keeps the rows in that atlas store
 ``tolerance``             labels and end states against rtol on the quick atlas's grid
+``handover``              the hand-over engine against brute-force runs of the same starts at
+                          1e12 and 1e14, tighter references where they differ (``handover``);
+                          ``--out STORE`` keeps the rows in that atlas store
+``basins``                the 4|5 band at delta = 0.5: the shares of the starts ending in 4 and
+                          in 5 against beta of (4.18) (``handover.basins``)
+``flows``                 the averaged flows against full integration at tol 1e-15: the error
+                          of the averaged amplitudes against the stated bound and its order
+                          in mu (``handover.flows``)
 ========================  ======================================================================
 
 Each prints a table (``--json``: the rows as JSON instead) and its progress on stderr.
@@ -22,7 +30,7 @@ import sys
 
 from ...errors import UsageError, printable
 
-KINDS = ("validate", "crosscheck", "physical", "convergence", "tolerance")
+KINDS = ("validate", "crosscheck", "physical", "convergence", "tolerance", "handover", "basins", "flows")
 
 
 def _say(line: str) -> None:
@@ -78,8 +86,28 @@ def _compute(req) -> tuple:
 
         rows = P.compare(members=n, tau_end=req.tau_end or 1e10, progress=_say)
         return rows, P.format_table(rows), 0 if all(r["label_atlas"] == r["label_physical"] for r in rows) else 1
+    if kind == "basins":
+        from . import handover as HV
+
+        rows = HV.basins(members=n, tau_end=req.tau_end or 1e16, progress=_say)
+        return rows, HV.format_basins(rows), 0
+    if kind == "flows":
+        from . import handover as HV
+
+        rows = HV.flows(progress=_say)
+        return rows, HV.format_flows(rows), 0 if all(r["within_bound"] for r in rows) else 1
     from . import convergence as CV
 
+    if kind == "handover":
+        from . import handover as HV
+
+        rows = HV.run(n, req.horizons or HV.HORIZONS, progress=_say)
+        if req.out:
+            from ...regimes.store.lock import StoreLock
+
+            with StoreLock(req.out, exclusive=True, what="--evidence handover --out"):   # one writer at a time
+                CV.record(req.out, rows, key="handover_validation")
+        return rows, HV.format_table(rows), 0
     if kind == "tolerance":
         rows = CV.tolerance(n, progress=_say)
         return rows, CV.format_tolerance(rows), 0

@@ -4,7 +4,8 @@ against the paper's formulas (the README's validation table).
     spinviz atlas --evidence validate [--members 32] [--workers 2] [--json]
 
 Each point is an atlas of one cell (built with ``parse_spec``, run with ``atlas`` into a
-temporary store), so the table is made by exactly the code that makes the diagrams.
+temporary store, the default engine, tau_end = 1e16 as the shipped atlases), so the table is
+made by exactly the code that makes the diagrams.
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ POINTS = [
 ]
 
 
-def run(members: int = 32, workers: int | None = None, tau_end: float = 1e10, points=POINTS, progress: bool = False):
+def run(members: int = 32, workers: int | None = None, tau_end: float = 1e16, points=POINTS, progress: bool = False):
     """A single-cell atlas at each validation point; one row per point with its labels and formulas.
     ``members``, ``workers`` and ``tau_end`` are checked first (``inputs.options.EvidenceRequest``)."""
     from ...inputs.options import EvidenceRequest

@@ -1,0 +1,284 @@
+"""The hand-over engine against brute force: the same starts at the validation points, run by
+the engine and by brute-force Taylor integration to each horizon.
+
+    spinviz atlas --evidence handover [--members 16] [--horizons 1e12,1e14] [--out STORE] [--json]
+
+Per point and horizon: the labels of both (same class -- an "approaching X" counted as X --,
+compatible -- a mixture "1|2" or "4|5" against one of its types -- or different), and for
+every handed-over run its averaged end amplitudes against the brute-force run's (read through
+the same near-identity transform, ``physics.averaged.scaled_amplitudes``) measured against its
+stated bound; on the reduced axial state the free/forced ratios of both.  Where they differ
+(a label, an end state beyond the bound, or the free/forced ratio by more than 0.1 in
+log10, where the free spiral is resolved), up to ``REFERENCE_RUNS`` of those starts are run
+again by a scalar Taylor integrator at ``REFERENCE_TOL`` -- the tighter reference says which
+of the two is wrong (past ~1e12 brute force at rtol 1e-10 loses the free spiral near
+alpha = -1: it decides 1 versus 2 on its own truncation error).  Both are timed.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import time
+from collections import Counter
+
+import numpy as np
+
+from ...inputs.atlas_spec import Settings, directions
+from ...physics import averaged as AV
+from ...regimes.engine import handover as HO
+from ...regimes.engine import runs as RN
+
+HORIZONS = (1e12, 1e14)
+REFERENCE_TOL = 1e-14          # near alpha = -1 the free spiral at 1e14 needs <= 1e-14 (1e-13 is off by 40 %)
+REFERENCE_RUNS = 2
+
+
+def points() -> list[tuple]:
+    """(name, model, delta, chi_deg, |omega0|): the validation points, the disputed ones, and
+    the truncated model's slow ones."""
+    from .convergence import points as conv
+
+    extra = [("T2 slow (alpha_T = -0.56)", "truncated", -0.6, math.degrees(0.3), 0.04),
+             ("T2 (-0.5, 0.8)", "truncated", -0.5, math.degrees(0.8), 0.04),
+             ("T4 (0.3, 0.72)", "truncated", 0.3, math.degrees(0.72), 0.04),
+             ("T4 near TF (beta_T = -0.91)", "truncated", 0.6, math.degrees(1.0), 0.04)]
+    return conv() + extra
+
+
+def _class(r) -> str:
+    return r.candidate if r.label == "approaching" else r.label
+
+
+def agreement(bf, en) -> str:
+    """"same", "compatible" (a mixture against one of its types), "undecided" (brute force
+    "other": no class fits its samples yet) or "differ"."""
+    if bf == en:
+        return "same"
+    if bf == "other":
+        return "undecided"
+    pairs = {("1|2", "1"), ("1|2", "2"), ("4|5", "4"), ("4|5", "5")}
+    return "compatible" if (bf, en) in pairs or (en, bf) in pairs else "differ"
+
+
+def reference(model: str, delta: float, chi: float, omega0, tau: float, tol: float = REFERENCE_TOL):
+    """omega at ``tau`` by a scalar Taylor integrator at ``tol`` (the atlas's scaled variable)."""
+    from ...integrators.taylor import template
+
+    eps = float(np.linalg.norm(omega0))
+    ta = copy.copy(template(model, "none", tol, "double", 0, symmetric=True, residual=False, runaway=False))
+    ta.time = 0.0
+    ta.state[:] = np.asarray(omega0) / eps
+    k = math.sqrt(eps)
+    ta.pars[:] = [delta, math.sin(chi) * k, math.cos(chi) * k, eps][:len(ta.pars)]
+    ta.propagate_until(tau * eps)
+    return eps * np.asarray(ta.state) / math.sqrt(1.0 + eps * eps * tau)
+
+
+def compare_point(name, model, d, cdeg, w, members: int, horizon: float, rtol: float, seed: int = 1) -> dict:
+    """One point at one horizon: engine and brute force on the same starts (see the module docstring)."""
+    chi = math.radians(cdeg)
+    starts = directions(members, seed) * w
+    t0 = time.perf_counter()
+    en = HO.cell_records(model, d, chi, starts, Settings(tau_end=horizon, rtol=rtol))
+    t1 = time.perf_counter()
+    st = Settings(tau_end=horizon, rtol=rtol, engine="taylor", max_steps=10**9)
+    bf = [RN.classify_run(r, model, d, chi, st) for r in RN.integrate_many(model, [(d, chi)] * members, list(starts), st)]
+    t2 = time.perf_counter()
+    flow = AV.Flow(model, d, chi) if d != 0.0 and 0.0 < chi < 0.5 * math.pi else None
+    verdict = [agreement(_class(b), _class(e)) for b, e in zip(bf, en)]
+    diff, ratio_e, ratio_b, out, ratio_off = [], [], [], [], []
+    for k, (b, e) in enumerate(zip(bf, en)):
+        lim = e.limit or {}
+        if not math.isfinite(lim.get("tau_handover", math.nan)) or flow is None:
+            continue
+        w_end = b.omega_final
+        a, bb = AV.scaled_amplitudes(flow, w_end[0] + 1j * w_end[1], w_end[2], horizon)
+        dd = max(abs(lim["abar_end"] - a), abs(abs(lim["bbar_end"]) - bb))
+        diff.append(dd / lim["bound"])
+        if dd > lim["bound"]:
+            out.append(k)
+        if math.isfinite(lim.get("free_forced_ratio", math.nan)) and not lim.get("spiral_unresolved", 0):
+            ratio_e.append(lim["free_forced_ratio"])
+            ratio_b.append(float(flow.free_forced_ratio(a * a, bb * bb, math.log(horizon))))
+            if abs(math.log10(ratio_e[-1] / ratio_b[-1])) > 0.1:
+                ratio_off.append(k)
+    refs = []
+    for k in list(dict.fromkeys([k for k, v in enumerate(verdict) if v == "differ"] + out + ratio_off))[:REFERENCE_RUNS]:
+        if flow is None:
+            break
+        tr = time.perf_counter()
+        wr = reference(model, d, chi, starts[k], horizon)
+        a, bb = AV.scaled_amplitudes(flow, wr[0] + 1j * wr[1], wr[2], horizon)
+        wb = bf[k].omega_final
+        ab, bbb = AV.scaled_amplitudes(flow, wb[0] + 1j * wb[1], wb[2], horizon)
+        lim = en[k].limit or {}
+        refs.append({"member": k, "brute": _class(bf[k]), "engine": _class(en[k]), "seconds": time.perf_counter() - tr,
+                     "engine_vs_ref": max(abs(lim.get("abar_end", math.nan) - a), abs(abs(lim.get("bbar_end", math.nan)) - bb)),
+                     "brute_vs_ref": max(abs(ab - a), abs(bbb - bb)), "bound": lim.get("bound", math.nan),
+                     "ratio_ref": float(flow.free_forced_ratio(a * a, bb * bb, math.log(horizon))) if flow.F else math.nan,
+                     "ratio_engine": lim.get("free_forced_ratio", math.nan),
+                     "ratio_brute": float(flow.free_forced_ratio(ab * ab, bbb * bbb, math.log(horizon))) if flow.F else math.nan})
+    return {"point": name, "model": model, "delta": d, "chi_deg": cdeg, "omega0": w, "members": members,
+            "horizon": horizon, "rtol": rtol,
+            "brute": dict(Counter(_shown(b) for b in bf)), "engine": dict(Counter(_shown(e) for e in en)),
+            "engine_limit": dict(Counter(_limit(e) for e in en)),
+            "agreement": dict(Counter(verdict)), "handed_over": len(diff),
+            "median_tau_handover": float(np.median([e.limit["tau_handover"] for e in en if e.limit and
+                                                    math.isfinite(e.limit.get("tau_handover", math.nan))]))
+            if diff else math.nan,
+            "beyond_bound": len(out), "max_diff_over_bound": float(max(diff)) if diff else math.nan,
+            "median_diff_over_bound": float(np.median(diff)) if diff else math.nan,
+            "ratio_log10_diff": float(np.median(np.abs(np.log10(ratio_e) - np.log10(ratio_b)))) if ratio_e else math.nan,
+            "ratio_compared": len(ratio_e),
+            "references": refs, "engine_s": t1 - t0, "brute_s": t2 - t1}
+
+
+def _shown(r) -> str:
+    return f"->{r.candidate}" if r.label == "approaching" else r.label
+
+
+def _limit(r) -> str:
+    code = (r.limit or {}).get("label_inf")
+    names = {v: k for k, v in RN.C.CODE.items()}
+    return names.get(code, r.label) if code is not None else r.label
+
+
+def run(members: int = 16, horizons=HORIZONS, rtol: float = 1e-10, progress=None) -> list[dict]:
+    """Every point of ``points`` at every horizon (``compare_point``)."""
+    say = progress or (lambda m: None)
+    rows = []
+    for p in points():
+        for h in horizons:
+            say(f"{p[0]}: tau_end = {h:g}")
+            rows.append(compare_point(*p, members, h, rtol))
+    return rows
+
+
+def format_table(rows: list[dict]) -> str:
+    """The rows as a Markdown table, and the references below it."""
+    out = ["| point | model | tau_end | brute force | engine at tau_end (limit) | agreement | handed over (median tau_h) | "
+           "end state: beyond bound, max diff/bound | 1-vs-2 ratio: median log10 diff | time engine / brute |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
+    refs = []
+    for r in rows:
+        lab = lambda c: ", ".join(f"{k} {v}" for k, v in sorted(c.items(), key=lambda kv: -kv[1]))  # noqa: E731
+        ho = f"{r['handed_over']}/{r['members']}" + (f" ({r['median_tau_handover']:.2g})" if r["handed_over"] else "")
+        es = f"{r['beyond_bound']}, {r['max_diff_over_bound']:.2f}" if r["handed_over"] else "-"
+        rat = f"{r['ratio_log10_diff']:.1e}" if math.isfinite(r["ratio_log10_diff"]) else "-"
+        out.append(f"| {r['point']} | {r['model']} | {r['horizon']:.0e} | {lab(r['brute'])} | {lab(r['engine'])} "
+                   f"({lab(r['engine_limit'])}) | {lab(r['agreement'])} | {ho} | {es} | {rat} | "
+                   f"{r['engine_s']:.2f} s / {r['brute_s']:.1f} s |")
+        for f in r["references"]:
+            refs.append(f"* {r['point']}, tau_end {r['horizon']:.0e}, start {f['member']} (brute {f['brute']}, engine "
+                        f"{f['engine']}): against tol {REFERENCE_TOL:g}, engine {f['engine_vs_ref']:.2e} (bound "
+                        f"{f['bound']:.2e}), brute force {f['brute_vs_ref']:.2e}; free/forced ratio reference "
+                        f"{f['ratio_ref']:.4g}, engine {f['ratio_engine']:.4g}, brute {f['ratio_brute']:.4g} "
+                        f"({f['seconds']:.0f} s)")
+    return "\n".join(out + ([""] + refs if refs else []))
+
+
+# --- the 4|5 band: basin fractions against beta -------------------------------------------------
+BAND_CHI_DEG = tuple(float(c) for c in np.arange(36.0, 47.01, 1.0))     # delta = 0.5: beta from -0.55 to -0.88
+
+
+def basins(delta: float = 0.5, chis_deg=BAND_CHI_DEG, members: int = 32,
+           tau_end: float = 1e16, rtol: float = 1e-8, seed: int = 1, omega: float = 0.1, progress=None) -> list[dict]:
+    """Across the 4|5 band at one delta: per chi, beta of (4.18) and the shares of the starts
+    whose limit is type 4 and type 5 (the hand-over engine: beyond beta = -3/4 the spiral is
+    captured, a type-4 run counting as 5 with its ``lock_to_5_at_tau``; before it both are
+    attractors and the fractions are the basins'), and what is still unsettled."""
+    from ...physics import asymptotics as FM
+
+    say = progress or (lambda m: None)
+    rows = []
+    starts = directions(members, seed) * omega
+    for cdeg in chis_deg:
+        chi = math.radians(float(cdeg))
+        say(f"basins: delta {delta:g}, chi {cdeg:g} deg")
+        recs = HO.cell_records("reduced", delta, chi, starts, Settings(tau_end=tau_end, rtol=rtol))
+        lim = Counter(_limit(r) for r in recs)
+        end = Counter(_shown(r) for r in recs)
+        lock = [r.evidence[RN.C.EVIDENCE.index("lock_to_5_at_tau")] for r in recs if _limit(r) == "5" and r.label == "4"]
+        rows.append({"delta": delta, "chi_deg": float(cdeg), "beta": FM.type4_eq4_18(delta, chi)["beta"],
+                     "members": members, "tau_end": tau_end, "limit": dict(lim), "at_tau_end": dict(end),
+                     "share_4": lim.get("4", 0) / members, "share_5": lim.get("5", 0) / members,
+                     "captured_later": len(lock),
+                     "median_lock_tau": float(np.nanmedian(lock)) if lock else math.nan})
+    return rows
+
+
+def format_basins(rows: list[dict]) -> str:
+    """The basin rows as a Markdown table."""
+    out = ["| chi | beta (4.18) | limit: 4 / 5 / other | at tau_end | type 4 at tau_end captured later (median tau) |",
+           "|---|---|---|---|---|"]
+    for r in rows:
+        other = r["members"] - round(r["share_4"] * r["members"]) - round(r["share_5"] * r["members"])
+        at = ", ".join(f"{k} {v}" for k, v in sorted(r["at_tau_end"].items(), key=lambda kv: -kv[1]))
+        lock = f"{r['captured_later']} ({r['median_lock_tau']:.1e})" if r["captured_later"] else "0"
+        out.append(f"| {r['chi_deg']:.1f}° | {r['beta']:.3f} | {100 * r['share_4']:.0f} % / {100 * r['share_5']:.0f} % / "
+                   f"{other} | {at} | {lock} |")
+    return "\n".join(out)
+
+
+# --- the averaged flows against full integration -------------------------------------------------
+FLOW_CELLS = (("reduced", 0.3, 0.72, "3"), ("reduced", -0.6, math.radians(77.0), "3 below delta = -1/2"),
+              ("reduced", 0.5, math.radians(39.0), "4"), ("reduced", 0.5, math.radians(20.0), "2"),
+              ("reduced", 0.5, math.radians(14.0), "2 -> 1"), ("reduced", -0.6, 0.3, "1"),
+              ("truncated", -0.5, 0.8, "T2"), ("truncated", 0.3, 0.72, "T4"))
+FLOW_MU = (1e-1, 5e-2, 3e-2, 1e-2, 3e-3, 1e-3)
+
+
+def flows(cells=FLOW_CELLS, mus=FLOW_MU, tau_f: float = 1e10, tol: float = 1e-15, progress=None) -> list[dict]:
+    """The averaged flow against full integration: per cell one start (omega0 = (0.06, -0.05,
+    0.05)) run by a scalar Taylor integrator at ``tol`` to ``tau_f`` on 40 samples a decade,
+    handed over at the first sample below each mu of ``mus``; the averaged amplitudes at tau_f
+    against the full run's (read through the same transform): the error, the engine's stated
+    bound 0.2 mu_h^2 |(a, b)|, the error / mu_h^2, and the order fitted over ``mus``."""
+    from ...integrators.taylor import template
+    from ...physics import averaged as AV
+
+    say = progress or (lambda m: None)
+    rows = []
+    for model, d, chi, what in cells:
+        say(f"flows: {model} ({d:g}, {math.degrees(chi):.1f} deg)")
+        f = AV.Flow(model, d, chi)
+        w0 = np.array([0.06, -0.05, 0.05])
+        eps = float(np.linalg.norm(w0))
+        tau = np.logspace(3, math.log10(tau_f), int(round(40 * (math.log10(tau_f) - 3))) + 1)
+        ta = copy.copy(template(model, "none", tol, "double", 0, symmetric=True, residual=False, runaway=False))
+        ta.time, k = 0.0, math.sqrt(eps)
+        ta.state[:] = w0 / eps
+        ta.pars[:] = [d, math.sin(chi) * k, math.cos(chi) * k, eps][:len(ta.pars)]
+        t0 = time.perf_counter()
+        u = np.asarray(ta.propagate_grid(np.concatenate([[0.0], tau * eps]))[-1])[1:]
+        w = eps * u / np.sqrt(1.0 + eps * eps * tau)[:, None]
+        mu = f.small_parameter(np.hypot(w[:, 0], w[:, 1]), w[:, 2])
+        a_ref, b_ref = AV.scaled_amplitudes(f, w[-1, 0] + 1j * w[-1, 1], w[-1, 2], tau[-1])
+        pts = []
+        for target in mus:
+            if not (mu[:-40] < target).any():                 # not reached a decade before tau_f
+                continue
+            i = int(np.argmax(mu < target))
+            r = HO.averaged_stage([f], tau, [i], [w[i]], math.inf)[0]
+            a, b = math.exp(0.5 * r["lnA"][-1]), math.exp(0.5 * r["lnB"][-1])
+            err = max(abs(a - a_ref), abs(b - b_ref))
+            pts.append({"mu_h": float(mu[i]), "tau_h": float(tau[i]), "error": err,
+                        "bound": HO.BOUND_C * mu[i] ** 2 * math.hypot(a, b), "error_over_mu2": err / mu[i] ** 2})
+        order = float(np.polyfit(np.log([p["mu_h"] for p in pts]), np.log([p["error"] for p in pts]), 1)[0])
+        rows.append({"model": model, "delta": d, "chi_deg": math.degrees(chi), "type": what, "tau_f": tau_f,
+                     "order": order, "points": pts, "seconds": time.perf_counter() - t0,
+                     "within_bound": all(p["error"] <= p["bound"] for p in pts),
+                     "max_error_over_bound": max(p["error"] / p["bound"] for p in pts)})
+    return rows
+
+
+def format_flows(rows: list[dict]) -> str:
+    """The flow rows as a Markdown table."""
+    out = ["| cell | type | error at mu_h = " + " / ".join(f"{m:.0e}".replace("e-0", "e-") for m in FLOW_MU)
+           + " | largest error / bound | order in mu_h |", "|---|---|---|---|---|"]
+    for r in rows:
+        errs = " / ".join(f"{p['error']:.1e}" for p in r["points"]) + " / -" * (len(FLOW_MU) - len(r["points"]))
+        out.append(f"| {r['model']} ({r['delta']:g}, {r['chi_deg']:.1f}°) | {r['type']} | {errs} | "
+                   f"{r['max_error_over_bound']:.2f} | {r['order']:.2f} |")
+    return "\n".join(out)

@@ -4,9 +4,11 @@ The regime atlas of the paper's figures 2, 3.D and 5
 
 Which asymptotic type of the paper's section 4 does a symmetric top end in, for every
 elongation δ = 1 − I3/I1 and dipole tilt χ, under each equation of motion?  The figure
-atlas (``scenes/atlas_figure.toml``) answers at 32 × 32 cells × 32 random starts, both
-models, to τ = 1e10, every cell along a change of type cut in four (64 × 64 there):
-142 464 runs, twelve minutes on two cores -- too long for a documentation build::
+atlas (``scenes/atlas_figure.toml``) answers as τ → ∞ at 32 × 32 cells × 32 random starts,
+both models: each run integrated in full until the flow averaged over the precession holds,
+then carried by it to τ = 1e16 and labelled by the attractor it is in; every cell along a
+change of type cut in four, twice (128 × 128 there): 206 464 runs, about a quarter of an
+hour on two cores -- too long for a documentation build::
 
     spinviz atlas scenes/atlas_figure.toml --out atlas_figure.zarr --plot atlas_figure.png
 
@@ -20,9 +22,10 @@ with the paper: the :doc:`regime atlas page <../atlas>`.
 """
 
 # %%
-# The extract: per refinement level, the grid and each run's type code (``regime``) and
-# best class (``candidate``, which type an "approaching" run approaches), as
-# (model, delta, chi, member) arrays; the spec of the atlas as JSON.
+# The extract: per refinement level, the grid and each run's type code at τ_end (``regime``)
+# and as τ → ∞ (``label_inf``), and its best class (``candidate``, which type an
+# "approaching" run approaches), as (model, delta, chi, member) arrays; the spec of the
+# atlas as JSON.
 import json
 
 import numpy as np
@@ -41,8 +44,8 @@ print(f"{len(spec['delta'])} x {len(spec['chi'])} cells, {spec['members']['count
       f"refined {spec.get('refine', {}).get('levels', 0)} time(s) where the types change")
 
 # %%
-# Each level as the Dataset ``spinviz.atlas`` returns (``label``: the type's name, as
-# ``store.open_atlas`` decodes it), the coarse grid first.
+# Each level as the Dataset ``spinviz.atlas`` returns (``label`` and ``limit_label``: the
+# types' names, as ``store.open_atlas`` decodes them), the coarse grid first.
 NAMES = {code: name for name, code in CODE.items()}
 DIMS = ("model", "delta", "chi", "member")
 levels = []
@@ -50,6 +53,7 @@ for k in range(int(saved["levels"])):
     regime = saved[f"regime_{k}"]
     levels.append(xr.Dataset(
         {"label": (DIMS, np.vectorize(NAMES.get, otypes=[str])(regime)),
+         "limit_label": (DIMS, np.vectorize(NAMES.get, otypes=[str])(saved[f"label_inf_{k}"])),
          "candidate": (DIMS, saved[f"candidate_{k}"])},
         coords={"model": saved["models"], "delta": saved[f"delta_{k}"], "chi": saved[f"chi_{k}"],
                 "member": np.arange(regime.shape[-1])},
@@ -57,13 +61,14 @@ for k in range(int(saved["levels"])):
     print(f"level {k}: {regime.shape[1]} x {regime.shape[2]} cells, {int((regime != 0).sum())} runs")
 coarse = levels[0].assign(
     confidence=(DIMS, saved["confidence"]),
+    tau_handover=(DIMS, saved["tau_handover"].astype(float)),
     omega0=(("member", "axis"), saved["omega0"]),
     series=(("model", "delta", "chi", "start", "sample", "axis"), saved["series"]))
 levels[0] = coarse.assign_coords(tau=("sample", saved["tau"]), start=np.arange(saved["series"].shape[3]))
 
 # %%
-# The share of each type over the coarse grid, per model, counted as the diagram counts it
-# (a run still approaching a type counts for that type; "failed": truncated starts too close
+# The share of each type as τ → ∞ over the coarse grid, per model, counted as the diagram
+# counts it (a run still approaching a type counts for that type; "failed": truncated starts too close
 # to that equation's singular surface, near δ = 1, refused rather than integrated through it).
 for model in levels[0]["model"].values:
     by_type = {name: 100 * float(s.mean()) for name, s in shares(levels[0], str(model)).items()}
@@ -71,12 +76,15 @@ for model in levels[0]["model"].values:
 
 # %%
 # The δ–χ diagram, both models side by side: each cell split into bars as wide as the
-# shares of its starts' types (hatched: still approaching that type at τ_end; a dot: two
-# types coexist among the starts); black, the paper's boundaries as printed; blue and red,
-# the lines spinviz derived; grey, the DAST families of figure 5.
+# shares of its starts' types as τ → ∞ (hatched: a run integrated in full still approaching
+# its type at τ_end; a dot: two types coexist among the starts); thick lines are sharp
+# boundaries, a band under a line a coexistence band; black, the paper's boundaries as
+# printed; blue and red, the lines spinviz derived; grey, the DAST families of figure 5.
 diagram(levels, "atlas_figure.png")
 
 # %%
 # The hodographs of the most confident run of each type: ω·√(τ + 1/ω₀²) in the body frame
-# (ω₀ the starting spin rate), as the paper's figure 3 draws them.
+# (ω₀ the starting spin rate), as the paper's figure 3 draws them; a ring marks where a run
+# went over to the averaged flow (after it, the amplitudes are the run's, the phase the
+# averaged one).
 hodographs(levels[0], "atlas_figure_hodographs.png")

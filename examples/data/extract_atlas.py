@@ -1,10 +1,10 @@
 """The extract of the figure atlas that the gallery's ``plot_atlas_figure.py`` draws.
 
-The figure atlas takes twelve minutes on two cores, too long for a documentation build, and
-its store is ~60 MB.  This script keeps what the atlas's pictures read -- per refinement
-level the grid and each run's type (``regime``) and best class (``candidate``); on the
-coarse level each run's confidence, the starts, and the stored series of the runs the
-hodographs show -- in one compressed NumPy file of a few hundred kB::
+The figure atlas takes about a quarter of an hour on two cores, too long for a documentation
+build, and its store is ~90 MB.  This script keeps what the atlas's pictures read -- per refinement
+level the grid and each run's type at tau_end (``regime``), as tau -> oo (``label_inf``) and
+best class (``candidate``); on the coarse level each run's confidence and hand-over time,
+the starts, and the stored series of the runs the hodographs show -- in one compressed NumPy file of a few hundred kB::
 
     spinviz atlas scenes/atlas_figure.toml --out atlas_figure.zarr
     python examples/data/extract_atlas.py atlas_figure.zarr
@@ -45,9 +45,11 @@ def extract(store: str) -> dict[str, np.ndarray]:
     for k, ds in enumerate(levels):
         # a run not computed (a refined level computes only the cells it cut) reads "missing", code 0
         out[f"regime_{k}"] = ds["regime"].where(ds["done"] == 1, 0).values.astype(np.int8)
+        out[f"label_inf_{k}"] = ds["label_inf"].where(ds["done"] == 1, 0).values.astype(np.int8)
         out[f"candidate_{k}"] = ds["candidate"].values.astype(np.int8)
         out[f"delta_{k}"], out[f"chi_{k}"] = ds["delta"].values, ds["chi"].values
     out["confidence"] = top["confidence"].values.astype(np.float32)
+    out["tau_handover"] = top["tau_handover"].values.astype(np.float32)
     out["omega0"], out["tau"] = top["omega0"].values, top["tau"].values
     # the series of the runs the hodographs show; the rest of the array is NaN (compresses to nothing)
     series = np.full(top["series"].shape, np.nan, dtype=np.float32)

@@ -181,6 +181,7 @@ def test_domain_2_with_alpha_far_below_minus_one_is_type_1():
     assert _median(recs, "w2_tau") == pytest.approx(f["B"], rel=1e-3)
 
 
+@pytest.mark.slow
 def test_domain_3_deep():
     """(0.8, 11.4 deg): deep in (4.17): type 3, A^2 and B^2 of (4.16) within 1 %."""
     d, ch = 0.8, math.radians(11.4)

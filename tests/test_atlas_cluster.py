@@ -67,6 +67,7 @@ def test_store_opens_with_plain_xarray(reference):
     assert (full["label"].sel(model="reduced", delta=0.5).isel(chi=1).values == "5").sum() >= 2
 
 
+@pytest.mark.slow
 def test_interrupted_then_resumed_store_is_identical(spec_path, reference, tmp_path):
     """Stop after 2 batches (as Ctrl-C would): the store holds exactly the finished batches,
     consistently; the same call again computes only the rest and gives the same numbers."""
@@ -103,6 +104,7 @@ def test_store_of_another_spec_is_refused(spec_path, reference, tmp_path):
     assert sorted((p.relative_to(reference), p.stat().st_mtime_ns) for p in Path(reference).rglob("*")) == before
 
 
+@pytest.mark.slow
 def test_killed_worker_still_completes_the_store(spec_path, reference, tmp_path):
     """Two worker processes; the one that delivered the first batch is killed (SIGKILL) while
     it holds more: Dask reruns its batches elsewhere and the store is complete and identical."""
@@ -161,6 +163,7 @@ def test_existing_scheduler_with_two_workers(spec_path, reference, tmp_path):
                 p.kill()
 
 
+@pytest.mark.slow
 def test_unreachable_scheduler_exit_2_nothing_written(spec_path, tmp_path, monkeypatch, capsys):
     from spinviz.commands import main
 
@@ -210,6 +213,7 @@ def test_sigterm_stops_cleanly_and_resume_completes(spec_path, reference, tmp_pa
     same_numbers(out, reference)
 
 
+@pytest.mark.slow
 def test_plots_show_every_member(reference, tmp_path):
     """The diagram's shares add up to 1 in every cell; one hodograph per type found."""
     from PIL import Image

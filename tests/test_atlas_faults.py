@@ -199,6 +199,7 @@ def test_store_without_checksums_refused(spec_path, reference, tmp_path, capsys)
         f"so its runs cannot be trusted; move it away and compute the atlas again")
 
 
+@pytest.mark.slow
 def test_write_cut_before_its_checksums_is_recomputed(spec_path, reference, tmp_path, monkeypatch, capsys):
     """A process killed between a chunk's files and its record (simulated: the record's write
     raises): that chunk has runs marked done and nothing vouching for them; the resume
@@ -226,6 +227,7 @@ def test_write_cut_before_its_checksums_is_recomputed(spec_path, reference, tmp_
 
 
 # --- tasks that do not finish -------------------------------------------------------------------
+@pytest.mark.slow
 def test_failed_task_is_not_written_and_the_call_fails(spec_path, reference, tmp_path, monkeypatch):
     """A task that raises outside the runs (here: a broken worker environment) is not a result:
     its 3 runs stay "not computed" (before: recorded as "failed" and done, so the same
@@ -273,6 +275,7 @@ def test_workers_beyond_the_cores_refused(spec_path, tmp_path, capsys):
     assert sorted(p.name for p in tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_unreachable_scheduler_library_names_the_parameter(spec_path, tmp_path, monkeypatch):
     monkeypatch.setattr(cluster, "CONNECT_TIMEOUT_S", 1.0)
     addr = f"tcp://127.0.0.1:{_free_port()}"

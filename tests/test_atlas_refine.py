@@ -68,6 +68,7 @@ def test_level_one_computes_exactly_the_children_of_flagged_cells(refined):
     assert (codes[done1] > 0).all() and (codes[~done1] == 0).all()
 
 
+@pytest.mark.slow
 def test_rerun_computes_nothing_and_a_lost_level_is_recomputed_identically(refined, tmp_path):
     spec, out, res = refined
     copy = str(tmp_path / "r.zarr")
@@ -102,6 +103,7 @@ def test_verify_covers_every_level_and_resume_repairs_a_damaged_one(refined, tmp
     assert ST.verify(level1).clean
 
 
+@pytest.mark.slow
 def test_diagram_tiles_the_plane_once_finer_cells_over_coarser(refined):
     """compose_levels: every point of the delta-chi rectangle in exactly one drawn cell (the
     coarse cells a finer level computed again are left out), every computed level-1 cell

@@ -57,6 +57,7 @@ def test_dast_cube_final_states_residual_rotation_vs_rest():
     assert c.first_exceed["angle(d, L)"]["1 deg"] < c.first_exceed["angle(d, L)"]["10 deg"] < 6.0 * Th
 
 
+@pytest.mark.slow
 def test_compare_command_json_and_plots(tmp_path, capsys):
     code = main(["compare", str(SCENES / "hodograph_askew.toml"), "--out", str(tmp_path / "h"), "--samples", "200", "--json"])
     assert code == 0

@@ -76,6 +76,7 @@ def test_fitted_tau0_cannot_reject_the_reduced_model_for_a_truncated_truth(cube_
     assert abs(DC.z_at(rec, "truncated", start, fitted, {})) < 1e-2
 
 
+@pytest.mark.slow
 def test_results_do_not_depend_on_batching_or_processes(cube_setup):
     """Each trial has its own seed: in this process in one batch and over two worker processes in
     batches of one, the decision times are the same numbers."""

@@ -69,6 +69,7 @@ def glb(scene, tmp_path_factory) -> Path:
 
 
 # --- keyframes ------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_keyframes_are_video_frames_within_the_stated_angle(plan):
     """Every keyframe is one of the video's frames holding exactly its pose; slerp between them
     (rotations.slerp_series, an implementation apart from the chooser's) stays within the

@@ -48,6 +48,7 @@ def test_check_never_imports_rendering(check_quick):
     assert not (check_quick.modules & set(RENDERING)), check_quick.modules & set(RENDERING)
 
 
+@pytest.mark.slow
 def test_public_names_work_any_number_of_times():
     """No public name is shadowed by a submodule of the same name: every public name is the
     same object before and after all submodules are imported."""

@@ -229,6 +229,7 @@ def spectral_peak(x, rate, center_s, window_s=0.25):
     return (k + 0.5 * (a - c) / (a - 2 * b + c)) * rate / (16 * n), float(np.sqrt(np.mean(seg**2)))
 
 
+@pytest.mark.slow
 def test_wav_follows_the_scaled_rotation_frequency(tmp_path, capsys):
     """``spinviz listen`` on the DAST cube: the WAV read back with scipy is 16-bit stereo; in each
     ear the strongest line follows the rotation frequency |Omega|/2 pi of (6.7) (left, reduced) and

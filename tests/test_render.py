@@ -133,6 +133,7 @@ show = ["dipole", "hud"]
         session.close()
 
 
+@pytest.mark.slow
 def test_video_has_the_expected_frames_and_size(tmp_path):
     """MP4 through two worker processes (segments joined by stream copy, in a directory whose
     name needs the concat list's quoting) and a GIF: the frame count, size, codec and pixel
@@ -498,6 +499,7 @@ def test_render_workers_import_no_simulation_stack():
     assert r.stdout.decode().strip() == "[]"
 
 
+@pytest.mark.slow
 def test_render_starts_its_workers_before_it_simulates(tmp_path, monkeypatch):
     """pipeline.render opens the render processes first, so that their imports overlap the
     simulation: when the first model is integrated, the workers are already running; and the

@@ -287,6 +287,7 @@ def test_poses_point_the_arrows_along_their_vectors():
     assert np.all(length == 1.0)
 
 
+@pytest.mark.slow
 def test_planning_needs_no_drawing_library():
     """A picture is planned -- words, layout, camera, poses -- in a process that never loads
     Pillow, VTK, pyvista, imageio or matplotlib (text widths from a stand-in metrics)."""

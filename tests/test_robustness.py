@@ -177,6 +177,7 @@ def test_a_group_of_outputs_lands_together_even_when_a_rename_fails(tmp_path, mo
     assert sorted(p.name for p in tmp_path.iterdir()) == ["v.mp4", "v.png"]
 
 
+@pytest.mark.slow
 def test_a_crashing_render_worker_fails_the_render_in_one_line(tmp_path):
     """A render worker whose drawing stack cannot load (here: a vtkmodules that raises, as a
     missing libGL would) ends the render with exit status 1 and one line naming the worker and

@@ -137,6 +137,7 @@ def test_auto_picks_secular_radau_or_taylor_and_says_why():
     assert m == "taylor-long" and "long double" in why
 
 
+@pytest.mark.slow
 def test_driver_switches_to_radau_when_the_explicit_method_detects_stiffness(monkeypatch):
     """If the up-front estimate misses stiffness, taylor's stiffness watch (steps below 1e-5 rad
     of spin over 4 x 512 steps) fires and the driver reruns with radau, saying so.  The body:

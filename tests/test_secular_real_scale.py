@@ -112,6 +112,7 @@ def test_4_18_amplitude_corrected():
     assert abs(tr.omega[-1, 2]) < 0.1 * math.sqrt(wp2tau[-1] / tr.t[-1])       # omega3 is the smaller one
 
 
+@pytest.mark.slow
 def test_check_secular_holds_each_run_to_its_stated_errors():
     """The spinviz check row for domain 3 at tau0 |Omega0| = 1e-4, 1e-5: passes, the slow error
     falls at second order in eps, and every accepted run's error is under twice its statement."""

@@ -78,6 +78,7 @@ def test_the_reference_verifies_ok_over_both_levels(refined_atlas, capsys):
     assert f"level 1: runs: all {n1} computed" in lines
 
 
+@pytest.mark.slow
 def test_a_deleted_level_is_missing_not_ok_and_the_resume_computes_it(refined_atlas, copy, capsys):
     """``rm -r STORE/level1``: the level's runs gone is not "ok" -- the spec implies level 1,
     so it is named missing, exit 1; the resume computes it, and only it."""
@@ -93,6 +94,7 @@ def test_a_deleted_level_is_missing_not_ok_and_the_resume_computes_it(refined_at
     assert verify(copy, capsys)[0] == 0
 
 
+@pytest.mark.slow
 def test_a_level_without_its_zgroup_is_computed_again(refined_atlas, copy, capsys):
     """Only ``level1/.zgroup`` deleted: the level is not a whole store, named so by --verify;
     the resume removes it and computes it again, in one line (a level can always be
@@ -209,6 +211,7 @@ def test_a_changed_record_of_the_spec_is_damage(refined_atlas, copy, capsys):
 
 
 # --- one writer at a time -------------------------------------------------------------------------
+@pytest.mark.slow
 def test_a_second_command_on_a_store_being_written_is_refused_at_once(refined_atlas, copy, capsys):
     """Another holder of the lock (here: this test, as another process would): the atlas and
     --verify are refused at once with one line, exit 75, the store untouched; once the lock

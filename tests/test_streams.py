@@ -94,9 +94,11 @@ NAMES = [
     (b"gs\x1dsep", "gs\\x1dsep"), ("line\u2028sep".encode(), "line\\u2028sep"), ("bidi\u202eexe".encode(), "bidi\\u202eexe"),
     (b"csi\x9b31m", "csi\\x9b31m"), (b"byte\xff", "byte\\xff"), (b"esc\x1b[2J", "esc\\x1b[2J"),
 ]
+FAST_NAMES = ("new\\nline", "bidi\\u202eexe", "byte\\xff")    # one of each kind in the default run; the rest slow
 
 
-@pytest.mark.parametrize("raw, shown", NAMES, ids=[n[1] for n in NAMES])
+@pytest.mark.parametrize("raw, shown", [pytest.param(*n, id=n[1], marks=() if n[1] in FAST_NAMES else pytest.mark.slow)
+                                        for n in NAMES])
 def test_every_echoed_name_is_one_escaped_line(tmp_path, raw, shown):
     """Newline, carriage return, \\x1c, \\x1d, U+2028, U+202E and 0x9b in paths are echoed
     escaped (no line split or reordered on screen), and with a 0xff file name on a strict

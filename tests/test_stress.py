@@ -56,6 +56,7 @@ def test_transverse_dipole_leaves_5_7_at_third_order():
     assert r.error == pytest.approx(4.36e-9, rel=1e-3), r.record()      # the deviation at a = 5e-4 (4.360e-9)
 
 
+@pytest.mark.slow
 def test_truncated_equation_stops_beyond_its_singular_surface():
     """Started just inside 1 + (g x Omega).J^-1 g = 0 (denominator 1e-3), the run moves away
     from the surface (its smallest denominator is the start's) and matches radau at rtol 1e-12

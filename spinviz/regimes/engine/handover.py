@@ -50,6 +50,7 @@ from __future__ import annotations
 import copy
 import math
 import os
+import sys
 import threading
 import time
 
@@ -572,3 +573,19 @@ def cell_records(model: str, delta: float, chi: float, starts, settings, series:
                  len(starts) if series else 0)
     cells, omega0 = RN.flat_runs(b)
     return _records(b, cells, omega0)[0]
+
+
+def warm(settings, tol: float) -> None:
+    """Load (or compile once) this engine's integrators beside the brute-force ones
+    (``runs.warm``): the full stage's at ``tol`` and at a hundredth of it (the noise floor's
+    reruns), and the averaged stage's."""
+    from ...integrators.taylor import template, tolerance, width
+
+    tight, _ = tolerance(settings.rtol / 100.0, settings.rtol / 100.0)
+    for model in ("reduced", "truncated"):
+        for t in (tol, tight):
+            template(model, "none", t, "double", width(), symmetric=True, residual=False, runaway=False)
+    lv_template(width())
+
+
+RN.ENGINES["handover"] = sys.modules[__name__]

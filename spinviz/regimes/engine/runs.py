@@ -175,21 +175,25 @@ class Batch:
         return max(0, min(m1, self.series) - m0)
 
 
+# [run] engine -> the module that runs it, beside the brute force here ("taylor"): each
+# registers itself when imported, and the package imports it (engine/__init__.py), so a Dask
+# worker that unpickles a Batch has it
+ENGINES: dict = {}
+
+
 def run_batch(batch: Batch) -> dict:
     """Run and classify every run of ``batch``; arrays shaped (n_delta, n_chi, n_member[, k]).
 
-    The spec's ``[run].engine`` chooses how: "handover" (``handover.run_batch``: full
-    integration until the averaged flow holds, then the averaged flow) or "taylor" (brute
-    force: every run integrated to tau_end, here).
+    The spec's ``[run].engine`` chooses how: "handover" (``handover.run_batch``, registered in
+    ``ENGINES``: full integration until the averaged flow holds, then the averaged flow) or
+    "taylor" (brute force: every run integrated to tau_end, here).
 
     Also returns where and how it ran: ``worker_pid``, ``compute_s`` (wall time inside this
     function), ``classify_s`` (of which: classifying the runs), ``cpu_s`` (the process's CPU
     time meanwhile: below ``compute_s`` when other work on the machine took the core) and
     ``max_rss_mb`` (the worker process's peak resident memory so far)."""
-    if batch.settings.engine == "handover":
-        from . import handover
-
-        return handover.run_batch(batch)
+    if batch.settings.engine != "taylor":
+        return ENGINES[batch.settings.engine].run_batch(batch)
     start, cpu0 = time.perf_counter(), time.process_time()
     out = outputs(batch)
     cells, starts = flat_runs(batch)
@@ -291,12 +295,6 @@ def warm(settings: Settings | None = None) -> float:
     tol, _ = tolerance(st.rtol, st.rtol)
     for model in ("reduced", "truncated"):
         template(model, "none", tol, "double", width())
-    if st.engine == "handover":
-        from . import handover
-
-        tight, _ = tolerance(st.rtol / 100.0, st.rtol / 100.0)
-        for model in ("reduced", "truncated"):
-            for t in (tol, tight):
-                template(model, "none", t, "double", width(), symmetric=True, residual=False, runaway=False)
-        handover.lv_template(width())
+    if st.engine != "taylor":
+        ENGINES[st.engine].warm(st, tol)
     return time.perf_counter() - t0

@@ -1,7 +1,7 @@
 """The atlas on disk: an xarray Dataset in a Zarr store, written region by region.
 
 Layout (dims ``model``, ``delta``, ``chi``, ``member``; ``axis`` = 1, 2, 3; ``quantity`` =
-``classify.EVIDENCE``; ``formula`` = ``FORMULAS``):
+``classify.EVIDENCE``; ``formula`` = ``FORMULAS``)::
 
     regime, regime_early, candidate   int8   label codes (flag_values / flag_meanings; 0 = not computed yet)
     status, method                    int8   how the run ended (``runs.STATUS_TEXT``), the integrator

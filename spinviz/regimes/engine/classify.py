@@ -53,8 +53,7 @@ import numpy as np
 from ...physics import asymptotics as F
 
 VERSION = 3                # bump when a rule changes: stores made by another version are not resumed
-# 2: slow hand-overs labelled "approaching" (candidate: the class), no longer "other"
-# 3: runs handed over to the averaged flow are labelled by their attractor (engine.handover)
+#                            (what each version changed: CHANGELOG.md)
 
 MIN_CONFIDENCE = 0.5
 TOL_HALF = 0.03            # |slope + 1/2| accepted as "-1/2" (full score within TOL/2, none beyond 1.5 TOL)

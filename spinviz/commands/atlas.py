@@ -128,7 +128,7 @@ def run(args) -> int:
 def stopped(args, signal_name) -> str:
     """The one line of an atlas command stopped by a signal (wherever it landed): the finished
     chunks are on disk and the same command completes the store -- that is the point."""
-    from ..regimes.api import default_out
+    from ..inputs.atlas_spec import default_out
 
     if args.verify is not None or args.evidence is not None or args.bench or args.spec is None:
         return f"interrupted by {signal_name}; nothing was written"

@@ -187,7 +187,7 @@ def accuracy_notes(method: str, rtol: float, atol: float) -> list[str]:
 def _stats_in_units(stats: dict, time_scale: float) -> dict:
     """The integrator's stats with its times (spin units) in the trajectory's (s or tau0)."""
     out = dict(stats)
-    for key in ("stiff_at", "runaway_at", "handover_at"):
+    for key in ("stiff_at", "runaway_at", "handover_at", "regime_5_from"):
         if out.get(key) is not None:
             out[key] = out[key] / time_scale
     if "full_stage" in out:

@@ -141,88 +141,112 @@ def solve_handover(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, s
     ``step`` caps Taylor's steps.  A stage that fails fails the run, with its reason and the
     samples so far."""
     from . import secular as SC
-    from .taylor import MAX_STEPS, solve_taylor
 
     t = np.asarray(problem.t_eval, dtype=float)
-    n = t.size
-    with_q = problem.kinematics == "quaternion"
-    omega_out = np.full((n, 3), np.nan)
-    q_out = np.full((n, 4), np.nan) if with_q else None
-    w = np.asarray(problem.omega0, dtype=float)
-    q = None
-    if with_q:
-        q = R.normalize(problem.q0 if problem.q0 is not None else (1.0, 0.0, 0.0, 0.0))
-        q_out[0] = q
-    omega_out[0] = w
-    j, s, steps, chunks = 1, float(t[0]), 0, 0
-    target = target_norm(problem)
-    secular_sub = None
-    stats: dict = {}
-
-    def failed(message, status, reached):
-        stats.update(nsteps=steps, full_stage={"method": "taylor", "nsteps": steps, "chunks": chunks})
-        return Solution(t=t, omega=omega_out, q=q_out, success=False, message=message, stats=stats, status=status,
-                        reached=reached)
-
-    while s < t[-1]:
-        if chunks > 0 or float(np.linalg.norm(w)) <= target:
-            sub, e = _stage(problem, w, q, s, t[j:])
-            try:
-                SC.prepare(sub)
-                secular_sub = (sub, e)
-                break
-            except SC.NotApplicable:
-                pass
-        dt, _ = predict(problem.system, w, TARGET_MARGIN * target, float(t[-1] - s))
-        end = float(t[-1]) if chunks >= MAX_CHUNKS or not math.isfinite(dt) else min(float(t[-1]), s + max(dt, 1.0))
-        k = int(np.searchsorted(t, end, side="right"))
-        times = t[j:k] if k > j and t[k - 1] == end else np.concatenate([t[j:k], [end]])
-        sub, e = _stage(problem, w, q, s, times)
-        sol = solve_taylor(sub, rtol, atol, None if step is None else step * e, max_steps=max(1, MAX_STEPS - steps),
-                           stop_on_stiffness=True)
-        steps += int(sol.stats.get("nsteps", 0))
-        chunks += 1
-        rows = sol.omega[1:] * e
-        m = k - j
-        got = sol.reached - 1 if not sol.success else len(times)
-        omega_out[j:j + min(m, got)] = rows[:min(m, got)]
-        if with_q:
-            q_out[j:j + min(m, got)] = sol.q[1:1 + min(m, got)]
-        if not sol.success:
-            stats.update({k2: v for k2, v in sol.stats.items() if k2 in ("stiff_at", "runaway_at", "runaway_omega")})
-            for key in ("stiff_at", "runaway_at"):
-                if key in stats:
-                    stats[key] = s + stats[key] / e
-            return failed(f"the full stage (taylor): {sol.message}", sol.status, j + min(m, max(got, 0)))
-        w = rows[-1]
-        if with_q:
-            q = R.normalize(sol.q[-1])
-        j, s = k, end
-    stats.update(full_stage={"method": "taylor", "nsteps": steps, "chunks": chunks, "until": s})
-    if secular_sub is None:                         # no hand-over before t_end: resolved in full
-        stats.update(nsteps=steps, handover_at=None, phases_resolved=True,
-                     handover_note="tau0 |Omega| stayed above the bound of the averaged flow: resolved in full")
-        return Solution(t=t, omega=omega_out, q=q_out, stats=stats)
-    sub, e = secular_sub
+    full = _FullStage(problem, rtol, atol, step)
+    failure = full.run()
+    stats = {"full_stage": {"method": "taylor", "nsteps": full.steps, "chunks": full.chunks, "until": full.s},
+             "nsteps": full.steps}
+    if failure is not None:
+        message, status, stage_stats = failure
+        stats.update(stage_stats)
+        return Solution(t=t, omega=full.omega, q=full.q_out, success=False, message=message, stats=stats,
+                        status=status, reached=full.j)
+    if full.handover is None:                        # no hand-over before t_end: resolved in full
+        stats.update(handover_at=None, phases_resolved=True,
+                     handover_note="tau0 |Omega| stayed above secular's bound: resolved in full")
+        return Solution(t=t, omega=full.omega, q=full.q_out, stats=stats)
+    sub, e = full.handover
+    j, s = full.j, full.s
     sol = SC.solve_secular(sub, rtol, atol)
     if not sol.success:
-        return failed(f"after the hand-over at t = {s:.4g} (spin units), secular: {sol.message}", sol.status or 1, j)
-    omega_out[j:] = sol.omega[1:] * e
-    if with_q:
-        q_out[j:] = sol.q[1:]
+        return Solution(t=t, omega=full.omega, q=full.q_out, success=False, stats=stats, status=sol.status or 1,
+                        message=f"after the hand-over at t = {s:.4g} (spin units), secular: {sol.message}", reached=j)
+    full.omega[j:] = sol.omega[1:] * e
+    if full.q_out is not None:
+        full.q_out[j:] = sol.q[1:]
     sec = dict(sol.stats)
-    for key in ("segments",):
-        if key in sec:
-            sec[key] = [[s + a / e, mode] for a, mode in sec[key]]
+    if "segments" in sec:
+        sec["segments"] = [[s + a / e, mode] for a, mode in sec["segments"]]
     if "resonances" in sec:
-        sec["resonances"] = [[m_, s + a / e, kick] for m_, a, kick in sec["resonances"]]
+        sec["resonances"] = [[m, s + a / e, kick] for m, a, kick in sec["resonances"]]
     if sec.get("regime_5_from") is not None:
         sec["regime_5_from"] = s + sec["regime_5_from"] / e
     stats.update(sec)
-    stats.update(nsteps=steps + int(sec.get("nsteps", 0)), handover_at=s,
+    stats.update(nsteps=full.steps + int(sec.get("nsteps", 0)), handover_at=s,
                  handover_eps_rad=float(np.dot(sub.system.coupling, sub.system.coupling)), phases_resolved=False)
-    slow = _slow_series(sol.slow, q_out[:j] if with_q else None, q, omega_out[:j], problem)
-    return Solution(t=t, omega=omega_out, q=q_out, stats=stats, slow=slow)
+    q_full = None if full.q_out is None else full.q_out[:j]
+    slow = _slow_series(sol.slow, q_full, full.q, full.omega[:j], problem)
+    return Solution(t=t, omega=full.omega, q=full.q_out, stats=stats, slow=slow)
+
+
+class _FullStage:
+    """The full stage of ``solve_handover``: Taylor's method chunk by chunk, output filled in
+    (``omega``, ``q_out``: the grid of ``problem``, NaN where not reached), until ``secular``
+    applies (``handover``: its problem and scale) or t_end.  j: the next output index; s, w, q:
+    the time (spin units of ``problem``) and state reached."""
+
+    def __init__(self, problem: Problem, rtol: float, atol: float, step: float | None):
+        self.problem, self.rtol, self.atol, self.step = problem, rtol, atol, step
+        self.t = t = np.asarray(problem.t_eval, dtype=float)
+        self.omega = np.full((t.size, 3), np.nan)
+        self.w = self.omega[0] = np.asarray(problem.omega0, dtype=float)
+        self.q_out = self.q = None
+        if problem.kinematics == "quaternion":
+            self.q_out = np.full((t.size, 4), np.nan)
+            self.q = self.q_out[0] = R.normalize(problem.q0 if problem.q0 is not None else (1.0, 0.0, 0.0, 0.0))
+        self.j, self.s, self.steps, self.chunks = 1, float(t[0]), 0, 0
+        self.handover = None
+
+    def run(self):
+        """Advance to the hand-over or t_end; None, or (message, status, stats) of a failure."""
+        from .secular import NotApplicable, prepare
+
+        target = target_norm(self.problem)
+        t_end = float(self.t[-1])
+        while self.s < t_end:
+            if self.chunks > 0 or float(np.linalg.norm(self.w)) <= target:
+                sub, e = _stage(self.problem, self.w, self.q, self.s, self.t[self.j:])
+                try:
+                    prepare(sub)
+                    self.handover = (sub, e)
+                    return None
+                except NotApplicable:
+                    pass
+            dt, _ = predict(self.problem.system, self.w, TARGET_MARGIN * target, t_end - self.s)
+            end = t_end if self.chunks >= MAX_CHUNKS or not math.isfinite(dt) else min(t_end, self.s + max(dt, 1.0))
+            failure = self._chunk(end)
+            if failure is not None:
+                return failure
+        return None
+
+    def _chunk(self, end: float):
+        """One Taylor run from (s, w, q) to ``end``, its samples stored."""
+        from .taylor import MAX_STEPS, solve_taylor
+
+        t, j, s = self.t, self.j, self.s
+        k = int(np.searchsorted(t, end, side="right"))
+        times = t[j:k] if k > j and t[k - 1] == end else np.concatenate([t[j:k], [end]])
+        sub, e = _stage(self.problem, self.w, self.q, s, times)
+        sol = solve_taylor(sub, self.rtol, self.atol, None if self.step is None else self.step * e,
+                           max_steps=max(1, MAX_STEPS - self.steps), stop_on_stiffness=True)
+        self.steps += int(sol.stats.get("nsteps", 0))
+        self.chunks += 1
+        got = min(k - j, len(times) if sol.success else max(sol.reached - 1, 0))
+        self.omega[j:j + got] = sol.omega[1:1 + got] * e
+        if self.q_out is not None:
+            self.q_out[j:j + got] = sol.q[1:1 + got]
+        if not sol.success:
+            self.j = j + got
+            stage = {key: s + sol.stats[key] / e for key in ("stiff_at", "runaway_at") if key in sol.stats}
+            if "runaway_omega" in sol.stats:
+                stage["runaway_omega"] = (np.asarray(sol.stats["runaway_omega"]) * e).tolist()
+            return f"the full stage (taylor): {sol.message}", sol.status, stage
+        self.w = sol.omega[-1] * e
+        if self.q is not None:
+            self.q = R.normalize(sol.q[-1])
+        self.j, self.s = k, end
+        return None
 
 
 def _slow_series(slow: dict, q_full, q_h, omega_full, problem: Problem) -> dict:

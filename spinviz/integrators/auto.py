@@ -139,7 +139,7 @@ def choose_method(body, model: str, omega0, t_end: float, kinematics: str = "qua
       whose braking brings tau0 |Omega| to 1e-3 before t_end, after at most ``HARD_MAX_TURNS``
       turns, as the averaged flow predicts it: ``taylor -> secular`` (``handover``), Taylor's
       method in full until ``secular`` applies, then ``secular``.  Measured against full
-      Taylor runs to 1e11 tau0 (~1e5 turns, six bodies of both models, |omega0| = 0.01 .. 0.1):
+      Taylor runs to 1e11 tau0 (~1e5 turns, five bodies of both models, |omega0| = 0.01 .. 0.1):
       the slow variables within ``secular``'s own ``slow_error_estimate`` (3e-8 .. 1e-4 of
       |Omega|), the full stage a few hundred turns at |omega0| = 0.01;
     * stiff (decay rate > 10 x spin rate): ``radau`` with the exact Jacobian;

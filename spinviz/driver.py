@@ -27,7 +27,7 @@ from .errors import SimulationError, SpecTypeError, SpinvizError
 from .inputs.simulation import SimulationRequest
 from .integrators import Problem, Solution, get
 from .integrators import status as ST
-from .integrators.auto import HARD_MAX_TURNS, choose_method, estimated_turns
+from .integrators.auto import HANDOVER, HARD_MAX_TURNS, choose_method, estimated_turns
 from .integrators.scaling import body_spin_problem, spin_problem
 from .physics.bodies import Body
 from .physics.equations import System, truncated_singularity
@@ -134,7 +134,8 @@ def simulate_request(request: SimulationRequest) -> Trajectory:
     # a declining secular run can be handed to a resolving method when its cost check would pass
     resolvable = (auto and method == "secular"
                   and estimated_turns(body, model, omega0, horizon, (problem, eps)) <= HARD_MAX_TURNS)
-    _check_method(method, body, kinematics)
+    if method != HANDOVER:
+        _check_method(method, body, kinematics)
     start = time.perf_counter()
     try:
         sol, name, reason = solve(problem, method, rtol=rtol, atol=atol, step=None if step is None else step * time_scale,
@@ -150,7 +151,7 @@ def simulate_request(request: SimulationRequest) -> Trajectory:
     if not sol.success:
         raise SimulationError(_failure_message(problem, sol, name, time_scale))
     stats = _stats_in_units(sol.stats, time_scale)
-    notes = accuracy_notes(name, rtol, atol)
+    notes = accuracy_notes("taylor" if name == HANDOVER else name, rtol, atol)
     stats.update(method=name, method_reason=reason, runtime_s=runtime, eps_rad=eps, rtol=rtol, atol=atol,
                  tolerance_met=not notes)
     if notes:
@@ -186,9 +187,11 @@ def accuracy_notes(method: str, rtol: float, atol: float) -> list[str]:
 def _stats_in_units(stats: dict, time_scale: float) -> dict:
     """The integrator's stats with its times (spin units) in the trajectory's (s or tau0)."""
     out = dict(stats)
-    for key in ("stiff_at", "runaway_at"):
-        if key in out:
+    for key in ("stiff_at", "runaway_at", "handover_at", "regime_5_from"):
+        if out.get(key) is not None:
             out[key] = out[key] / time_scale
+    if "full_stage" in out:
+        out["full_stage"] = {**out["full_stage"], "until": out["full_stage"]["until"] / time_scale}
     if "segments" in out:
         out["segments"] = [[t / time_scale, mode] for t, mode in out["segments"]]
     if "resonances" in out:
@@ -243,12 +246,20 @@ def solve(problem: Problem, method: str, *, rtol: float, atol: float, step: floa
 
     Under ``auto``: a ``secular`` run that declines (a resonance, the oscillating regime) is
     resolved in full by ``taylor`` when ``resolvable`` (affordable), and an explicit method
-    that meets stiffness the estimate from the initial state missed is replaced by radau.
+    that meets stiffness the estimate from the initial state missed is replaced by radau;
+    ``taylor -> secular`` (``integrators.handover``) runs as one method.
     The solution is checked for non-finite values; ``success`` False keeps its samples so far."""
-    integrator = get(method)
     kw = {"rtol": rtol, "atol": atol}
     if step is not None:
         kw["step"] = step
+    if method == HANDOVER:
+        from .integrators.handover import solve_handover
+
+        sol = solve_handover(problem, **kw)
+        if sol.success:
+            _check_finite(sol)
+        return sol, HANDOVER, reason
+    integrator = get(method)
     extra = {"stop_on_stiffness": True} if auto and integrator.detects_stiffness else {}
     sol = integrator.solve(problem, **kw, **extra)
     if auto and not sol.success and integrator.name == "secular" and resolvable:

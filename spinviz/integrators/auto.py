@@ -8,7 +8,9 @@ import numpy as np
 
 from ..errors import SpecError
 from .base import get
+from .handover import NAME as HANDOVER
 from .scaling import body_spin_problem
+from .secular import EPS_MAX
 
 MAX_RESOLVED_TURNS = 1e6     # beyond this, resolving every turn costs more than ~10 s
 HARD_MAX_TURNS = 5e7         # taylor resolves an askew asymmetric body at ~17 us a turn (rtol 1e-10, 7.7 steps a turn): ~15 min
@@ -47,12 +49,16 @@ def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", ste
     """Refuse, before any work, a run that cannot finish: more than 1e10 fixed steps, or more
     than ``HARD_MAX_TURNS`` turns (estimated with braking) for a method that resolves every
     turn.  ``secular`` follows the slow variables instead and has no such limit; ``auto`` is
-    judged by the method it picks (``picked``, when the caller has already chosen it).
+    judged by the method it picks (``picked``, when the caller has already chosen it), and the
+    hand-over ``taylor -> secular`` by its full stage alone: the turns before tau0 |Omega| has
+    braked to ``secular.EPS_MAX``, as the averaged flow predicts them (``handover.plan``).
     ``SpecError`` names "step" or "t_end"."""
     method = str(method).lower()
     auto = method == "auto"
     if auto:
         method = picked or choose_method(body, model, omega0, t_end, kinematics, spin=spin)[0]
+    if method == HANDOVER:
+        return                                  # choose_method picks it only where its full stage can finish
     if get(method).fixed_step:
         if step is not None and t_end / step > MAX_FIXED_STEPS:
             raise SpecError("step", f"t_end / step = {t_end / step:.3g} steps; at most {MAX_FIXED_STEPS:g} can finish")
@@ -64,21 +70,48 @@ def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", ste
         who = method
         if auto:
             who = ("every method for an asymmetric body" if not body.is_symmetric else
-                   f"{method} (averaging does not apply: tau0 |Omega0| is not small)")
+                   f"{method} (averaging does not apply: tau0 |Omega0| is not small"
+                   f"{_handover_note(body, model, omega0, t_end, spin)})")
         raise SpecError("t_end", f"the body turns ~{turns:.3g} times (estimated with braking) and {who} resolves each "
                                  f"turn: at most {HARD_MAX_TURNS:g} can finish")
+
+
+def _handover_note(body, model: str, omega0, t_end: float, spin=None) -> str:
+    """Why a symmetric top that is not fast at the start gets no hand-over: the full stage
+    before it, as predicted, is itself unaffordable, or the hand-over never comes."""
+    problem, eps = spin if spin is not None else body_spin_problem(body, model, omega0)
+    if not eps > EPS_MAX or model == "free":
+        return ""
+    from .handover import TARGET_MARGIN, predict, target_norm
+
+    S = float(t_end) * eps / body.tau0
+    t_h, turns_full = predict(problem.system, problem.omega0, TARGET_MARGIN * target_norm(problem), S)
+    if math.isfinite(t_h):
+        return (f", and the averaged flow predicts it to fall to {EPS_MAX:g} only after ~{turns_full:.3g} turns "
+                f"in full")
+    return f", nor does braking bring it to {EPS_MAX:g} by t_end (predicted by the averaged flow)"
 
 
 def estimated_turns(body, model: str, omega0, t_end: float, spin=None) -> float:
     """Turns of the body over [0, t_end] with braking: |omega| following the law of (3.7),
     d|omega|/ds = -kappa eps |omega|^3, with kappa measured at the start
-    (``braking_coefficient``); without braking (kappa = 0) |omega0| t_end / 2 pi."""
+    (``braking_coefficient``); without braking (kappa = 0) |omega0| t_end / 2 pi.  For a
+    symmetric top the larger of that and the averaged flow's count (``handover.predict``):
+    kappa at the start misses that omega_perp and omega3 brake at different rates -- with the
+    dipole on the axis omega3 is not braked at all ((5.2)), and the law from the start
+    undercounts 8e8 turns as 3e5."""
     problem, eps = spin if spin is not None else body_spin_problem(body, model, omega0)
     S = float(t_end) * eps / body.tau0                  # the horizon in spin units (|omega(0)| = 1)
     k = braking_coefficient(problem) * eps
     if k * S < 1e-8:
-        return S / (2.0 * math.pi)
-    return (math.sqrt(1.0 + 2.0 * k * S) - 1.0) / (2.0 * math.pi * k)
+        turns = S / (2.0 * math.pi)
+    else:
+        turns = (math.sqrt(1.0 + 2.0 * k * S) - 1.0) / (2.0 * math.pi * k)
+    if body.is_symmetric and model != "free":
+        from .handover import predict
+
+        turns = max(turns, predict(problem.system, problem.omega0, 0.0, S)[1])
+    return turns
 
 
 def stiffness_ratio(body, model: str, omega0, problem=None) -> float:
@@ -102,6 +135,13 @@ def choose_method(body, model: str, omega0, t_end: float, kinematics: str = "qua
     * more than 1e6 turns (estimated with braking) of a symmetric top with tau0 |Omega0| <=
       1e-3: ``secular`` (the hybrid slow flow; resolving each turn is neither affordable nor,
       past 1e16 turns, representable in float64);
+    * more than 1e6 turns of a symmetric top with tau0 |Omega0| > 1e-3 (not stiff, not free)
+      whose braking brings tau0 |Omega| to 1e-3 before t_end, after at most ``HARD_MAX_TURNS``
+      turns, as the averaged flow predicts it: ``taylor -> secular`` (``handover``), Taylor's
+      method in full until ``secular`` applies, then ``secular``.  Measured against full
+      Taylor runs to 1e11 tau0 (~1e5 turns, five bodies of both models, |omega0| = 0.01 .. 0.1):
+      the slow variables within ``secular``'s own ``slow_error_estimate`` (3e-8 .. 1e-4 of
+      |Omega|), the full stage a few hundred turns at |omega0| = 0.01;
     * stiff (decay rate > 10 x spin rate): ``radau`` with the exact Jacobian;
     * otherwise ``taylor`` (``taylor-long`` for rtol below 1e-15, where float64 stops): the
       fastest resolving method at every tolerance the bench measured, and the only one whose
@@ -128,9 +168,31 @@ def choose_method(body, model: str, omega0, t_end: float, kinematics: str = "qua
     ratio = stiffness_ratio(body, model, omega0, problem)
     if ratio > STIFF_RATIO:
         return "radau", f"stiff: decay rate {ratio:.3g} x the spin rate; implicit Radau with the exact Jacobian"
+    if turns > MAX_RESOLVED_TURNS and body.is_symmetric and model != "free":
+        picked = _handover_choice(body, model, omega0, t_end, problem, eps, turns)
+        if picked is not None:
+            return picked
     stiff = (f"decay/spin = {ratio:.2g}: stiff for Runge-Kutta, not yet for Taylor's method (faster than radau "
              f"below {STIFF_RATIO:g}, measured)") if ratio > 10.0 else f"non-stiff (decay/spin = {ratio:.2g})"
     if rtol < get("taylor").rtol_floor:
         return "taylor-long", (f"{stiff}, ~{turns:.3g} turns resolved; rtol {rtol:.2g} is below what float64 holds: "
                                f"Taylor's method in long double")
     return "taylor", f"{stiff}, ~{turns:.3g} turns resolved by Taylor's method"
+
+
+def _handover_choice(body, model: str, omega0, t_end: float, problem, eps: float, turns: float):
+    """(``HANDOVER``, why) for a symmetric top not fast at the start (tau0 |Omega0| >
+    ``EPS_MAX``) whose braking, as the averaged flow predicts it (``handover.plan``), brings
+    tau0 |Omega| to ``EPS_MAX`` before t_end after at most ``HARD_MAX_TURNS`` turns in full;
+    None otherwise (then it is resolved in full, within the usual limit)."""
+    from .handover import TARGET_MARGIN, predict, target_norm
+
+    S = float(t_end) * eps / body.tau0
+    t_h, turns_full = predict(problem.system, problem.omega0, TARGET_MARGIN * target_norm(problem), S)
+    if not (math.isfinite(t_h) and turns_full <= HARD_MAX_TURNS):
+        return None
+    return HANDOVER, (f"~{turns:.3g} turns of a symmetric top whose spin is not fast at the start (tau0 |Omega0| = "
+                      f"{eps:.2g} > {EPS_MAX:g}): Taylor's method in full, with quaternions, until braking brings "
+                      f"tau0 |Omega| to {EPS_MAX:g} (predicted by the averaged flow after ~{turns_full:.3g} turns, at "
+                      f"t ~ {t_h / eps * body.tau0:.3g}), then secular to t_end; the spin phase after the hand-over "
+                      f"is not resolved")

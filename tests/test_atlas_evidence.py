@@ -76,6 +76,7 @@ def test_handover_evidence_row_against_brute_force():
     assert HV.agreement("other", "3") == "undecided" and HV.agreement("1|2", "1") == "compatible"
 
 
+@pytest.mark.slow
 def test_convergence_rows_kept_in_the_store_which_stays_verifiable(tmp_path):
     spec = tmp_path / "e.toml"
     spec.write_text(SPEC)

@@ -601,6 +601,7 @@ def test_stop_signal_mid_atlas(spec_path, reference, tmp_path, sig, to_group):
         same_numbers(out, reference)
 
 
+@pytest.mark.slow
 def test_signal_inside_a_swallowing_callback_is_not_lost(spec_path, tmp_path, monkeypatch):
     """SIGTERM delivered while the main thread runs a callback whose exceptions are swallowed
     (a garbage-collection hook, as distributed's GC monitor installs): it is recorded, not

@@ -49,6 +49,7 @@ def regime(path):
     return np.asarray(zarr.open_group(path, mode="r", zarr_format=2)["regime"])
 
 
+@pytest.mark.slow
 def test_level_one_computes_exactly_the_children_of_flagged_cells(refined):
     _, out, res = refined
     types, done0 = LV.level_types(out, 0)
@@ -81,6 +82,7 @@ def test_rerun_computes_nothing_and_a_lost_level_is_recomputed_identically(refin
     np.testing.assert_array_equal(regime(ST.level_path(copy, 1)), regime(ST.level_path(out, 1)))
 
 
+@pytest.mark.slow
 def test_verify_covers_every_level_and_resume_repairs_a_damaged_one(refined, tmp_path, capsys):
     spec, out, res = refined
     copy = str(tmp_path / "r.zarr")

@@ -76,6 +76,7 @@ def test_compare_needs_two_models(tmp_path, capsys):
     assert "compare needs two models" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_compare_plots_units_colours_thresholds_and_shared_hodograph_axes(monkeypatch):
     """The plots as a reader gets them: every axis says its unit, the time axis is logarithmic
     (no symlog "0" over "10⁻³") in τ₀ here, the 1° and 10° lines are labelled, each model has one

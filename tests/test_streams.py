@@ -73,6 +73,7 @@ def test_a_full_stdout_names_the_stream_and_keeps_the_output(tmp_path):
     assert spinviz.Trajectory.load(out).t.size == 6
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("how", ["closed", "full"])
 def test_a_closed_or_full_stderr_never_costs_the_video(tmp_path, how):
     """``2>/dev/full`` or a closed stderr never costs the video: the progress bar, which cannot

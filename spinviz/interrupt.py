@@ -53,15 +53,21 @@ class Interrupted(KeyboardInterrupt):
 # error block and carries on): a signal arriving inside them is only recorded, and the
 # caller's loop raises it at its next ``check()`` -- between two frames.
 _SWALLOWING = ("vtkmodules", "vtk", "pyvista")
+# Python itself swallows what a weak reference's callback or a finalizer raises ("Exception
+# ignored in ...", printed on stderr): a signal handled inside one is only recorded too.
+_CALLBACK_MODULES = ("_weakrefset", "weakref")
 
 _deferring = 0            # depth of ``deferred()`` blocks: a signal is only recorded inside one
 
 
 def _inside_swallowing_library(frame) -> bool:
-    """Whether the interrupted code runs in one of those libraries: judged by module names,
-    from the innermost frame out to the first of spinviz's own."""
+    """Whether the interrupted code runs in one of those libraries, or in a weak reference's
+    callback or a finalizer: judged by module and function names, from the innermost frame
+    out to the first of spinviz's own."""
     while frame is not None:
         name = str(frame.f_globals.get("__name__", ""))
+        if name in _CALLBACK_MODULES or frame.f_code.co_name == "__del__":
+            return True
         if name.split(".")[0] == "spinviz":
             return False
         if name.split(".")[0] in _SWALLOWING:

@@ -56,6 +56,46 @@ def test_library_frames_are_judged_by_module_name(tmp_path):
     assert ns["result"] is True
 
 
+def test_a_signal_inside_a_weakref_callback_or_finalizer_is_recorded_not_raised(monkeypatch):
+    """Python swallows what a weak reference's callback or a ``__del__`` raises (it goes to
+    ``sys.unraisablehook``, which prints "Exception ignored in ..." on stderr): a signal
+    handled there is only recorded, and the caller's next ``check()`` raises it."""
+    import gc
+    import sys
+    import weakref
+
+    swallowed = []
+    monkeypatch.setattr(sys, "unraisablehook", lambda u: swallowed.append(u.exc_type.__name__))
+
+    class Thing:
+        pass
+
+    class Dying:
+        def __del__(self):
+            send(signal.SIGINT)
+            for _ in range(1000):
+                np.sqrt(2.0)
+
+    for make in ("weakset", "finalizer"):
+        with interrupt.handlers():
+            if make == "weakset":
+                things = weakref.WeakSet()
+                t = Thing()
+                things.add(t)
+                weakref.finalize(t, send, signal.SIGINT)
+                del t
+            else:
+                d = Dying()
+                del d
+            gc.collect()
+            for _ in range(1000):
+                np.sqrt(2.0)
+            assert interrupt.received() == signal.SIGINT, make
+            with pytest.raises(interrupt.Interrupted):
+                interrupt.check()
+        assert swallowed == [], make
+
+
 def test_a_stopped_kernel_has_returned_before_the_signal_is_reraised():
     """A signal landing while the main thread waits for a kernel: the exception reaches the
     caller only after the kernel saw its stop flag and returned.  (With Thread.join, CPython

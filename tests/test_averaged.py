@@ -205,20 +205,9 @@ def test_small_parameter():
 # --- against full integration (slow: Taylor runs at tol 1e-15) -------------------------------
 def full_run(model, delta, chi, omega0, taus, tol=1e-15):
     """omega at ``taus`` by heyoka at ``tol`` on the scaled variable (the atlas's template)."""
-    import copy
+    from spinviz.validation.atlas.handover import full_run as run
 
-    from spinviz.integrators.taylor import template
-
-    eps = float(np.linalg.norm(omega0))
-    ta = copy.copy(template(model, "none", tol, "double", 0, symmetric=True, residual=False, runaway=False))
-    k = math.sqrt(eps)
-    ta.time = 0.0
-    ta.state[:] = np.asarray(omega0) / eps
-    ta.pars[:] = [delta, math.sin(chi) * k, math.cos(chi) * k, eps][:len(ta.pars)]
-    t = np.concatenate([[0.0], np.asarray(taus, dtype=float) * eps])
-    res = ta.propagate_grid(t)
-    u = np.asarray(res[-1])[1:]
-    return eps * u / np.sqrt(1.0 + eps * t[1:])[:, None]
+    return run(model, delta, chi, omega0, taus, tol)
 
 
 @pytest.mark.slow

@@ -5,25 +5,14 @@ test needs to tell the two models apart at 5 sigma in 95 % of trials, with its p
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import json
 
 from ..errors import UsageError
-from .shared import EXIT_OK, add_detector_options, cannot_write, out, p, positive, prefix_of, progress, whole
+from .shared import EXIT_OK, add_detector_options, cannot_write, numbers, out, p, positive, prefix_of, progress, whole
 
 DASK_TRIALS = 2000            # from this many trials (or with --scheduler) the Monte Carlo runs on Dask
 KEYS = ("distance_cm", "integration_s")
-
-
-def _pair(text: str):
-    try:
-        v = tuple(float(x) for x in text.split(","))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected LO,HI, got {text!r}") from None
-    if len(v) != 2:
-        raise argparse.ArgumentTypeError(f"expected two numbers LO,HI, got {text!r}")
-    return v
 
 
 def add_parser(sub) -> None:
@@ -36,7 +25,7 @@ def add_parser(sub) -> None:
                                           "experiment): fit the P-f laws to it instead")
     d.add_argument("--trials", type=whole, help="Monte Carlo trials (default 200)")
     d.add_argument("--seed", type=whole, help="seed of the trials' random streams (default 1)")
-    d.add_argument("--spin-range", type=_pair, help="LO,HI: |Omega0| log-uniform over LO..HI x the scene's (default "
+    d.add_argument("--spin-range", type=numbers("LO,HI"), help="LO,HI: |Omega0| log-uniform over LO..HI x the scene's (default "
                                                     "0.5,2)")
     d.add_argument("--tau0", choices=("known", "fitted"), help="the body's tau0 known (default), or fitted with the start")
     add_detector_options(d, KEYS)

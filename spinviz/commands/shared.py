@@ -89,15 +89,27 @@ def names(text: str) -> tuple[str, ...]:
     return out
 
 
-def vector(text: str):
-    """Three comma-separated numbers X,Y,Z."""
-    try:
-        v = tuple(float(x) for x in text.split(","))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected X,Y,Z, got {text!r}") from None
-    if len(v) != 3:
-        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z, got {text!r}")
-    return v
+def numbers(form: str):
+    """The type of an option given as a fixed count of comma-separated numbers, named ``form``
+    (``"X,Y,Z"``, ``"LO,HI"``) in its messages; their ranges are the schema's."""
+    count = form.count(",") + 1
+    words = {2: "two", 3: "three"}[count]
+
+    def parse(text: str) -> tuple[float, ...]:
+        try:
+            v = tuple(float(x) for x in text.split(","))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {form}, got {text!r}") from None
+        if len(v) != count:
+            raise argparse.ArgumentTypeError(f"expected {words} numbers {form}, got {text!r}")
+        return v
+
+    parse.__name__ = form
+    parse.__doc__ = f"{words.capitalize()} comma-separated numbers {form}."
+    return parse
+
+
+vector = numbers("X,Y,Z")              # a direction or a point
 
 
 def size(text: str):

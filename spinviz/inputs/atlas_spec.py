@@ -231,8 +231,7 @@ def spec_from_record(attrs: dict, where: str) -> AtlasSpec:
         for k, values in (("delta", spec.deltas), ("chi", spec.chis)):
             lo, hi, n = axes[k]
             r = table(IA.AxisRange, {"min": lo, "max": hi, "cells": n}, f"grid_axes.{k}", where)
-            centres = r.min + (np.arange(r.cells) + 0.5) * (r.max - r.min) / r.cells
-            centres[np.abs(centres) < 1e-12 * (r.max - r.min)] = 0.0
+            centres = _centres(r)
             if centres.shape != values.shape or not np.allclose(centres, values, rtol=0.0, atol=1e-12 * (r.max - r.min)):
                 raise SceneError(where, f"grid_axes.{k}", "does not give the recorded grid")
     if refine.levels and axes is None:
@@ -317,13 +316,18 @@ def _axis(path, k: str, v, bounds: tuple, open_ends: bool, unit: str) -> np.ndar
         if v.min < lo or v.max > hi:
             raise SceneError(path, f"[grid.{k}].{'min' if v.min < lo else 'max'}",
                              f"the range must lie within {ends}{unit}, got [{v.min:g}, {v.max:g}]")
-        out = v.min + (np.arange(v.cells) + 0.5) * (v.max - v.min) / v.cells
-        out[np.abs(out) < 1e-12 * (v.max - v.min)] = 0.0     # an odd count centred on 0 hits it exactly (delta = 0: (5.2))
-        return out
+        return _centres(v)
     for x in v:
         if not (lo < x < hi if open_ends else lo <= x <= hi):
             raise SceneError(path, f"[grid].{k}", f"{x:g} is outside {ends}{unit}")
     return np.array(v, dtype=float)
+
+
+def _centres(r) -> np.ndarray:
+    """The centres of ``r.cells`` equal cells of (``r.min``, ``r.max``) (an ``AxisRange``)."""
+    out = r.min + (np.arange(r.cells) + 0.5) * (r.max - r.min) / r.cells
+    out[np.abs(out) < 1e-12 * (r.max - r.min)] = 0.0     # an odd count centred on 0 hits it exactly (delta = 0: (5.2))
+    return out
 
 
 def _check_horizon(path, s: Settings, omega0) -> None:

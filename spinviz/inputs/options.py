@@ -161,14 +161,16 @@ TAU_END_RANGE = (1e5, 1e16)      # below: the classifier's two 2-decade windows 
 HANDOVER_TAU_MAX = 1e20          # the hand-over engine's horizons (convergence, basins): where it was measured to hold
 MAX_HORIZONS = 8
 # Measured costs at tau = 1e10 (docs/atlas.md), growing as sqrt(tau / 1e10) -- the steps of a spiral:
-ATLAS_S_PER_RUN = 0.096          # a run of the atlas (one core; atlas_spec.CPU_S_PER_RUN)
+ATLAS_S_PER_RUN = 0.096          # a run of a single-cell atlas, cluster and classification included (one core)
 PHYSICAL_S_PER_RUN = 0.094       # an atlas run and its physical-unit simulate run (32 in 3 s)
 CROSSCHECK_S_PER_RUN = 25.0      # a SciPy DOP853 run of (4.2)-(4.4) at rtol 1e-10
 CONVERGENCE_S_PER_RUN = 0.0102   # a run of the study, per unit of sqrt(tau / 1e10) (8 min 46 s at its defaults)
 TOLERANCE_S_PER_RUN = 0.009      # a run of the 12 x 12 grid at one rtol (82 s for 9216)
-# The hand-over engine (regimes.engine.cost): a run kept in full costs a + b (tau/1e16)^(1/4) s,
-# a handed-over one a; brute force in the handover kind 0.7 s per start and unit of sqrt(tau/1e10)
-# over its 19 points (1 222 s for 16 starts at 1e12 and 1e14, the machine shared)
+# The hand-over engine, one core, rtol 1e-8 (docs/atlas.md, "Horizons"; regimes.engine.cost's model
+# reads these): a handed-over run costs HANDED_S_PER_RUN at any tau, a run kept in full
+# a + b (tau/1e16)^(1/4) s; brute force in the handover kind 0.7 s per start and unit of
+# sqrt(tau/1e10) over its 19 points (1 222 s for 16 starts at 1e12 and 1e14, the machine shared)
+HANDED_S_PER_RUN = 0.002
 ENGINE_S_PER_RUN = (0.002, 0.021)
 HANDOVER_S_PER_START = 0.7
 EVIDENCE_MEMBERS = {"validate": 32, "crosscheck": 3, "physical": 4, "convergence": 32, "tolerance": 8, "handover": 16,

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from ...errors import SceneError
 from ...inputs import atlas as IA
 from ...inputs.atlas_spec import AtlasSpec, Settings
-from ...inputs.options import MAX_DAYS_ENV, max_days
+from ...inputs.options import ENGINE_S_PER_RUN, HANDED_S_PER_RUN, MAX_DAYS_ENV, max_days
 from ...inputs.render import usable_cores
 from ...physics.averaged import averaging_holds
 
@@ -25,8 +25,8 @@ BYTES_PER_CELL = 1200            # the paper's predictions at each (delta, chi),
 BYTES_PER_TASK = 1000            # a batch (its chi tuple, omega0 view, region), its key and counters
 BYTES_PER_RUN = 16               # done mask, label codes and their copies
 CPU_S_PER_RUN = 0.010            # engine "taylor": a run to tau_end = 1e10, growing as sqrt(tau_end) (a spiral's steps)
-CPU_S_HANDED = 0.002             # engine "handover", a cell where the averaged flow holds: the same at any tau_end
-CPU_S_FULL = (0.002, 0.021)      # engine "handover", a cell integrated in full (5, 4|5, "?"): a + b (tau_end/1e16)^(1/4)
+CPU_S_HANDED = HANDED_S_PER_RUN  # engine "handover", a cell where the averaged flow holds: the same at any tau_end
+CPU_S_FULL = ENGINE_S_PER_RUN    # engine "handover", a cell integrated in full (5, 4|5, "?"): a + b (tau_end/1e16)^(1/4)
 SAMPLED_AXIS = 64               # cells per axis of the subgrid a large grid's CPU time is estimated on
 MEMORY_SHARE = 0.5               # of physical memory, for this process (the workers need the rest)
 

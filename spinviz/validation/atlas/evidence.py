@@ -102,19 +102,23 @@ def _compute(req) -> tuple:
         from . import handover as HV
 
         rows = HV.run(n, req.horizons or HV.HORIZONS, progress=_say)
-        if req.out:
-            from ...regimes.store.lock import StoreLock
-
-            with StoreLock(req.out, exclusive=True, what="--evidence handover --out"):   # one writer at a time
-                CV.record(req.out, rows, key="handover_validation")
+        _keep(req, rows, "handover_validation")
         return rows, HV.format_table(rows), 0
     if kind == "tolerance":
         rows = CV.tolerance(n, progress=_say)
         return rows, CV.format_tolerance(rows), 0
     rows = CV.study(n, req.horizons or CV.HORIZONS, progress=_say)
-    if req.out:
-        from ...regimes.store.lock import StoreLock
-
-        with StoreLock(req.out, exclusive=True, what="--evidence convergence --out"):   # one writer at a time
-            CV.record(req.out, rows)
+    _keep(req, rows, "convergence")
     return rows, CV.format_table(rows), 0
+
+
+def _keep(req, rows: list, key: str) -> None:
+    """The rows kept in the atlas store ``--out`` names (if any), under ``key``, one writer at
+    a time (the store's lock)."""
+    if not req.out:
+        return
+    from ...regimes.store.lock import StoreLock
+    from . import convergence as CV
+
+    with StoreLock(req.out, exclusive=True, what=f"--evidence {req.kind} --out"):
+        CV.record(req.out, rows, key=key)

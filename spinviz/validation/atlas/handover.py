@@ -61,8 +61,9 @@ def agreement(bf, en) -> str:
     return "compatible" if (bf, en) in pairs or (en, bf) in pairs else "differ"
 
 
-def reference(model: str, delta: float, chi: float, omega0, tau: float, tol: float = REFERENCE_TOL):
-    """omega at ``tau`` by a scalar Taylor integrator at ``tol`` (the atlas's scaled variable)."""
+def full_run(model: str, delta: float, chi: float, omega0, taus, tol: float = REFERENCE_TOL) -> np.ndarray:
+    """omega (N, 3) at ``taus`` by a scalar Taylor integrator at ``tol`` on the atlas's scaled
+    variable u = omega / (|omega0| sqrt(1 + |omega0|^2 tau)), time |omega0| tau."""
     from ...integrators.taylor import template
 
     eps = float(np.linalg.norm(omega0))
@@ -71,8 +72,14 @@ def reference(model: str, delta: float, chi: float, omega0, tau: float, tol: flo
     ta.state[:] = np.asarray(omega0) / eps
     k = math.sqrt(eps)
     ta.pars[:] = [delta, math.sin(chi) * k, math.cos(chi) * k, eps][:len(ta.pars)]
-    ta.propagate_until(tau * eps)
-    return eps * np.asarray(ta.state) / math.sqrt(1.0 + eps * eps * tau)
+    taus = np.asarray(taus, dtype=float)
+    u = np.asarray(ta.propagate_grid(np.concatenate([[0.0], taus * eps]))[-1])[1:]
+    return eps * u / np.sqrt(1.0 + eps * eps * taus)[:, None]
+
+
+def reference(model: str, delta: float, chi: float, omega0, tau: float, tol: float = REFERENCE_TOL):
+    """omega at ``tau`` by a scalar Taylor integrator at ``tol`` (``full_run``)."""
+    return full_run(model, delta, chi, omega0, [tau], tol)[-1]
 
 
 def compare_point(name, model, d, cdeg, w, members: int, horizon: float, rtol: float, seed: int = 1) -> dict:
@@ -235,24 +242,15 @@ def flows(cells=FLOW_CELLS, mus=FLOW_MU, tau_f: float = 1e10, tol: float = 1e-15
     handed over at the first sample below each mu of ``mus``; the averaged amplitudes at tau_f
     against the full run's (read through the same transform): the error, the engine's stated
     bound 0.2 mu_h^2 |(a, b)|, the error / mu_h^2, and the order fitted over ``mus``."""
-    from ...integrators.taylor import template
-    from ...physics import averaged as AV
-
     say = progress or (lambda m: None)
     rows = []
     for model, d, chi, what in cells:
         say(f"flows: {model} ({d:g}, {math.degrees(chi):.1f} deg)")
         f = AV.Flow(model, d, chi)
         w0 = np.array([0.06, -0.05, 0.05])
-        eps = float(np.linalg.norm(w0))
         tau = np.logspace(3, math.log10(tau_f), int(round(40 * (math.log10(tau_f) - 3))) + 1)
-        ta = copy.copy(template(model, "none", tol, "double", 0, symmetric=True, residual=False, runaway=False))
-        ta.time, k = 0.0, math.sqrt(eps)
-        ta.state[:] = w0 / eps
-        ta.pars[:] = [d, math.sin(chi) * k, math.cos(chi) * k, eps][:len(ta.pars)]
         t0 = time.perf_counter()
-        u = np.asarray(ta.propagate_grid(np.concatenate([[0.0], tau * eps]))[-1])[1:]
-        w = eps * u / np.sqrt(1.0 + eps * eps * tau)[:, None]
+        w = full_run(model, d, chi, w0, tau, tol)
         mu = f.small_parameter(np.hypot(w[:, 0], w[:, 1]), w[:, 2])
         a_ref, b_ref = AV.scaled_amplitudes(f, w[-1, 0] + 1j * w[-1, 1], w[-1, 2], tau[-1])
         pts = []

@@ -13,6 +13,8 @@ The public API (see the README's "Python" section)::
     tr.save("run.npz"); tr = spinviz.Trajectory.load("run.npz")
     img = spinviz.render_frame(sc, t=0.0)                                       # RGB array: the first frame
     spinviz.render("scenes/default.toml", out="renders/default.mp4")
+    c = spinviz.compare("scenes/default.toml")                                 # the two models side by side
+    obs = spinviz.observe("scenes/dast_cube.toml", distance_cm=20)              # what a receiver records
 
 Importing the package is light: every name loads its module on first use (PEP 562), and
 nothing here imports numba, pyvista, vtk or imageio.  No public name is also a submodule
@@ -46,10 +48,14 @@ _API = {
     "TrajectoryFileError": ("errors", "TrajectoryFileError"),
     "SimulationError": ("errors", "SimulationError"),
     "atlas": ("regimes.api", "atlas"),
+    "compare": ("experiment", "compare"),
+    "observe": ("experiment", "observe"),
+    "decide": ("experiment", "decide"),
+    "listen": ("experiment", "listen"),
 }
 _SUBMODULES = {
-    "units", "rotations", "errors", "atomic", "plotting", "physics", "integrators", "inputs", "driver", "trajectory",
-    "rendering", "pipeline", "analysis", "validation", "regimes", "commands",
+    "units", "rotations", "errors", "atomic", "plotting", "presentation", "physics", "integrators", "inputs", "driver",
+    "trajectory", "rendering", "pipeline", "executors", "experiment", "analysis", "validation", "regimes", "commands",
 }
 
 __all__ = sorted(_API) + ["__version__"]

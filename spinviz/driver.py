@@ -30,7 +30,8 @@ from .integrators import status as ST
 from .integrators.auto import HANDOVER, HARD_MAX_TURNS, choose_method, estimated_turns
 from .integrators.scaling import body_spin_problem, spin_problem
 from .physics.bodies import Body
-from .physics.equations import System, truncated_singularity
+from .physics.equations import truncated_singularity
+from .physics.models import System
 from .trajectory import Trajectory
 
 __all__ = ["simulate", "simulate_request", "SimulationRequest", "solve", "solve_many", "SimulationError", "Run"]

@@ -101,6 +101,20 @@ class SpecTypeError(SpecError, TypeError):
     where a number is): both a ``SpecError`` (ValueError) and a ``TypeError``."""
 
 
+class OptionError(SpecError):
+    """``name=value`` refused; ``reason`` says why (a cluster's ``scheduler=`` that cannot be
+    used: no scheduler there, no worker, another spinviz version).  A ``SpecError`` about the
+    argument ``name``, so the command line names it by its option like any other."""
+
+    def __init__(self, name: str, value, reason: str):
+        super().__init__(name, f"{printable(value, 100)}: {reason}")
+        self.value = value
+        self.args = (f"{name}={printable(repr(value), 100)}: {reason}",)
+
+    def __str__(self) -> str:
+        return self.args[0]
+
+
 class SceneError(SpinvizError, ValueError):
     """A scene that cannot be used: ``path``, ``key`` and ``reason`` give the one line."""
 

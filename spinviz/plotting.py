@@ -1,8 +1,15 @@
-"""2-D plots (matplotlib, imported only when a plot is drawn) and their atomic saving."""
+"""2-D plots (matplotlib, imported only when a plot is drawn), their atomic saving, and what
+every plot of spinviz shares: each model's colour and line (``presentation``) and the time
+axis's unit."""
 
 from __future__ import annotations
 
+from . import units as U
 from .atomic import atomic_path
+from .presentation import color_hex as model_color
+from .presentation import line_kwargs as model_line
+
+__all__ = ["pyplot", "save", "model_color", "model_line", "time_unit", "plot_trajectory"]
 
 
 def pyplot():
@@ -27,6 +34,22 @@ def save(fig, path: str, dpi: int = 110, close: bool = True) -> None:
     finally:
         if close:
             plt.close(fig)
+
+
+def time_unit(t_end: float, units: str) -> tuple[float, str]:
+    """(seconds per unit, axis label) for times up to t_end: hours, days or years (10⁶ years
+    beyond a million), or τ₀ for dimensionless runs."""
+    if units != "cgs":
+        return 1.0, "time t (τ₀)"
+    if t_end >= 2e6 * U.YEAR:
+        return 1e6 * U.YEAR, "time t (million years)"
+    if t_end >= 2 * U.YEAR:
+        return U.YEAR, "time t (years)"
+    if t_end >= 2 * U.DAY:
+        return U.DAY, "time t (days)"
+    if t_end >= 2 * U.HOUR:
+        return U.HOUR, "time t (hours)"
+    return 1.0, "time t (s)"
 
 
 def plot_trajectory(traj, path: str | None = None):

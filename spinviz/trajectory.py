@@ -19,6 +19,7 @@ from . import rotations as R
 from . import units as U
 from .atomic import atomic_path, open_regular, plain
 from .errors import SpecTypeError, TrajectoryFileError
+from .physics import models as M
 from .physics.bodies import Body
 from .physics.equations import angular_momentum_world, kinetic_energy
 
@@ -435,7 +436,7 @@ class Trajectory:
             stats = dict(meta["stats"])
         except Exception as e:         # KeyError, TypeError, BodyError: the metadata is damaged
             raise TrajectoryFileError(path, f"damaged metadata: {type(e).__name__} {e}") from None
-        if model not in ("reduced", "truncated", "free"):
+        if model not in M.names():
             raise TrajectoryFileError(path, f"damaged metadata: unknown model {model!r}")
         slow = {k[5:]: v for k, v in arrays.items() if k.startswith("slow_")} or None
         try:

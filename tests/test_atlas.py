@@ -263,9 +263,9 @@ def test_derived_lines():
 def test_dast_families_from_the_crystal_data():
     """Family 1 (a = b, symmetry axis c): chi = 55 deg, delta of the 100 x 100 x 50 box = -0.6
     as the preset; family 2 (b = c, symmetry axis a): chi = 35 deg, delta = 1 - I_a/I_b."""
-    from spinviz.physics.presets import dast_box, dast_family1
+    from spinviz.physics.presets import dast_box, dast_families, dast_family1
 
-    f1, f2 = FM.dast_families()
+    f1, f2 = dast_families()
     assert np.degrees(f1["chi"][0]) == pytest.approx(55.0) and np.degrees(f2["chi"][0]) == pytest.approx(35.0)
     body = dast_family1()
     assert body.delta == pytest.approx(FM.box_delta(50.0, 100.0)) and math.degrees(body.chi) == pytest.approx(55.0)

@@ -27,9 +27,12 @@ from procs import gone
 
 from spinviz import interrupt
 from spinviz.commands import main as cli_main
-from spinviz.regimes import api, cluster
+from spinviz.errors import OptionError
+from spinviz.executors import cluster
+from spinviz.regimes import api
+from spinviz.regimes import cluster as atlas_cluster
 from spinviz.regimes.engine import runs as RN
-from spinviz.regimes.faults import AtlasIncomplete, OptionError, StoreDamaged
+from spinviz.regimes.faults import AtlasIncomplete, StoreDamaged
 from spinviz.regimes.store import dataset as store
 from spinviz.regimes.store import integrity, levels
 
@@ -493,7 +496,7 @@ def test_task_error_that_never_reaches_the_client(spec_path, reference, tmp_path
     deep traceback fails distributed's check, and the future would stay pending forever):
     after ``STALL_S`` without a result (here 1 s) the scheduler's log is asked, the task
     counted as failed, the others computed; exit status 1; the same call completes the store."""
-    monkeypatch.setattr(cluster, "STALL_S", 1.0)
+    monkeypatch.setattr(atlas_cluster, "STALL_S", 1.0)
     deep = tmp_path / "deep.py"
     deep.write_text(DEEP)
     ext = external(worker_args=["--preload", str(deep)])

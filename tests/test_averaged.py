@@ -11,7 +11,7 @@ import pytest
 
 from spinviz.physics import asymptotics as FM
 from spinviz.physics import averaged as AV
-from spinviz.physics.equations import SYMMETRIC_RATES
+from spinviz.physics import models as M
 
 CELLS = [(0.3, 0.72), (-0.6, 0.3), (0.5, math.radians(39.0)), (-0.6, math.radians(77.0)), (0.6, 1.0), (-0.5, 0.8),
          (0.8, 0.2), (0.5, math.radians(14.0))]
@@ -22,13 +22,13 @@ def radiation_harmonics(model, delta, chi, wp, w3, nodes=64):
     rate less the free precession) at omega_perp = wp, omega3 = w3: (z' by harmonic, w3' by harmonic)."""
     phi = 2.0 * math.pi * np.arange(nodes) / nodes
     w1, w2 = wp * np.cos(phi), wp * np.sin(phi)
-    a1, a2, a3 = SYMMETRIC_RATES[model](w1, w2, np.full(nodes, w3), delta, math.sin(chi), math.cos(chi))
+    a1, a2, a3 = M.get(model).symmetric_rate(w1, w2, np.full(nodes, w3), delta, math.sin(chi), math.cos(chi))
     tz = (a1 - delta * w2 * w3) + 1j * (a2 + delta * w1 * w3)
     return np.fft.fft(tz) / nodes, np.fft.fft(a3) / nodes
 
 
 def table_harmonics(flow, wp, w3, nodes=64):
-    """The same from ``HARMONICS``: sum of c wp^(j+k) w3^l into harmonic m."""
+    """The same from the model's ``Averaged.harmonics``: sum of c wp^(j+k) w3^l into harmonic m."""
     z, t3 = np.zeros(nodes, dtype=complex), np.zeros(nodes, dtype=complex)
     for m, j, k, l, c in flow.z_terms:
         z[m % nodes] += c * wp ** (j + k) * w3**l
@@ -64,7 +64,7 @@ def test_averaged_flows_are_4_12_and_spinvizs_truncated_flow(delta, chi):
     omega3') equal (4.12) as printed (reduced) and ``asymptotics.truncated_averaged``
     (truncated: spinviz's derived equation); and the averaged rates equal the project's rate
     averaged over phi numerically."""
-    for model in AV.MODELS:
+    for model in M.for_atlas():
         f = AV.Flow(model, delta, chi)
         P = -sum(c for m, j, k, l, c in f.z_terms if (j, k, l) == (2, 1, 0))
         Q = -sum(c for m, j, k, l, c in f.z_terms if (j, k, l) == (1, 0, 2))
@@ -144,7 +144,7 @@ def test_forced_response_is_type_1_of_4_9(delta, chi):
 def test_near_identity_transform_round_trip_is_second_order(rng):
     """to_true(to_averaged(x)) = x + O(mu^2): halving |omega| (mu halves) cuts the round trip's
     relative error by ~4 (and without the transform the averaged state differs by O(mu))."""
-    for model in AV.MODELS:
+    for model in M.for_atlas():
         for _ in range(10):
             d, chi = rng.uniform(0.2, 0.8) * rng.choice([-1, 1]), rng.uniform(0.2, 1.3)
             f = AV.Flow(model, d, chi)

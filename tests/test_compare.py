@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from spinviz import plotting as PL
 from spinviz.analysis import compare as C
 from spinviz.commands import main
 from spinviz.driver import simulate
@@ -98,8 +99,8 @@ def test_compare_plots_units_colours_thresholds_and_shared_hodograph_axes(monkey
     assert {"1° apart", "10° apart"} <= notes
     for ax in axes[1:]:
         colors = {line.get_label(): line.get_color() for line in ax.get_lines()}
-        assert colors == {"reduced": C.model_color("reduced"), "truncated": C.model_color("truncated")}
-    assert C.model_color("reduced") != C.model_color("truncated")
+        assert colors == {"reduced": PL.model_color("reduced"), "truncated": PL.model_color("truncated")}
+    assert PL.model_color("reduced") != PL.model_color("truncated")
     a, b = hodo.axes[:2]
     assert a.get_xlim() == b.get_xlim() and a.get_ylim() == b.get_ylim() and a.get_zlim() == b.get_zlim()
     assert a.get_xlabel() == "ω₁ / |ω₀|"
@@ -110,6 +111,6 @@ def test_compare_plots_units_colours_thresholds_and_shared_hodograph_axes(monkey
 
 def test_time_unit_for_people():
     year = 365.25 * 86400.0
-    assert C.time_unit(19 * 86400.0, "cgs") == (86400.0, "time t (days)")
-    assert C.time_unit(6.6e6 * year, "cgs") == (1e6 * year, "time t (million years)")
-    assert C.time_unit(1200.0, "dimensionless") == (1.0, "time t (τ₀)")
+    assert PL.time_unit(19 * 86400.0, "cgs") == (86400.0, "time t (days)")
+    assert PL.time_unit(6.6e6 * year, "cgs") == (1e6 * year, "time t (million years)")
+    assert PL.time_unit(1200.0, "dimensionless") == (1.0, "time t (τ₀)")

@@ -12,9 +12,10 @@ import pytest
 
 from spinviz.analysis import decide as DC
 from spinviz.commands import main
+from spinviz.executors.processes import ProcessMapper
 from spinviz.inputs.decide import DecideArguments
 from spinviz.inputs.scene_spec import load_scene
-from spinviz.physics import longitudinal as LG
+from spinviz.physics import models as M
 
 ROOT = Path(__file__).resolve().parents[1]
 CUBE = ROOT / "scenes" / "dast_cube.toml"
@@ -42,13 +43,13 @@ def test_prediction_is_the_closed_forms(cube_setup):
     """The Monte Carlo's model of the line is physics.longitudinal's (5.2), (5.4)."""
     t = np.geomspace(1.0, 1e6, 50)
     w0, share = 3.1e21, 0.37
-    for model in LG.MODELS:
+    for model in M.with_line_law():
         f, y = DC._prediction(model, t, w0, share, cube_setup.tau0)
-        f2, shape = LG.line(model, t, share * w0, (1 - share) * w0, cube_setup.tau0)
+        f2, shape = M.get(model).line.line(t, share * w0, (1 - share) * w0, cube_setup.tau0)
         assert np.allclose(f, f2, rtol=1e-14) and np.allclose(y, np.log(shape), rtol=1e-13)
 
 
-@pytest.mark.parametrize("truth", DC.MODELS)
+@pytest.mark.parametrize("truth", M.with_line_law())
 def test_noise_free_records_give_back_the_start(cube_setup, truth):
     """From noise-free records the true model's fit returns the start (omega_L0^2 to 1e-14, the share
     sin^2 theta_L0 to 1e-9) with chi2 ~ 0, and Z is the other model's chi2 to the 1/2 power."""
@@ -82,9 +83,9 @@ def test_results_do_not_depend_on_batching_or_processes(cube_setup):
     batches of one, the decision times are the same numbers."""
     setup = short(cube_setup, horizon=300.0)
     a = DC.run(setup, 3, seed=7, batch=3)
-    with DC.ProcessMapper(2) as m:
+    with ProcessMapper(2) as m:
         b = DC.run(setup, 3, seed=7, mapper=m, batch=1)
-    for truth in DC.MODELS:
+    for truth in M.with_line_law():
         assert np.array_equal(a.times(truth), b.times(truth))
     assert np.all(np.isfinite(a.times("reduced")))
     import json
@@ -101,7 +102,7 @@ def test_z_stays_above_five_after_the_decision(cube_setup):
     for i, row in enumerate(rows):
         rng = np.random.default_rng(seqs[i])
         start = DC.draw_start(setup, rng)
-        for truth in DC.MODELS:
+        for truth in M.with_line_law():
             rec = DC.observe_trial(setup, start, truth, rng)
             t = row[truth]["t"]
             if not math.isfinite(t):
@@ -123,13 +124,13 @@ def test_the_five_sigma_time_is_stable_against_the_monte_carlo_size(cube_setup):
     intervals overlap (two independent such intervals of one quantity miss each other in well
     under 1 % of cases) -- and the larger run's interval is finite and the narrower (the smaller
     run's may be unbounded above: its upper end falls among the ~2 % of trials never decided)."""
-    from spinviz.inputs.render import usable_cores
+    from spinviz.executors.processes import usable_cores
 
     setup = short(cube_setup, horizon=3600.0)
-    with DC.ProcessMapper(usable_cores()) as m:
+    with ProcessMapper(usable_cores()) as m:
         small = DC.run(setup, 96, seed=1, mapper=m)
         large = DC.run(setup, 384, seed=2, mapper=m)
-    for truth in DC.MODELS:
+    for truth in M.with_line_law():
         a, b = small.t95[truth], large.t95[truth]
         ia, ib = (DC.quantile_interval(o.times(truth), level=0.95) for o in (small, large))
         assert all(math.isfinite(x) for x in (a, b, ia[0], *ib)), (truth, a, b, ia, ib)
@@ -199,6 +200,6 @@ def test_dask_runs_the_same_trials(cube_setup, monkeypatch, capsys, tmp_path):
     assert "decide: 8 trials on embedded LocalCluster, 1 worker" in captured.err
     rec = json.loads(captured.out)
     here = DC.run(cube_setup, 8, seed=1)
-    for truth in DC.MODELS:
+    for truth in M.with_line_law():
         assert rec["decision_times_s"][truth] == [x if math.isfinite(x) else None for x in here.times(truth)]
     assert (tmp_path / "c_decide.png").stat().st_size > 30_000

@@ -328,7 +328,7 @@ def test_atlas_arguments_raise_spinviz_errors_before_any_work(tmp_path, kw, kind
 
 def test_workers_are_bounded_by_the_cores(tmp_path):
     """More render processes or atlas workers than cores only share them: refused, saying how many."""
-    from spinviz.inputs.render import usable_cores
+    from spinviz.executors.processes import usable_cores
 
     n = usable_cores()
     with pytest.raises(SpecError) as e:

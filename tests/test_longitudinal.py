@@ -8,6 +8,7 @@ import pytest
 
 from spinviz.physics import closed_forms as CF
 from spinviz.physics import longitudinal as LG
+from spinviz.physics import models as M
 
 W = math.pi * 1e10
 
@@ -21,7 +22,7 @@ def test_state_is_the_closed_forms_5_2_and_5_4(delta, w20, w30):
     t = np.geomspace(1e-3, 1e3, 25) / (tau0 * (w20**2 + w30**2))
     u0, b0 = w20**2, eps**2 * w30**2
     for model, cf in (("reduced", CF.omega_eq5_2), ("truncated", CF.omega_eq5_4)):
-        u, b = LG.state(model, t, u0, b0, tau0)
+        u, b = M.get(model).line.state(t, u0, b0, tau0)
         with np.errstate(over="ignore"):                         # expm1 overflows where u -> 0
             w = cf(t / tau0, delta, w20 * tau0, w30 * tau0) / tau0
         assert np.allclose(u, w[:, 0] ** 2 + w[:, 1] ** 2, rtol=1e-12, atol=0), model
@@ -32,15 +33,15 @@ def test_sphere_is_6_7_and_6_9():
     """The spherical top (eps = 1) in CGS: (6.7) reduced, (6.9) truncated."""
     tau0 = 3.4e-27
     t = np.geomspace(1.0, 1e7, 30)
-    u, b = LG.state("reduced", t, W**2, W**2, tau0)
+    u, b = LG.reduced_state(t, W**2, W**2, tau0)
     w = CF.omega_eq6_7(t, tau0, W, W)
     assert np.allclose(np.sqrt(u), w[:, 1], rtol=1e-12, atol=0) and np.allclose(np.sqrt(b), w[:, 2], rtol=1e-15)
-    u, b = LG.state("truncated", t, W**2, W**2, tau0)
+    u, b = LG.truncated_state(t, W**2, W**2, tau0)
     w = CF.omega_eq6_9(t, tau0, W, W)
     assert np.allclose(np.sqrt(u), w[:, 1], rtol=1e-12, atol=0) and np.allclose(np.sqrt(b), w[:, 2], rtol=1e-12)
 
 
-@pytest.mark.parametrize("model", LG.MODELS)
+@pytest.mark.parametrize("model", M.with_line_law())
 def test_power_follows_its_law_along_the_run(model):
     """Eliminating t: the power shape Omega_perp^2 omega_L^2 over the law (f^4, or f^2 (f^2 - f_inf^2)
     with f_inf = sqrt(b0)/2 pi) is the same constant at every time -- and not under the other law.
@@ -48,10 +49,10 @@ def test_power_follows_its_law_along_the_run(model):
     tau0 = 3.4e-27
     u0, b0 = 0.8 * W**2, 1.3 * W**2
     t = np.geomspace(1.0, 3e5, 40)
-    f, shape = LG.line(model, t, u0, b0, tau0)
+    f, shape = M.get(model).line.line(t, u0, b0, tau0)
     f_inf = math.sqrt(b0) / (2 * math.pi)
-    own = shape / LG.law(model, f, f_inf)
-    other = shape / LG.law("truncated" if model == "reduced" else "reduced", f, f_inf)
+    own = shape / M.get(model).line.law(f, f_inf)
+    other = shape / M.get("truncated" if model == "reduced" else "reduced").line.law(f, f_inf)
     assert np.ptp(own) / own.mean() < 1e-12
     assert np.ptp(other) / other.mean() > 0.1
 

@@ -11,11 +11,13 @@ import pytest
 from scipy.io import wavfile
 from scipy.optimize import brentq
 
+import spinviz
 from spinviz.analysis import observe as OB
 from spinviz.analysis import sonify as SO
 from spinviz.commands import main
 from spinviz.inputs.scene_spec import load_scene
 from spinviz.physics import closed_forms as CF
+from spinviz.physics import models as M
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"
@@ -98,8 +100,8 @@ def test_receiver_parts_the_cube_at_five_sigma(cube):
     sc, obs, _ = cube
     f = obs.parting["frequency"]
     u0, b0 = LG.start_state(sc.omega0, sc.body.dipole_direction, 1.0)
-    fr, _ = LG.line("reduced", 1.0, u0, b0, sc.body.tau0)
-    ft, _ = LG.line("truncated", 1.0, u0, b0, sc.body.tau0)
+    fr, _ = M.get("reduced").line.line(1.0, u0, b0, sc.body.tau0)
+    ft, _ = M.get("truncated").line.line(1.0, u0, b0, sc.body.tau0)
     bg = obs.budgets[0]
     rel = bg.sigma_f[1] / bg.freq[1, bg.dominant[1]]
     assert f.setup_time == pytest.approx(1.0, rel=1e-6)
@@ -208,7 +210,7 @@ def test_antenna_inside_a_wavelength_gets_no_snr():
     """At 1 cm the cube's 4.2 cm line has the antenna in the intermediate zone: the whole field is
     given (1.84 times the radiation term: the closed form of test_receiver's), the radiation-zone
     SNR is not, and so no parting for this receiver."""
-    obs, _ = OB.run_scene(load_scene(SCENES / "dast_cube.toml"), samples=50, distance_cm=1.0)
+    obs = spinviz.observe(SCENES / "dast_cube.toml", samples=50, distance_cm=1.0)
     rec = json.loads(json.dumps(obs.record(), allow_nan=False))          # strict JSON: no NaN, no Infinity
     start = rec["budget"]["reduced"]["start"]
     assert start["zone"] == "intermediate" and start["snr_integration"] is None and start["received_w"] is None
@@ -285,7 +287,7 @@ TWO_MODELS = ONE_MODEL.replace('model = "reduced"', 'models = ["reduced", "trunc
 
 
 @pytest.mark.parametrize("argv,text,message", [
-    (["observe", "{scene}"], ONE_MODEL, "observe needs two models"),
+    (["observe", "{scene}"], ONE_MODEL, "[simulation].models: observe needs two models"),
     (["observe", "{scene}"], TWO_MODELS.replace("delta = 0.3\nchi = 0.7", "inertia = [1.0, 0.8, 0.55]\ndipole = [0.5, 0.3, 0.8]"),
      "needs a symmetric top"),
     (["observe", "{scene}", "--los", "1,2"], TWO_MODELS, "--los: expected three numbers"),
@@ -304,7 +306,7 @@ TWO_MODELS = ONE_MODEL.replace('model = "reduced"', 'models = ["reduced", "trunc
     (["observe", "{scene}"], TWO_MODELS + "[observe]\nt_end_T = -3\n", "[observe].t_end_T: must be positive"),
     (["listen", "{scene}", "--out", "{tmp}/x.mp3"], TWO_MODELS, "--out: "),
     (["listen", "{scene}", "--out", "{tmp}/x.wav", "--f0", "1e5"], TWO_MODELS, "--f0: must lie in [20, 5000]"),
-    (["listen", "{scene}", "--out", "{tmp}/x.wav"], ONE_MODEL, "observe needs two models"),
+    (["listen", "{scene}", "--out", "{tmp}/x.wav"], ONE_MODEL, "[simulation].models: listen needs two models"),
 ])
 def test_bad_input_is_one_line_exit_2_and_writes_nothing(argv, text, message, tmp_path, capsys):
     scene = tmp_path / "scene.toml"

@@ -13,7 +13,7 @@ from spinviz.commands import main
 from spinviz.errors import SceneError
 from spinviz.inputs.measurements import read_measurements
 from spinviz.physics import bodies as B
-from spinviz.physics import longitudinal as LG
+from spinviz.physics import models as M
 from spinviz.physics import presets as P
 
 W = math.pi * 1e10
@@ -25,7 +25,7 @@ def series(model, t, sigma_lnp, sigma_f, seed, u0=W**2, b0=W**2):
     """The line of ``model`` (closed forms) at times t with Gaussian noise: sigma_lnp on ln P,
     sigma_f (Hz) on f."""
     rng = np.random.default_rng(seed)
-    f, shape = LG.line(model, t, u0, b0, TAU0)
+    f, shape = M.get(model).line.line(t, u0, b0, TAU0)
     p = 1e-19 * shape / shape[0] * np.exp(sigma_lnp * rng.standard_normal(t.size))
     fo = f + sigma_f * rng.standard_normal(t.size)
     return PF.Series(fo, p, np.full(t.size, sigma_f), sigma_lnp * p, t, "W/sr")

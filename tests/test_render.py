@@ -537,7 +537,7 @@ def test_power_inset_pixels_in_the_default_scene(size):
     bar's cursor -- at the first, middle and last frames, with each model's dot on it; and late in
     the run the reduced (teal) curve runs far below the truncated (purple) one: its residual
     rotation about the dipole does not radiate."""
-    from spinviz.rendering.style import MODEL_COLORS
+    from spinviz.presentation import style as model_style
 
     plan, imgs, session = scene_frames(SCENES[[p.stem for p in SCENES].index("default")], size=size)
     try:
@@ -545,7 +545,7 @@ def test_power_inset_pixels_in_the_default_scene(size):
         pal = session.picture.theme.hud
         assert inset.plots == ("power",)
         x0, y0, x1, y1 = inset.boxes[0]
-        teal, purple = MODEL_COLORS["reduced"], MODEL_COLORS["truncated"]
+        teal, purple = model_style("reduced").color, model_style("truncated").color
         index = {"first": 0, "middle": plan.frames // 2, "last": plan.frames - 1}
         for name, img in imgs.items():
             f = index[name]

@@ -14,6 +14,7 @@ import pytest
 
 from spinviz import pipeline
 from spinviz import units as U
+from spinviz.presentation import style as model_style
 from spinviz.rendering.camera import Camera
 from spinviz.rendering.captions import texts_of
 from spinviz.rendering.fonts import Fonts
@@ -23,7 +24,7 @@ from spinviz.rendering.overlay import Fill, Text
 from spinviz.rendering.picture import plan_picture
 from spinviz.rendering.spec import RenderSpec
 from spinviz.rendering.stage import ARROW_VECTORS, EDGE_PX, arrow_length, content_points
-from spinviz.rendering.style import MODEL_COLORS, theme
+from spinviz.rendering.style import theme
 from spinviz.rendering.timeline import frame_times
 from spinviz.rotations import matrix_from_quat
 
@@ -341,7 +342,7 @@ def test_power_plot_is_planned_in_watts_on_whole_decades_and_lines_up_with_the_t
     assert [c[1] for c in curves] == [(0, 128, 128), (136, 60, 180)]
     s = plan.sim_t / plan.sim_t[-1]
     for (color, _, rows), panel in zip(inset.dots, plan.panels):
-        assert color == MODEL_COLORS[panel.model]
+        assert color == model_style(panel.model).color
         want = [_rows_of(1.5e-17 * 10.0 ** (-POWER_DECADES_FALL[panel.model] * x), box, inset.scales[0]) for x in s]
         np.testing.assert_allclose(rows, want, atol=0.5)
         np.testing.assert_allclose(panel.power[0], 1.5e-10)                      # erg/s in the plan

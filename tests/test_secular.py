@@ -9,9 +9,9 @@ from spinviz import rotations as R
 from spinviz.driver import SimulationError, simulate
 from spinviz.integrators import slowflow as SF
 from spinviz.integrators.auto import choose_method
-from spinviz.integrators.status import MODEL_ID
 from spinviz.physics import bodies as B
 from spinviz.physics import closed_forms as CF
+from spinviz.physics import models as M
 from spinviz.physics import presets as P
 
 W = math.pi * 1e10                      # the spin of section 6, rad/s
@@ -23,7 +23,7 @@ NODES = SF.phase_nodes(SF.M_PHASES)
 def averaged(delta, chi, wp, w3, scale=1.0):
     """(d w_perp, d w3, d p) of the compiled averaged flow: radiation part plus the free -delta w3."""
     J, g = (1.0, 1.0, 1.0 - delta), tuple(math.sqrt(scale) * np.array([math.sin(chi), 0.0, math.cos(chi)]))
-    dwp, dw3, dp, _ = SF.avg_rates(MODEL_ID["reduced"], J, g, wp, w3, *NODES, False)
+    dwp, dw3, dp, _ = SF.avg_rates(M.get("reduced").kernel_id, J, g, wp, w3, *NODES, False)
     return dwp, dw3, dp - delta * w3
 
 
@@ -170,9 +170,10 @@ def test_radiation_part_plus_free_rate_is_the_rate(model):
     """At 200 random states (the rate functions take arrays): round-off, measured at most
     3.6e-15 absolute."""
     from spinviz.physics import equations as E
+    from spinviz.physics import models as M
 
     w = np.random.default_rng(3).normal(size=(3, 200))
     J, g = (1.0, 0.8, 0.5), (0.3, -0.2, 0.7)
-    total = np.array(E.rate_function(model)(*w, J, g))
-    parts = np.array(E.radiation_function(model)(*w, J, g)) + np.array(E.free_rate(*w, J, g))
+    total = np.array(M.rate_function(model)(*w, J, g))
+    parts = np.array(M.radiation_function(model)(*w, J, g)) + np.array(E.free_rate(*w, J, g))
     np.testing.assert_allclose(parts, total, rtol=1e-13, atol=1e-14)

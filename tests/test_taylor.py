@@ -14,6 +14,7 @@ from spinviz.integrators.scaling import spin_problem
 from spinviz.physics import bodies as B
 from spinviz.physics import cases
 from spinviz.physics import equations as E
+from spinviz.physics import models as M
 
 hy = pytest.importorskip("heyoka")
 
@@ -46,7 +47,7 @@ def test_taylor_right_hand_sides_are_the_rates_of_physics_equations(model, rng):
         got = cf(np.concatenate([u, q]), pars=np.array([*J, *g, c]), time=t)
         sigma = math.sqrt(1.0 + c * t)
         w = u / sigma
-        a = np.array(E.rate_function(model)(*w, tuple(J), tuple(g)))
+        a = np.array(M.rate_function(model)(*w, tuple(J), tuple(g)))
         want = np.concatenate([sigma * a + u * c / (2.0 * sigma**2), E.quat_rate(*q, *w)])
         uu, gg = float(u @ u), float(g @ g)
         euler = (uu / sigma + gg * uu**1.5 / sigma**2 + c * math.sqrt(uu)) / J.min()
@@ -71,7 +72,7 @@ def test_symmetric_form_is_the_general_rate(model, rng):
         n1, n3 = k * math.sin(chi), k * math.cos(chi)
         u = rng.normal(size=3) * 10 ** rng.uniform(-2, 0)
         got = cf(u, pars=np.array([delta, n1, n3, 0.0]), time=0.0)
-        want = np.array(E.rate_function(model)(*u, (1.0, 1.0, 1.0 - delta), (n1, 0.0, n3)))
+        want = np.array(M.rate_function(model)(*u, (1.0, 1.0, 1.0 - delta), (n1, 0.0, n3)))
         terms = ((u @ u) + k * k * (u @ u) ** 1.5) / (1.0 - delta)
         worst = max(worst, float(np.max(np.abs(got - want))) / terms)
     assert worst < 1e-14, worst
@@ -232,7 +233,7 @@ def test_solve_many_spin_units_round_trip():
 
 def test_spin_problem_coupling_and_time_scale():
     """The spin-unit problem of the atlas's runs: |omega(0)| = 1, |g|^2 = eps, t scaled by eps."""
-    s = E.System("reduced", (1.0, 1.0, 0.7), (0.6, 0.0, 0.8))
+    s = M.System("reduced", (1.0, 1.0, 0.7), (0.6, 0.0, 0.8))
     p, eps = spin_problem(s, (0.03, 0.0, 0.04), np.array([0.0, 10.0]), kinematics="none")
     assert eps == pytest.approx(0.05) and np.linalg.norm(p.omega0) == pytest.approx(1.0)
     assert float(np.dot(p.system.coupling, p.system.coupling)) == pytest.approx(0.05)

@@ -18,8 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import rotations as R
-from .. import units as U
-from ..plotting import pyplot, save
+from ..plotting import model_color, pyplot, save, time_unit
 from ..trajectory import Trajectory
 from ..units import format_time
 
@@ -128,7 +127,7 @@ def summarize(tr: Trajectory) -> ModelSummary:
 def compare(trajs: list[Trajectory]) -> Comparison:
     """Compare two trajectories of the same body and initial state, stored at the same times."""
     if len(trajs) != 2:
-        raise ValueError("compare needs a scene with two models (models = [\"reduced\", \"truncated\"])")
+        raise ValueError(f"compare takes two trajectories (one model each), got {len(trajs)}")
     a, b = trajs
     resolved = a.phase_resolved and b.phase_resolved and a.q is not None and b.q is not None
     mis = dip = None
@@ -169,30 +168,6 @@ def format_table(c: Comparison, title: str) -> str:
 
 
 DIFF_STYLES = {"misorientation": ("0.6", "-."), "dipoles": ("0.35", "--"), "cone": ("0.0", "-")}
-
-
-def model_color(model: str) -> str:
-    """The model's colour in the videos (``rendering.style.MODEL_COLORS``), as matplotlib hex."""
-    from ..rendering.style import MODEL_COLORS
-
-    r, g, b = MODEL_COLORS.get(model, (90, 90, 90))
-    return f"#{r:02x}{g:02x}{b:02x}"
-
-
-def time_unit(t_end: float, units: str) -> tuple[float, str]:
-    """(seconds per unit, axis label) for times up to t_end: hours, days or years (10⁶ years
-    beyond a million), or τ₀ for dimensionless runs."""
-    if units != "cgs":
-        return 1.0, "time t (τ₀)"
-    if t_end >= 2e6 * U.YEAR:
-        return 1e6 * U.YEAR, "time t (million years)"
-    if t_end >= 2 * U.YEAR:
-        return U.YEAR, "time t (years)"
-    if t_end >= 2 * U.DAY:
-        return U.DAY, "time t (days)"
-    if t_end >= 2 * U.HOUR:
-        return U.HOUR, "time t (hours)"
-    return 1.0, "time t (s)"
 
 
 def plot(c: Comparison, path: str, title: str) -> None:

@@ -47,10 +47,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import units as U
-from ..physics import longitudinal as LG
+from ..physics import models as M
 from . import receiver as RC
 
-MODELS = LG.MODELS
 DECISION_Z = 5.0
 SHARE = 0.95
 RECORDS_PER_DECADE = 12
@@ -80,6 +79,7 @@ class Setup:
     epsilon: float = 1.0
     spin_range: tuple = (0.5, 2.0)
     tau0_mode: str = "known"
+    models: tuple = ("reduced", "truncated")
 
     def edges(self) -> np.ndarray:
         """Record edges (s): 0, t_int, then ``RECORDS_PER_DECADE`` a decade to the horizon, each
@@ -98,24 +98,16 @@ class Setup:
 
 def setup_from_scene(sc, spec, horizon: float, spin_range=(0.5, 2.0), tau0_mode: str = "known") -> Setup:
     """The ``Setup`` of scene ``sc`` watched by receiver ``spec`` (``inputs.receiver.ReceiverSpec``)
-    for ``horizon`` s; ValueError naming what is missing when the scene cannot be decided so."""
-    body = sc.body
-    if body.units != "cgs":
-        raise ValueError("decide needs a body in physical units (CGS): the receiver has distances, powers and noise")
-    if not LG.has_line_law(body.delta, body.chi, body.is_symmetric):
-        raise ValueError(f"[body]: decide needs a dipole along the symmetry axis (chi = 0) or a spherical top "
-                         f"(delta = 0), whose line is a closed form of the start ((5.2), (5.4)); this body has "
-                         f"delta = {body.delta:.3g}, chi = {math.degrees(body.chi):.3g} deg")
-    if len(sc.models) != 2 or set(sc.models) != set(MODELS):
-        raise ValueError("[simulation].models: decide compares the reduced and the truncated model: "
-                         "models = [\"reduced\", \"truncated\"]")
+    for ``horizon`` s; ``SceneError`` naming what the scene lacks (``Scene.require("decide")``)."""
+    body = sc.require("decide").body
     gain = None if spec.antenna_area_cm2 is not None else float(U.gain_from_dbi(
         spec.record()["antenna_gain_dbi"]))
     return Setup(tau0=body.tau0, larmor=2.0 * body.dipole_magnitude**2 / (3.0 * U.C_LIGHT**3),
                  distance_cm=spec.distance_cm, noise_density=spec.noise_density, integration_s=spec.integration_s,
                  bandwidth_hz=spec.bandwidth_hz, gain=gain, area_cm2=spec.antenna_area_cm2,
                  omega_ref=float(np.linalg.norm(sc.omega0)), horizon=float(horizon), epsilon=body.epsilon,
-                 spin_range=tuple(float(x) for x in spin_range), tau0_mode=tau0_mode)
+                 spin_range=tuple(float(x) for x in spin_range), tau0_mode=tau0_mode,
+                 models=tuple(sc.models))
 
 
 # --- one trial --------------------------------------------------------------------------------
@@ -160,17 +152,9 @@ def _nodes(edges: np.ndarray):
 def _prediction(model: str, t, w0, share, tau0):
     """(f, y) at times t: the line frequency (Hz) and y = ln(Omega_perp^2 omega_L^2) from the start
     (omega_L0^2, sin^2 theta_L0); complex parameters allowed (complex-step derivatives)."""
-    u0 = share * w0
-    b0 = (1.0 - share) * w0
-    if model == "truncated":
-        F2 = 1.0 + 2.0 * tau0 * u0 * t
-        return np.sqrt(w0 / F2) / (2.0 * math.pi), np.log(u0 * w0) - 2.0 * np.log(F2)
-    x = 2.0 * tau0 * b0 * t
-    small = np.abs(x) < 1e-8
-    ratio = np.where(small, 1.0 + 0.5 * x, np.expm1(x) / np.where(small, 1.0, x))
-    u = u0 / (1.0 + 2.0 * tau0 * w0 * t * ratio)
-    w2 = u + b0
-    return np.sqrt(w2) / (2.0 * math.pi), np.log(u * w2)
+    u, b = M.get(model).line.state(t, share * w0, (1.0 - share) * w0, tau0)
+    w2 = u + b
+    return np.sqrt(w2) / (2.0 * math.pi), np.log(u) + np.log(w2)
 
 
 @dataclass
@@ -208,10 +192,11 @@ def observe_trial(setup: Setup, start: Start, truth: str, rng) -> Records:
     weight = S * w / np.where(energy > 0, energy, 1.0)[:, None]
     fbar, ybar = np.sum(weight * f, axis=1), np.sum(weight * y, axis=1)
     tm = np.sum(weight * t, axis=1)
-    u, b = LG.state(truth, tm, start.u0, start.b0, setup.tau0)
+    line = M.get(truth).line
+    u, b = line.state(tm, start.u0, start.b0, setup.tau0)
     fm = np.sqrt(u + b) / (2.0 * math.pi)
-    fdot = -setup.tau0 * u * fm
-    fddot = setup.tau0**2 * fm * u * ((3.0 * u + 2.0 * b) if truth == "reduced" else 3.0 * u)
+    rate, accel = line.drift(u, b, setup.tau0)
+    fdot, fddot = rate * fm, accel * fm
     t_coh = RC.coherent_interval(fdot, fddot, setup.integration_s, setup.bandwidth_hz)
     s_mean = energy / (edges[1:] - edges[:-1])
     rho_c = 2.0 * s_mean * t_coh / setup.noise_density
@@ -287,7 +272,8 @@ def _polarization_chi2(rec: Records) -> float:
 def z_at(rec: Records, truth: str, start: Start, setup: Setup, warm: dict) -> float:
     """Z of ``truth`` against the other model on records ``rec`` (module docstring, step 3);
     ``warm`` {model: x} holds the last best fits (starting points for the next)."""
-    other = MODELS[1] if truth == MODELS[0] else MODELS[0]
+    first, second = setup.models
+    other = second if truth == first else first
     fitted = setup.tau0_mode == "fitted"
     x_true = np.array([0.0, start.share, 0.0])
     chi = {}
@@ -335,7 +321,7 @@ def run_trials(setup: Setup, seed: int, indices) -> list[dict]:
         rng = np.random.default_rng(seqs[i])
         start = draw_start(setup, rng)
         row = {"trial": int(i), "u0": start.u0, "b0": start.b0, "cos_alpha": start.cos_alpha}
-        for truth in MODELS:
+        for truth in setup.models:
             rec = observe_trial(setup, start, truth, rng)
             t_star, z_end = decision_time(rec, truth, start, setup)
             row[truth] = {"t": t_star, "z_end": z_end, "records": int(rec.end.size)}
@@ -373,8 +359,8 @@ class Outcome:
                 "tau0": s.tau0_mode, "horizon_s": s.horizon, "decision_z": DECISION_Z, "share": SHARE,
                 "t95_s": {k: _num(v) for k, v in self.t95.items()},
                 "t95_interval_s": {k: [_num(x) for x in v] for k, v in self.interval.items()},
-                "decided_at_horizon": {m: float(np.mean(np.isfinite(self.times(m)))) for m in MODELS},
-                "decision_times_s": {m: [_num(x) for x in self.times(m)] for m in MODELS}}
+                "decided_at_horizon": {m: float(np.mean(np.isfinite(self.times(m)))) for m in s.models},
+                "decision_times_s": {m: [_num(x) for x in self.times(m)] for m in s.models}}
 
 
 def _num(x):
@@ -408,7 +394,7 @@ def quantile_interval(times: np.ndarray, share: float = SHARE, level: float = 0.
 
 def summarize(out: Outcome) -> Outcome:
     """Fill ``t95`` and its 68 % interval (``quantile_interval``: the Monte Carlo's own spread)."""
-    for m in MODELS:
+    for m in out.setup.models:
         t = out.times(m)
         out.t95[m] = quantile_time(t)
         out.interval[m] = quantile_interval(t)
@@ -427,47 +413,6 @@ def run(setup: Setup, trials: int, seed: int = 1, mapper=None, batch: int = 8) -
     return summarize(Outcome(setup=setup, trials=trials, seed=seed, rows=rows))
 
 
-def _quiet_worker() -> None:
-    """A pool worker leaves SIGINT and SIGHUP to its parent (a terminal sends them to the whole
-    process group): the parent stops the pool itself."""
-    import signal
-
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGHUP, signal.SIG_IGN)
-
-
-class ProcessMapper:
-    """``with ProcessMapper(n) as m: m(fn, items)``: ``map`` over ``n`` worker processes, in order,
-    waiting in short slices that look at ``interrupt.check()``; the pool is terminated on any
-    exception (a stop signal included), so nothing keeps running after the command."""
-
-    def __init__(self, workers: int):
-        self.workers = int(workers)
-        self.pool = None
-
-    def __enter__(self) -> ProcessMapper:
-        import multiprocessing
-
-        self.pool = multiprocessing.get_context("fork").Pool(self.workers, initializer=_quiet_worker)
-        return self
-
-    def __call__(self, fn, items) -> list:
-        from ..interrupt import check
-
-        job = self.pool.map_async(fn, items, chunksize=1)
-        while not job.ready():
-            check()
-            job.wait(0.05)
-        return job.get()
-
-    def __exit__(self, kind, value, tb) -> None:
-        if kind is None:
-            self.pool.close()
-        else:
-            self.pool.terminate()
-        self.pool.join()
-
-
 def format_outcome(out: Outcome, title: str, receiver) -> str:
     """The answer for people: the setup, the start distribution, and per truth the time by which
     95 % of the trials are decided at 5 sigma (with the Monte Carlo's interval)."""
@@ -477,7 +422,7 @@ def format_outcome(out: Outcome, title: str, receiver) -> str:
              f"tau0: {'the body' + chr(39) + 's (known)' if s.tau0_mode == 'known' else 'fitted with the start'}; "
              f"{out.trials} trials (seed {out.seed}); watched for at most {U.human_time(s.horizon)}", ""]
     lines.append(f"how long to watch: the time by which {100 * SHARE:g} % of the trials reach Z = {DECISION_Z:g}")
-    for m in MODELS:
+    for m in s.models:
         t = out.times(m)
         decided = float(np.mean(np.isfinite(t)))
         t95 = out.t95[m]

@@ -9,16 +9,12 @@ import math
 import numpy as np
 
 from .. import units as U
-from ..physics import longitudinal as LG
-from ..plotting import pyplot, save
-from .compare import model_color, time_unit
-
-STYLES = {"reduced": ("-", 2.2), "truncated": ("--", 1.6)}
+from ..physics import models as M
+from ..plotting import model_color, model_line, pyplot, save, time_unit
 
 
 def _style(model: str, **kw):
-    ls, lw = STYLES.get(model, ("-", 1.6))
-    return {"color": model_color(model), "ls": ls, "lw": lw, **kw}
+    return model_line(model, **kw)
 
 
 def _time_axis(ax, tl: str) -> None:
@@ -85,7 +81,7 @@ def _resolution_panel(ax, obs, pos, scale) -> None:
         series = {"frequency": bg.sigma_f[pos] / f, "power": bg.sigma_lnp[pos], "polarization": bg.sigma_pol[pos]}
         for key, y in series.items():
             y = np.where(np.isfinite(y), y, np.nan)
-            ax.plot(t, y, color=colors[key], ls=STYLES[bg.model][0], lw=1.4,
+            ax.plot(t, y, color=colors[key], ls=model_line(bg.model)["ls"], lw=1.4,
                     label=f"{key} ({'σ_f/f' if key == 'frequency' else 'σ_P/P' if key == 'power' else 'σ_ψ, rad'}), "
                           f"{bg.model}")
     ax.set_yscale("log")
@@ -137,12 +133,13 @@ def _pf_panel(ax, obs) -> None:
         ax.errorbar(s.f_hz / 1e9, s.power, yerr=s.sigma_power, fmt="o", ms=2.0, color=model_color(m), alpha=0.45,
                     elinewidth=0.6, label=f"{m}'s run, {len(s)} integrations: verdict {r.verdict} (Z = {r.z:.3g})")
         f = np.linspace(s.f_hz.min(), s.f_hz.max(), 300)
-        for law, ls in (("truncated", "--"), ("reduced", "-")):
-            fit = r.truncated if law == "truncated" else r.reduced
-            y = np.exp(fit.params["a"]) * LG.law(law, f, fit.params["f_inf_hz"])
-            ax.plot(f / 1e9, y, color=model_color(law), ls=ls, lw=1.0)
-    ax.plot([], [], color=model_color("truncated"), ls="--", label="fitted P = A f⁴ (truncated law)")
-    ax.plot([], [], color=model_color("reduced"), ls="-", label="fitted P = A f²(f² − f∞²) (reduced law)")
+        for law in ("truncated", "reduced"):
+            fit = getattr(r, law)
+            y = np.exp(fit.params["a"]) * M.get(law).line.law(f, fit.params["f_inf_hz"])
+            ax.plot(f / 1e9, y, **model_line(law, lw=1.0))
+    for law in ("truncated", "reduced"):
+        formula = M.get(law).line.formula.replace("P ∝", "P = A")
+        ax.plot([], [], **model_line(law, lw=1.0), label=f"fitted {formula} ({law} law)")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.xaxis.set_major_formatter(lambda v, _: f"{v:g}")
@@ -189,16 +186,16 @@ def plot_decide(out, title: str, path: str) -> None:
     interval), and each trial's decision time against its start's f_inf / f0 = eps |Omega_par| /
     omega_L0 (the slow trials are the starts spun nearly across the dipole) (PNG, atomic)."""
     plt = pyplot()
-    from .decide import DECISION_Z, MODELS, SHARE
+    from .decide import DECISION_Z, SHARE
 
     s = out.setup
-    finite = np.concatenate([out.times(m)[np.isfinite(out.times(m))] for m in MODELS])
+    finite = np.concatenate([out.times(m)[np.isfinite(out.times(m))] for m in out.setup.models])
     lo = max(float(finite.min()) / 2 if finite.size else s.integration_s, s.integration_s / 2)
     T = np.geomspace(lo, s.horizon, 400)
     scale, tl = time_unit(max(float(finite.max()) if finite.size else s.horizon, lo * 10), "cgs")
     fig, axes = plt.subplots(1, 2, figsize=(15, 5.8))
     ax = axes[0]
-    for j, m in enumerate(MODELS):
+    for j, m in enumerate(out.setup.models):
         never = 100.0 * float(np.mean(~np.isfinite(out.times(m))))
         ax.plot(T / scale, out.fraction(m, T), **_style(m, label=f"truth: {m} ({never:.3g} % never decided)"))
         t95 = out.t95[m]
@@ -214,7 +211,7 @@ def plot_decide(out, title: str, path: str) -> None:
     _time_axis(ax, tl.replace("time t", "observation time"))
     ax.legend(fontsize=8, loc="center right")
     ax = axes[1]
-    for m in MODELS:
+    for m in out.setup.models:
         share = np.array([r["b0"] / (r["u0"] + r["b0"]) for r in out.rows])
         t = out.times(m)
         never = ~np.isfinite(t)

@@ -110,10 +110,11 @@ def observe(trajs, title: str, line_of_sight=None, receiver=None, omega0=None, r
     sphere, the closed forms the parting curves use."""
     from ..inputs.receiver import ReceiverSpec
     from ..physics import longitudinal as LG
+    from ..physics import models as M
     from .detector import default_line_of_sight, detect
 
     if len(trajs) != 2:
-        raise ValueError("observe needs a scene with two models (models = [\"reduced\", \"truncated\"])")
+        raise ValueError(f"observe takes two trajectories (one model each), got {len(trajs)}")
     receiver = ReceiverSpec() if receiver is None else receiver
     n = default_line_of_sight(trajs[0]) if line_of_sight is None else line_of_sight
     dets = [detect(tr, n, receiver.distance_cm) for tr in trajs]
@@ -121,9 +122,8 @@ def observe(trajs, title: str, line_of_sight=None, receiver=None, omega0=None, r
     scales, printed = _scales(body, omega0)
     law = LG.has_line_law(body.delta, body.chi, body.is_symmetric)
     start = (LG.start_state(omega0, body.dipole_direction, body.epsilon)
-             if law and omega0 is not None and {t.model for t in trajs} == set(LG.MODELS) else None)
-    by_model = {d.model: d for d in dets}
-    a, b = (by_model["reduced"], by_model["truncated"]) if start is not None else dets
+             if law and omega0 is not None and all(M.get(t.model).line is not None for t in trajs) else None)
+    a, b = dets
     obs = Observation(title=title, units=body.units, detections=dets,
                       parting=PT.curves(a, b, start, body.tau0, rtol), scales=scales, printed=printed,
                       horizon=float(trajs[0].t[-1]))
@@ -319,28 +319,19 @@ def _num(x, unit, cgs, kind) -> str:
 MIN_LINE = 1e-6
 
 
-def run_scene(sc, samples: int = 800, line_of_sight=None, distance_cm=None, receive: bool = True,
-              integration_s=None):
+def run_scene(sc, samples: int = 800, line_of_sight=None, receiver=None, receive: bool = True,
+              command: str = "observe"):
     """Simulate both models of scene ``sc`` over its ``[observe]`` horizon (or its own) at
-    ``observe_times`` and observe them with its receiver (its distance and integration time
-    overridden by ``distance_cm``, ``integration_s``; none with ``receive`` False):
-    (Observation, trajectories)."""
-    from dataclasses import replace
-
+    ``observe_times`` and observe them with ``receiver`` (an ``inputs.receiver.ReceiverSpec``;
+    default the scene's; nothing received with ``receive`` False): (Observation, trajectories).
+    The scene must have what ``command`` needs (``Scene.require``)."""
     from ..driver import simulate_request
 
-    if len(sc.models) != 2:
-        raise ValueError("[simulation].models: observe needs two models, e.g. models = [\"reduced\", \"truncated\"]")
-    if not sc.body.is_symmetric:
-        raise ValueError("[body]: the detector needs a symmetric top (I1 = I2); this body is asymmetric")
+    sc.require(command)
     horizon = sc.observe.t_end or sc.t_end
     times = observe_times(horizon, samples)
     trajs = [simulate_request(sc.request(m, t_eval=times)) for m in sc.models]
     los = line_of_sight if line_of_sight is not None else sc.observe.line_of_sight
-    receiver = sc.observe.receiver
-    if distance_cm is not None:
-        receiver = replace(receiver, distance_cm=float(distance_cm))
-    if integration_s is not None:
-        receiver = replace(receiver, integration_s=float(integration_s))
+    receiver = sc.observe.receiver if receiver is None else receiver
     obs = observe(trajs, sc.title, los, receiver, omega0=sc.omega0, rtol=sc.rtol, receive=receive)
     return obs, trajs

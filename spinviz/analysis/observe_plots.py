@@ -9,17 +9,13 @@ import math
 import numpy as np
 
 from .. import units as U
-from ..plotting import pyplot, save
+from ..plotting import model_color, model_line, pyplot, save, time_unit
 from . import parting as PT
-from .compare import model_color, time_unit
 from .observe import MIN_LINE, OBSERVABLES, Observation, horizon_text
-
-STYLES = {"reduced": ("-", 2.4), "truncated": ("--", 1.7)}     # both visible where they coincide
 
 
 def _style(model: str):
-    ls, lw = STYLES.get(model, ("-", 1.7))
-    return {"color": model_color(model), "ls": ls, "lw": lw, "label": model}
+    return model_line(model, label=model)
 
 
 def _scale_marks(ax, obs: Observation, scale: float, t, axis: str = "x") -> None:

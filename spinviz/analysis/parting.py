@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..physics import longitudinal as LG
+from ..physics import models as M
 from .detector import Detection
 
 OBSERVABLES = ("power", "frequency", "polarization")
@@ -55,12 +55,13 @@ def differences(a: Detection, b: Detection) -> dict[str, np.ndarray]:
     return {"power": p, "frequency": f, "polarization": d}
 
 
-def exact_differences(t, u0: float, b0: float, tau0: float) -> dict[str, np.ndarray]:
-    """|ln(P_red/P_tru)| and |f_red/f_tru - 1| at times t from (5.2) and (5.4) (a top with d along
-    its axis, or a sphere, from the start (u0, b0) of ``physics.longitudinal.start_state``)."""
-    fr, pr = LG.line("reduced", t, u0, b0, tau0)
-    ft, pt = LG.line("truncated", t, u0, b0, tau0)
-    return {"power": np.abs(np.log(pr / pt)), "frequency": np.abs(fr / ft - 1.0)}
+def exact_differences(t, u0: float, b0: float, tau0: float, models=("reduced", "truncated")) -> dict[str, np.ndarray]:
+    """|ln(P_a/P_b)| and |f_a/f_b - 1| of the two ``models`` at times t from their closed-form
+    lines ((5.2) and (5.4): a top with d along its axis, or a sphere, from the start (u0, b0) of
+    ``physics.longitudinal.start_state``)."""
+    fa, pa = M.get(models[0]).line.line(t, u0, b0, tau0)
+    fb, pb = M.get(models[1]).line.line(t, u0, b0, tau0)
+    return {"power": np.abs(np.log(pa / pb)), "frequency": np.abs(fa / fb - 1.0)}
 
 
 def parting_time(t, D, r: float) -> float | None:
@@ -150,8 +151,8 @@ def setup_parting(c: PartingCurve, t_sigma, sigma, t_first: float) -> PartingCur
 
 
 def curves(a: Detection, b: Detection, start=None, tau0: float = 1.0, rtol: float = 1e-10) -> dict:
-    """The three parting curves of detections a (reduced) and b (truncated); ``start`` (u0, b0)
-    when the closed forms hold (then power and frequency come from them), else from the runs."""
+    """The three parting curves of detections a and b (one model each); ``start`` (u0, b0) when
+    the closed forms hold (then power and frequency come from them), else from the runs."""
     d = differences(a, b)
     floor = 10.0 * rtol
     runs = "the integrated runs (differences below 10 rtol not resolved)"
@@ -159,9 +160,11 @@ def curves(a: Detection, b: Detection, start=None, tau0: float = 1.0, rtol: floa
     if start is not None:
         horizon = float(a.t[-1])
         t = np.unique(np.concatenate([np.geomspace(horizon * 1e-12, horizon, 4000), a.t[a.t > 0]]))
-        exact = exact_differences(t, start[0], start[1], tau0)
+        models = (a.model, b.model)
+        exact = exact_differences(t, start[0], start[1], tau0, models)
+        source = "closed forms " + ", ".join(M.get(m).line.equation for m in models)
         for key in ("power", "frequency"):
-            out[key] = curve(key, t, exact[key], "closed forms (5.2), (5.4)", CLOSED_FLOOR)
+            out[key] = curve(key, t, exact[key], source, CLOSED_FLOOR)
     else:
         for key in ("power", "frequency"):
             out[key] = curve(key, a.t, d[key], runs, floor)

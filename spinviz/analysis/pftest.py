@@ -40,6 +40,7 @@ import numpy as np
 
 from .. import units as U
 from ..physics import longitudinal as LG
+from ..physics import models as M
 
 DECISION_Z = 5.0
 CONSISTENT_Z = 3.0
@@ -139,16 +140,17 @@ class PfTest:
         return out
 
 
-VERDICTS = {"reduced": "reduced (the line levels off: P ∝ f²(f² − f∞²), f∞ > 0 at 5σ)",
-            "truncated": "truncated (P ∝ f⁴ fits, f∞ consistent with 0)",
+VERDICTS = {"reduced": f"reduced (the line levels off: {M.REDUCED.line.formula}, f∞ > 0 at 5σ)",
+            "truncated": f"truncated ({M.TRUNCATED.line.formula} fits, f∞ consistent with 0)",
             "neither": "neither law fits at 5σ", "undecided": "undecided (3σ ≤ Z < 5σ)"}
 
 
 def line_law(body) -> tuple[str | None, str]:
     """(line, reason): the line the test uses for ``body`` and its laws, or (None, why there is none)."""
     if LG.has_line_law(body.delta, body.chi, body.is_symmetric):
+        laws = ", ".join(f"{m} {M.get(m).line.formula} {M.get(m).line.equation}" for m in ("truncated", "reduced"))
         return ("the rotation line |L|/(2π I1), the only one (d along the symmetry axis, or a sphere, cones about L); "
-                "truncated P ∝ f⁴ (5.4), reduced P ∝ f²(f² − f∞²) (5.2)"), ""
+                + laws), ""
     shape = "an asymmetric top" if not body.is_symmetric else f"a symmetric top with δ = {body.delta:.3g}, χ = " \
                                                               f"{math.degrees(body.chi):.3g}°"
     return None, (f"{shape} has no power-frequency law: the paper's laws hold for a dipole along the axis (χ = 0) or a "

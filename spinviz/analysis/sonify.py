@@ -33,7 +33,6 @@ from .. import units as U
 from .detector import Detection
 
 RATE = 44_100
-MAX_SECONDS = 600.0
 NYQUIST_SHARE = 0.45          # lines above 0.45 x the sample rate are dropped (they would alias)
 AUDIBLE_HZ = 20.0
 PITCH_RANGE = 16.0            # pitch="auto": a fall in frequency beyond 16x (4 octaves) is compressed into it
@@ -119,8 +118,8 @@ def synthesize(dets: list[Detection], duration: float = 20.0, f0: float = 440.0,
 
     knee : the log time map's k (default t_end/1000); pitch : "linear" (every frequency times
     one factor) or "auto" (that, unless the dominant frequency falls by more than 16x over the
-    run: then f0 (f/f_start)^gamma with gamma putting the whole fall into 16x)."""
-    _check_synthesis(dets, duration, time_map, pitch)
+    run: then f0 (f/f_start)^gamma with gamma putting the whole fall into 16x).  The sound's
+    arguments are ``inputs.options.ListenRequest``'s (``experiment.listen`` checks them)."""
     a, b = dets
     t = np.asarray(a.t, dtype=float)
     t_end = float(t[-1])
@@ -164,18 +163,6 @@ def synthesize(dets: list[Detection], duration: float = 20.0, f0: float = 440.0,
                       phase_resolved=bool(a.phase_resolved and b.phase_resolved), dropped_above_nyquist=dropped,
                       below_audible_s=float(below.sum() / rate))
     return out, mapping
-
-
-def _check_synthesis(dets, duration: float, time_map: str, pitch: str) -> None:
-    """``synthesize``'s arguments, checked before any work (ValueError saying which)."""
-    if len(dets) != 2:
-        raise ValueError("listen needs two models, one for each ear")
-    if not 0.5 <= duration <= MAX_SECONDS:
-        raise ValueError(f"duration must lie in [0.5, {MAX_SECONDS:g}] s, got {duration:g}")
-    if time_map not in ("log", "linear"):
-        raise ValueError(f"time map must be 'log' or 'linear', got {time_map!r}")
-    if pitch not in ("auto", "linear"):
-        raise ValueError(f"pitch must be 'auto' or 'linear', got {pitch!r}")
 
 
 def _channel(d: Detection, amp, fr, t, ts, ant, comp: float, rate: int):
@@ -260,8 +247,7 @@ def plot_wav(path_wav, path_png, title: str = "") -> None:
     axes from the file's own mapping; the mapping stated under the title (PNG, atomic)."""
     from scipy.io import wavfile
 
-    from ..plotting import pyplot, save
-    from .compare import model_color
+    from ..plotting import model_color, pyplot, save
 
     plt = pyplot()
     rate, data = wavfile.read(path_wav)
@@ -328,25 +314,23 @@ def audio_frequency(f, mapping: dict):
     return mapping["f0_audio"] * (np.asarray(f, dtype=float) / mapping["f0_source"]) ** mapping["pitch_exponent"]
 
 
-def listen_scene(sc, out_wav: str, out_png: str | None, duration: float = 20.0, f0: float = 440.0,
-                 time_map: str = "log", samples: int = 800, line_of_sight=None, distance_cm=None,
-                 dynamic_range_db: float = 60.0, pitch: str = "auto"):
+def listen_scene(sc, out_wav: str, out_png: str | None, req, line_of_sight=None, receiver=None):
     """Simulate and detect both models of scene ``sc`` (``observe.run_scene``), synthesize and
-    write the WAV (and its spectrogram PNG); returns the Mapping.  The caller makes the paths
-    atomic as a group (these write in place).  The sound's arguments are checked first
-    (``inputs.options.ListenRequest``: ``SpecError`` naming the argument), before the runs."""
-    from ..inputs.options import ListenRequest
+    write the WAV (and its spectrogram PNG, unless ``out_png`` is None); returns the Mapping.
+    ``req``: the sound, an ``inputs.options.ListenRequest`` (checked by its maker,
+    ``experiment.listen``, before any run); ``receiver``: where the detector stands (its
+    distance sets the field's zone; nothing is received).  The caller makes the paths atomic as
+    a group (these write in place)."""
     from .observe import run_scene
 
-    ListenRequest(duration=duration, f0=f0, time_map=time_map, pitch=pitch, dynamic_range_db=dynamic_range_db,
-                  samples=samples)
-    obs, _ = run_scene(sc, samples, line_of_sight, distance_cm, receive=False)     # the sound needs no receiver
+    duration, f0, time_map, pitch = req.duration, req.f0, req.time_map, req.pitch
+    obs, _ = run_scene(sc, req.samples, line_of_sight, receiver, receive=False, command="listen")
     # the log map's knee: a tenth of the braking time 1/(tau0 |Omega0|^2), where the motion starts to
     # change, unless t_end/1000 comes first (a geological horizon must not spend its first second on nothing)
     w0 = np.asarray(sc.omega0, dtype=float)
     horizon = float(obs.horizon)
     knee = min(horizon / 1000.0, 0.1 / (sc.body.tau0 * float(w0 @ w0))) if float(w0 @ w0) > 0 else horizon / 1000.0
-    data, mapping = synthesize(obs.detections, duration, f0, time_map, dynamic_range_db, knee=knee, pitch=pitch)
+    data, mapping = synthesize(obs.detections, duration, f0, time_map, req.dynamic_range_db, knee=knee, pitch=pitch)
     with open(out_wav, "wb") as fh:
         fh.write(wav_bytes(data, mapping.rate, sc.title, mapping))
     if out_png:

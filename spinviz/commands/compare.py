@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 
-from ..errors import SpecError, UsageError
 from .shared import EXIT_OK, cannot_write, need_matplotlib, out, p, positive, prefix_of
 
 
@@ -23,28 +22,17 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     """Carry out ``spinviz compare`` with the parsed ``args``; return its exit status."""
+    from .. import experiment
     from ..analysis import compare
     from ..atomic import Outputs
-    from ..driver import simulate_request
     from ..inputs.scene_spec import load_scene
 
     sc = load_scene(args.scene)
-    if len(sc.models) != 2:
-        raise UsageError(f"{args.scene}: [simulation].models: compare needs two models, "
-                         f"e.g. models = [\"reduced\", \"truncated\"]")
     need_matplotlib("compare's plots")
-    if args.samples > compare.MAX_SAMPLES:
-        raise UsageError(f"--samples: at most {compare.MAX_SAMPLES} (each model is stored at 2 x samples instants), "
-                         f"got {args.samples}")
     prefix = prefix_of(args)
     paths = [f"{prefix}_compare.png", f"{prefix}_hodograph.png"]
     group = Outputs(paths, [args.scene])                # checked before the runs, landed together after
-    times = compare.compare_times(sc.t_end, max(2, args.samples))
-    try:
-        trajs = [simulate_request(sc.request(m, t_eval=times)) for m in sc.models]
-    except SpecError as e:                              # the output times are the option's
-        raise SpecError("samples", e.reason) if e.key == "t_eval" else e from None
-    c = compare.compare(trajs)
+    c = experiment.compare(sc, samples=args.samples)    # the arguments and the scene checked before the runs
     try:
         with group as tmps:
             compare.plot(c, tmps[0], sc.title)

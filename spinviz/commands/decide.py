@@ -5,14 +5,21 @@ test needs to tell the two models apart at 5 sigma in 95 % of trials, with its p
 
 from __future__ import annotations
 
-import dataclasses
 import json
 
-from ..errors import UsageError
-from .shared import EXIT_OK, add_detector_options, cannot_write, numbers, out, p, positive, prefix_of, progress, whole
-
-DASK_TRIALS = 2000            # from this many trials (or with --scheduler) the Monte Carlo runs on Dask
-KEYS = ("distance_cm", "integration_s")
+from .shared import (
+    EXIT_OK,
+    add_detector_options,
+    cannot_write,
+    numbers,
+    out,
+    p,
+    positive,
+    prefix_of,
+    progress,
+    receiver_options,
+    whole,
+)
 
 
 def add_parser(sub) -> None:
@@ -28,7 +35,7 @@ def add_parser(sub) -> None:
     d.add_argument("--spin-range", type=numbers("LO,HI"), help="LO,HI: |Omega0| log-uniform over LO..HI x the scene's (default "
                                                     "0.5,2)")
     d.add_argument("--tau0", choices=("known", "fitted"), help="the body's tau0 known (default), or fitted with the start")
-    add_detector_options(d, KEYS)
+    add_detector_options(d, line_of_sight=False)
     d.add_argument("--workers", type=positive, help="worker processes (default: one per core)")
     d.add_argument("--scheduler", help="run the trials on a Dask cluster at this address (tcp://HOST:8786)")
     d.add_argument("--out", help="prefix of the plot (default renders/<scene>): <prefix>_decide.png")
@@ -37,28 +44,20 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     """Carry out ``spinviz decide`` with the parsed ``args``; return its exit status."""
+    from .. import experiment
     from ..analysis import decide as DC
     from ..atomic import Outputs
-    from ..inputs.decide import DecideArguments
     from ..inputs.scene_spec import load_scene
 
-    spec = DecideArguments(**{k: getattr(args, k) for k in ("trials", "seed", "spin_range", "tau0", "workers",
-                                                            "scheduler") if getattr(args, k) is not None})
     sc = load_scene(args.scene)
-    receiver = sc.observe.receiver
-    given = {k: getattr(args, k) for k in KEYS if getattr(args, k) is not None}
-    if given:
-        receiver = dataclasses.replace(receiver, **given)       # SpecError: named by its option
     if args.measurements is not None:
         return _measurements(args, sc)
-    try:
-        setup = DC.setup_from_scene(sc, receiver, sc.observe.t_end or sc.t_end, spec.spin_range, spec.tau0)
-    except ValueError as e:
-        raise UsageError(f"{args.scene}: {e}") from None
+    given = {k: getattr(args, k) for k in ("trials", "seed", "spin_range", "tau0", "workers", "scheduler")
+             if getattr(args, k) is not None}
     prefix = prefix_of(args)
     plot = f"{prefix}_decide.png"
     group = Outputs([plot], [args.scene])
-    outcome = _trials(DC, setup, spec, args)
+    outcome = experiment.decide(sc, say=progress, **given, **receiver_options(args))
     try:
         with group as tmps:
             from ..analysis.experiment_plots import plot_decide
@@ -66,6 +65,7 @@ def run(args) -> int:
             plot_decide(outcome, sc.title, tmps[0])
     except OSError as e:
         raise cannot_write(prefix, e) from None
+    receiver = experiment.receiver_of(sc, **receiver_options(args))
     if args.json:
         print(json.dumps({**outcome.record(), "receiver": receiver.record(), "plots": [plot]}, indent=2))
     else:
@@ -74,43 +74,17 @@ def run(args) -> int:
     return EXIT_OK
 
 
-def _trials(DC, setup, spec, args):
-    """The Monte Carlo where it belongs: a Dask cluster when large or asked for (the atlas's
-    ``Cluster``), worker processes otherwise."""
-    from ..inputs.render import usable_cores
-
-    if args.scheduler is not None or spec.trials >= DASK_TRIALS:
-        from ..regimes.cluster import Cluster, check_workers, polled
-
-        check_workers(args.workers, args.scheduler)
-        with Cluster(args.scheduler, args.workers) as cl:
-            progress(f"decide: {spec.trials} trials on {cl.describe}")
-
-            def mapper(fn, items):
-                return polled(cl.client.gather, cl.client.map(fn, items, pure=False))
-
-            return DC.run(setup, spec.trials, spec.seed, mapper)
-    workers = min(args.workers or usable_cores(), max(1, spec.trials // 8))
-    if workers == 1:
-        return DC.run(setup, spec.trials, spec.seed)
-    with DC.ProcessMapper(workers) as mapper:
-        return DC.run(setup, spec.trials, spec.seed, mapper)
-
-
 def _measurements(args, sc) -> int:
     """``decide --measurements FILE``: the start-free P-f test of measured data."""
-    from ..analysis import pftest as PF
-    from ..inputs.measurements import read_measurements
+    from .. import experiment
 
-    law, reason = PF.line_law(sc.body)
-    data, unit = read_measurements(args.measurements)
+    law, test = experiment.test_measurements(sc, args.measurements)
     if law is None:
         if args.json:
-            print(json.dumps({"measurements": args.measurements, "law": None, "reason": reason}, indent=2))
+            print(json.dumps({"measurements": args.measurements, "law": None, "reason": test}, indent=2))
         else:
-            out(f"{p(args.measurements)}: no test: {reason}")
+            out(f"{p(args.measurements)}: no test: {test}")
         return EXIT_OK
-    test = PF.fit(PF.from_measurements(data, unit, args.measurements))
     if args.json:
         print(json.dumps({"measurements": args.measurements, "law": law, **test.record()}, indent=2, default=float))
     else:

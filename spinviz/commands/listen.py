@@ -5,10 +5,8 @@ from __future__ import annotations
 
 import os
 
-from ..errors import SimulationError, UsageError
-from .shared import EXIT_OK, add_detector_options, cannot_write, detector_overrides, need_matplotlib, out, p, positive, real
-
-MAX_SAMPLES = 100_000
+from ..errors import SimulationError
+from .shared import EXIT_OK, add_detector_options, cannot_write, need_matplotlib, out, p, positive, real, receiver_options
 
 
 def add_parser(sub) -> None:
@@ -26,38 +24,25 @@ def add_parser(sub) -> None:
                          "16x, which is then compressed into 16x (default)")
     li.add_argument("--dynamic-range-db", type=real, default=60.0,
                     help="the field's range in dB is compressed into this many dB of sound when larger (default 60)")
-    add_detector_options(li, hidden=("distance_cm",))
+    add_detector_options(li, hidden=("integration_s", "antenna_gain_dbi", "noise_temperature_k"))
     li.add_argument("--samples", type=positive, default=800, help="evenly spaced plus as many log-spaced instants")
 
 
 def run(args) -> int:
     """Carry out ``spinviz listen`` with the parsed ``args``; return its exit status."""
+    from .. import experiment
     from ..analysis import sonify
-    from ..atomic import Outputs
-    from ..inputs.options import ListenRequest
-    from ..inputs.scene_spec import load_scene
 
-    detector_overrides(args)
-    if os.path.splitext(args.out)[1].lower() != ".wav":
-        raise UsageError(f"--out: {args.out}: the sound is written as WAV; give a path ending in .wav")
-    png = args.png or os.path.splitext(args.out)[0] + ".png"
-    if os.path.splitext(png)[1].lower() != ".png":
-        raise UsageError(f"--png: {png}: give a path ending in .png")
-    ListenRequest(duration=args.duration, f0=args.f0, time_map=args.time_map, pitch=args.pitch,   # named by option
-                  dynamic_range_db=args.dynamic_range_db, samples=args.samples)
-    sc = load_scene(args.scene)
     need_matplotlib("listen's spectrogram")
-    group = Outputs([args.out, png], [args.scene])
     try:
-        with group as (tmp_wav, tmp_png):
-            mapping = sonify.listen_scene(sc, tmp_wav, tmp_png, args.duration, args.f0, args.time_map, args.samples,
-                                          args.line_of_sight, args.distance_cm, args.dynamic_range_db, args.pitch)
+        mapping = experiment.listen(args.scene, args.out, png=args.png, duration=args.duration, f0=args.f0,
+                                    time_map=args.time_map, pitch=args.pitch, dynamic_range_db=args.dynamic_range_db,
+                                    samples=args.samples, line_of_sight=args.line_of_sight, **receiver_options(args))
     except SimulationError as e:
         raise SimulationError(f"{args.scene}: {e}") from None
-    except ValueError as e:
-        raise UsageError(f"{args.scene}: {e}") from None
     except OSError as e:
         raise cannot_write(args.out, e) from None
+    png = args.png or os.path.splitext(args.out)[0] + ".png"
     out(f"{p(args.out)}: {mapping.duration_s:g} s, {mapping.rate} Hz, 16-bit stereo")
     out(mapping.statement())
     if mapping.dropped_above_nyquist:

@@ -8,11 +8,8 @@ from __future__ import annotations
 import argparse
 import json
 
-from ..errors import SimulationError, UsageError
-from .shared import EXIT_OK, add_detector_options, cannot_write, detector_overrides, need_matplotlib, out, p, positive, prefix_of
-
-MAX_SAMPLES = 100_000
-KEYS = ("line_of_sight", "distance_cm", "integration_s")
+from ..errors import SimulationError
+from .shared import EXIT_OK, add_detector_options, cannot_write, need_matplotlib, out, p, positive, prefix_of, receiver_options
 
 
 def _refused_option(text: str):
@@ -30,7 +27,7 @@ def add_parser(sub) -> None:
     o.add_argument("scene")
     o.add_argument("--out", help="prefix of the PNG plots (default renders/<scene>): <prefix>_observe.png, "
                                  "<prefix>_detector.png and, for a physical body, <prefix>_receiver.png")
-    add_detector_options(o, KEYS)
+    add_detector_options(o)
     for gone in ("--power-factor", "--frequency-resolution", "--polarization-deg"):
         # fixed thresholds: the resolutions are the receiver's; say so instead of "unrecognized"
         o.add_argument(gone, type=_refused_option, help=argparse.SUPPRESS)
@@ -40,25 +37,21 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     """Carry out ``spinviz observe`` with the parsed ``args``; return its exit status."""
+    from .. import experiment
     from ..analysis import observe as OB
     from ..analysis import observe_plots as OP
     from ..atomic import Outputs
     from ..inputs.scene_spec import load_scene
 
-    detector_overrides(args, KEYS)
     sc = load_scene(args.scene)
     need_matplotlib("observe's plots")
-    if args.samples > MAX_SAMPLES:
-        raise UsageError(f"--samples: at most {MAX_SAMPLES}, got {args.samples}")
     prefix = prefix_of(args)
     paths = [f"{prefix}_observe.png", f"{prefix}_detector.png"] + ([f"{prefix}_receiver.png"] if sc.units == "cgs" else [])
     group = Outputs(paths, [args.scene])
     try:
-        obs, _ = OB.run_scene(sc, args.samples, args.line_of_sight, args.distance_cm, integration_s=args.integration_s)
+        obs = experiment.observe(sc, samples=args.samples, line_of_sight=args.line_of_sight, **receiver_options(args))
     except SimulationError as e:
         raise SimulationError(f"{args.scene}: {e}") from None
-    except ValueError as e:
-        raise UsageError(f"{args.scene}: {e}") from None
     try:
         with group as tmps:
             OP.plot(obs, tmps[0])

@@ -122,29 +122,32 @@ def size(text: str):
 
 
 # --- the detector's options (observe, decide, listen) ----------------------------------------
-def add_detector_options(parser, keys=("line_of_sight", "distance_cm"), hidden: tuple = ()) -> None:
-    """The detector's options of a scene command, each overriding the scene's ``[observe]`` key
-    of the same name (``detector_overrides`` checks them with that table's schema)."""
-    helps = {"line_of_sight": ("--los", vector, "X,Y,Z", "line of sight X,Y,Z in the world frame (default: the "
-                                                          "scene's [observe], else across L(0))"),
-             "distance_cm": ("--distance-cm", real, None, "the antenna's distance (default: the scene's [observe], "
-                                                          "else 10)"),
-             "integration_s": ("--integration-s", real, None, "the length of one estimate (default: the scene's "
-                                                              "[observe], else 1)")}
-    for key in keys:
-        flag, kind, metavar, text = helps[key]
-        parser.add_argument(flag, dest=key, type=kind, metavar=metavar,
+# The receiver keys (``inputs.receiver.ReceiverSpec``) that observe, decide and listen take as
+# options, each overriding the scene's [observe] key of its name: a key named here is an option
+# of the three commands, --key-with-dashes, checked by the receiver's schema.
+RECEIVER_OPTIONS = {
+    "distance_cm": "the antenna's distance, cm (default: the scene's [observe], else 10)",
+    "integration_s": "the length of one estimate, s (default: the scene's [observe], else 1)",
+    "antenna_gain_dbi": "the antenna's gain, dBi, flat over the band (default: the scene's [observe], else 5)",
+    "noise_temperature_k": "the system noise temperature, K (default: the scene's [observe], else 5)",
+}
+
+
+def add_detector_options(parser, line_of_sight: bool = True, hidden: tuple = ()) -> None:
+    """The detector's options of a scene command: ``--los`` (unless ``line_of_sight`` is False)
+    and one per ``RECEIVER_OPTIONS`` key (those in ``hidden`` not listed in --help)."""
+    if line_of_sight:
+        parser.add_argument("--los", dest="line_of_sight", type=vector, metavar="X,Y,Z",
+                            help="line of sight X,Y,Z in the world frame (default: the scene's [observe], else "
+                                 "across L(0))")
+    for key, text in RECEIVER_OPTIONS.items():
+        parser.add_argument("--" + key.replace("_", "-"), dest=key, type=real,
                             help=argparse.SUPPRESS if key in hidden else text)
 
 
-def detector_overrides(args, keys=("line_of_sight", "distance_cm")) -> dict:
-    """The detector options given, checked by the scene's ``[observe]`` table's own schema (so an
-    option and the key it overrides take the same values; a ``SpecError`` names the option)."""
-    from ..inputs.scene import ObserveTable
-
-    given = {k: getattr(args, k) for k in keys if getattr(args, k, None) is not None}
-    ObserveTable(**given)
-    return given
+def receiver_options(args) -> dict:
+    """The receiver options given on the command line (``RECEIVER_OPTIONS``'s keys, None: not given)."""
+    return {k: getattr(args, k, None) for k in RECEIVER_OPTIONS}
 
 
 # --- reports ------------------------------------------------------------------------------

@@ -27,10 +27,10 @@ from pydantic import Field, PlainValidator, model_validator
 from pydantic_core import PydanticCustomError
 
 from ..errors import SpecError, brief
-from .base import Flag, Int, Path, Positive, Real, Text, between, check_vector, refused, request, wrong_type
+from ..physics import models as M
+from .base import Flag, Int, Path, Positive, Real, Text, between, check_vector, refused, registered, request, wrong_type
 from .toml import Table
 
-MODELS = ("reduced", "truncated")
 MAX_RUNS = 100_000_000
 MAX_CELLS = 4096                 # per axis
 MAX_MEMBERS = 100_000
@@ -58,11 +58,11 @@ class Added:
 
 def _models(v):
     if isinstance(v, str) or not isinstance(v, list | tuple) or not v:
-        raise wrong_type(f"must be a non-empty list of {', '.join(MODELS)}, got {brief(v)}")
+        raise wrong_type(f"must be a non-empty list of {', '.join(M.for_atlas())}, got {brief(v)}")
     out = []
     for m in v:
-        if m not in MODELS:
-            raise ValueError(f"unknown model {brief(m)}; valid: {', '.join(MODELS)}")
+        if m not in M.for_atlas():
+            raise ValueError(f"unknown model {brief(m)}; valid: {', '.join(M.for_atlas())}")
         if m in out:
             raise ValueError(f"{m!r} named twice")
         out.append(m)
@@ -229,7 +229,7 @@ class AtlasFile:
     members: Table
     title: Text = ""
     description: Text = ""
-    model: Literal["reduced", "truncated"] | None = None
+    model: registered(M.for_atlas) | None = None
     models: Annotated[tuple, PlainValidator(_models)] | None = None
     run: Table | None = None
     classify: Table | None = None
@@ -285,7 +285,7 @@ def check_cluster(workers: int | None, scheduler: str | None) -> None:
     if scheduler is not None and workers is not None:
         raise SpecError("workers", "applies to the embedded cluster only; an existing cluster (scheduler) has the "
                                    "workers it was started with")
-    from .render import usable_cores
+    from ..executors.processes import usable_cores
 
     cores = usable_cores()
     if workers is not None and workers > cores:

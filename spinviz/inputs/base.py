@@ -27,6 +27,7 @@ import functools
 import math
 import os
 import unicodedata
+from collections.abc import Callable, Sequence
 from typing import Annotated, Any
 
 import numpy as np
@@ -38,7 +39,7 @@ from ..errors import SpecError, SpecTypeError, brief
 
 __all__ = ["request", "Real", "Positive", "NonNegative", "Int", "Text", "Line", "vector", "Direction", "check_vector",
            "between",
-           "at_most", "refused", "wrong_type", "one_line", "fields_of", "terms", "SpecError", "SpecTypeError"]
+           "at_most", "refused", "registered", "wrong_type", "one_line", "fields_of", "terms", "SpecError", "SpecTypeError"]
 
 CONFIG = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False, arbitrary_types_allowed=True)
 
@@ -200,6 +201,21 @@ def refused(reason: str):
         return v
 
     return Annotated[Any, AfterValidator(check)]
+
+
+def registered(valid: Callable[[], Sequence[str]]):
+    """A choice among names a registry holds (``valid()`` lists them when a value is checked,
+    so a name registered later is accepted): ``Literal``'s check, in ``Literal``'s words."""
+
+    def check(v):
+        if not isinstance(v, str):
+            raise wrong_type(f"must be a string, got {brief(v)}")
+        names = tuple(valid())
+        if v not in names:
+            raise ValueError(f"unknown value {brief(v)}; valid: {', '.join(names)}")
+        return v
+
+    return Annotated[str, PlainValidator(check)]
 
 
 # --- request classes -----------------------------------------------------------------------

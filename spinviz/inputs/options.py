@@ -226,7 +226,7 @@ class EvidenceRequest:
     @model_validator(mode="after")
     def _check(self):
         if self.workers is not None:
-            from .render import usable_cores
+            from ..executors.processes import usable_cores
 
             cores = usable_cores()
             if self.workers > cores:
@@ -251,7 +251,7 @@ class EvidenceRequest:
         n = self.n_members
         grows = math.sqrt((self.tau_end or 1e10) / 1e10)
         if self.kind == "validate":
-            from .render import usable_cores
+            from ..executors.processes import usable_cores
 
             return 11 * n * ATLAS_S_PER_RUN * grows / (self.workers or usable_cores())
         if self.kind == "crosscheck":
@@ -278,10 +278,30 @@ SOUND_SECONDS = (0.5, 600.0, "seconds of sound")
 LISTEN_SAMPLES = 100_000         # instants of each model's run (the detector's memory per instant)
 
 
+def _extension(ext: str, what: str):
+    """A path (str or os.PathLike) ending in ``ext``, kept as str."""
+
+    def check(v):
+        if v is None:
+            return None
+        if not isinstance(v, str | os.PathLike):
+            raise wrong_type(f"must be a path (str or os.PathLike), got {type(v).__name__} {brief(v)}")
+        v = os.fspath(v)
+        if os.path.splitext(v)[1].lower() != ext:
+            raise ValueError(f"{brief(v)}: {what}; give a path ending in {ext}")
+        return v
+
+    return Annotated[Any, PlainValidator(check)]
+
+
 @request
 class ListenRequest:
-    """``spinviz listen``'s sound (``analysis.sonify.listen_scene``): how long, at which pitch,
-    how sound time and pitch follow the run's, how much dynamic range, from how many instants."""
+    """``spinviz listen``'s sound (``experiment.listen``): where it goes (``out``, a WAV, and its
+    spectrogram ``png``, default beside it), how long, at which pitch, how sound time and pitch
+    follow the run's, how much dynamic range, from how many instants."""
+
+    out: _extension(".wav", "the sound is written as WAV")
+    png: _extension(".png", "the spectrogram is a PNG") = None
 
     duration: Annotated[Real, between(*SOUND_SECONDS)] = 20.0
     f0: Annotated[Real, between(20.0, 5000.0, "Hz: audible, well under the Nyquist frequency")] = 440.0
@@ -289,3 +309,8 @@ class ListenRequest:
     pitch: Literal["auto", "linear"] = "auto"
     dynamic_range_db: Annotated[Real, between(1.0, 120.0, "dB of sound")] = 60.0
     samples: Annotated[Int, between(2, LISTEN_SAMPLES, "instants of each model's run")] = 800
+
+    @property
+    def png_path(self) -> str:
+        """The spectrogram's path: ``png``, or the WAV's with .png."""
+        return self.png if self.png is not None else os.path.splitext(self.out)[0] + ".png"

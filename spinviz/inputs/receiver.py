@@ -52,6 +52,8 @@ RESOLUTION_COMPUTED = ("the resolutions are computed from the receiver (distance
 # the keys of [observe] that describe the detector (the same names as ReceiverSpec's fields)
 DETECTOR_KEYS = ("distance_cm", "bandwidth_hz", "integration_s", "noise_temperature_k", "noise_density_w_per_hz",
                  "antenna_gain_dbi", "antenna_area_cm2")
+# of each pair, one is given: an override of one replaces the scene's other
+_PAIRS = (("noise_temperature_k", "noise_density_w_per_hz"), ("antenna_gain_dbi", "antenna_area_cm2"))
 
 
 @request
@@ -107,6 +109,23 @@ class ReceiverSpec:
             antenna = f"gain {DEFAULT_GAIN_DBI if self.antenna_gain_dbi is None else self.antenna_gain_dbi:g} dBi"
         return (f"antenna at {self.distance_cm:g} cm, {antenna}, both polarizations; {noise}; "
                 f"band {self.bandwidth_hz:.3g} Hz; {self.integration_s:g} s per estimate")
+
+    def with_options(self, **given) -> ReceiverSpec:
+        """This receiver with the values given (keys of ``DETECTOR_KEYS``; None: not given) in
+        place of its own, checked by this schema (``SpecError`` naming the key); a value for one
+        of a pair (noise temperature or density, gain or area) replaces the other."""
+        unknown = sorted(set(given) - set(DETECTOR_KEYS))
+        if unknown:
+            raise SpecError(unknown[0], f"not a receiver key; valid: {', '.join(DETECTOR_KEYS)}")
+        given = {k: v for k, v in given.items() if v is not None}
+        if not given:
+            return self
+        values = {k: getattr(self, k) for k in DETECTOR_KEYS}
+        for pair in _PAIRS:
+            for k in pair:
+                if k in given:
+                    values.update({o: None for o in pair if o != k})
+        return ReceiverSpec(**{**values, **given})
 
     def record(self) -> dict:
         """The receiver's settings as plain numbers (JSON), with the defaults filled in."""

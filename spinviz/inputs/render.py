@@ -23,6 +23,7 @@ from typing import Annotated, Literal
 from pydantic import AfterValidator, Field, PlainValidator, model_validator
 
 from ..errors import SpecError, brief
+from ..executors.processes import usable_cores
 from .base import Flag, Int, Line, NonNegative, Path, Positive, Real, one_line, request, wrong_type
 
 SHOW_ITEMS = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud", "hodograph", "inset", "power")
@@ -203,14 +204,6 @@ class RenderSpec:
 
 
 # --- the arguments of render, render_frame, Renderer and plan -------------------------------------
-def usable_cores() -> int:
-    """The cores this process may run on (its affinity mask, else the machine's count)."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        return os.cpu_count() or 1
-
-
 def _workers(v):
     cores = usable_cores()
     if v > cores:

@@ -21,11 +21,12 @@ from .. import rotations as R
 from .. import units as U
 from ..errors import SpecError, brief
 from ..physics import bodies as B
+from ..physics import models as M
 from ..physics import presets as P
 from . import receiver as RX
 from .base import Direction, Line, Positive, Real, Text, between, check_vector, one_line, refused, request, wrong_type
 from .render import MAX_TITLE
-from .simulation import MODELS, Atol, Method, Quaternion, Rtol, Samples, Vector3
+from .simulation import Atol, Method, ModelName, Quaternion, Rtol, Samples, Vector3
 from .toml import Table
 
 # Physical ranges of the CGS inputs, the body constructors' own (physics.bodies): the same
@@ -63,8 +64,8 @@ def _models(v):
     if not isinstance(v, list | tuple) or not 1 <= len(v) <= 2 or not all(isinstance(m, str) for m in v):
         raise wrong_type(f"must be a list of one or two model names, got {brief(v)}")
     for m in v:
-        if m not in MODELS:
-            raise ValueError(f"unknown model {brief(m)}; valid: {', '.join(MODELS)}")
+        if m not in M.names():
+            raise ValueError(f"unknown model {brief(m)}; valid: {', '.join(M.names())}")
     if len(set(v)) != len(v):
         raise ValueError(f"{v[0]!r} named twice")
     return tuple(v)
@@ -254,7 +255,7 @@ class SimulationTable:
     t_end_Theta in the paper's T or Theta), samples, units and the integrator settings."""
 
     samples: Samples
-    model: Literal["reduced", "truncated", "free"] | None = None
+    model: ModelName | None = None
     models: Annotated[tuple, PlainValidator(_models)] | None = None
     t_end: Positive | None = None
     t_end_T: Positive | None = None
@@ -268,7 +269,7 @@ class SimulationTable:
     @model_validator(mode="after")
     def _choices(self):
         if one_of(self, "model", "models") is None:
-            raise SpecError("model", f"missing value; valid: {', '.join(MODELS)}")
+            raise SpecError("model", f"missing value; valid: {', '.join(M.names())}")
         if one_of(self, *HORIZON_KEYS) is None:
             raise SpecError("t_end", "missing value (or give t_end_T / t_end_Theta)")
         return self

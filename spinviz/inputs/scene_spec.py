@@ -70,6 +70,33 @@ def _readonly(a) -> np.ndarray:
 
 
 @dataclass(frozen=True)
+class Needs:
+    """What a command asks of a scene beyond its own validity (``Scene.require``).
+
+    models : how many models it compares (None: any); line_law : every model with a closed-form
+    line and a body that radiates one line (d along the symmetry axis, or a sphere: (5.2),
+    (5.4)); symmetric : a symmetric top (I1 = I2: the detector's lines are those of the free
+    precession); cgs : a body in physical units (a receiver has distances, powers and noise).
+    """
+
+    models: int | None = None
+    line_law: bool = False
+    symmetric: bool = False
+    cgs: bool = False
+
+
+_COUNT = {1: "one", 2: "two", 3: "three"}
+
+# what each library function that takes a scene needs of it, checked once when it starts
+NEEDS = {
+    "compare": Needs(models=2),
+    "observe": Needs(models=2, symmetric=True),
+    "listen": Needs(models=2, symmetric=True),
+    "decide": Needs(models=2, line_law=True, cgs=True),
+}
+
+
+@dataclass(frozen=True)
 class Scene:
     """A validated scene, in the body's units (CGS: s, rad/s; dimensionless: tau0, 1/tau0).
 
@@ -107,6 +134,38 @@ class Scene:
     def model(self) -> str:
         """The first of the scene's models (the one ``spinviz simulate`` runs by default)."""
         return self.models[0]
+
+    def require(self, command: str) -> Scene:
+        """This scene, if it has what ``command`` (a key of ``NEEDS``) needs; ``SceneError``
+        naming the file, the key and what is missing otherwise."""
+        from ..physics import longitudinal as LG
+        from ..physics import models as M
+
+        needs = NEEDS[command]
+        if needs.models is not None and len(self.models) != needs.models:
+            example = ", ".join(f'"{m}"' for m in M.with_line_law())
+            raise SceneError(self.path, "[simulation].models",
+                             f"{command} needs {_COUNT.get(needs.models, needs.models)} models, e.g. models = [{example}]")
+        body = self.body
+        if needs.cgs and body.units != "cgs":
+            raise SceneError(self.path, "[body]", f"{command} needs a body in physical units (CGS): the receiver has "
+                                                  f"distances, powers and noise")
+        if needs.symmetric and not body.is_symmetric:
+            raise SceneError(self.path, "[body]", f"{command} needs a symmetric top (I1 = I2): the detector's lines "
+                                                  f"are those of the free precession; this body is asymmetric")
+        if needs.line_law:
+            if not LG.has_line_law(body.delta, body.chi, body.is_symmetric):
+                shape = (f"delta = {body.delta:.3g}, chi = {math.degrees(body.chi):.3g} deg" if body.is_symmetric
+                         else "an asymmetric top")
+                raise SceneError(self.path, "[body]", f"{command} needs a dipole along the symmetry axis (chi = 0) or "
+                                                      f"a spherical top (delta = 0), whose line is a closed form of "
+                                                      f"the start ((5.2), (5.4)); this body has {shape}")
+            without = [m for m in self.models if M.get(m).line is None]
+            if without:
+                raise SceneError(self.path, "[simulation].models",
+                                 f"{command} compares models with a closed-form line "
+                                 f"({', '.join(M.with_line_law())}); {without[0]!r} has none")
+        return self
 
     def request(self, model: str | None = None, *, kinematics: str = "quaternion", t_eval=None) -> SimulationRequest:
         """The typed request for one run of ``model`` (default the first): the scene's

@@ -17,10 +17,10 @@ import numpy as np
 from pydantic import Field, PlainValidator, model_validator
 
 from ..errors import SpecError, brief
+from ..physics import models as M
 from ..physics.bodies import Body
-from .base import Int, Positive, Real, at_most, between, request, vector, wrong_type
+from .base import Int, Positive, Real, at_most, between, registered, request, vector, wrong_type
 
-MODELS = ("reduced", "truncated", "free")
 KINEMATICS = ("quaternion", "euler_zxz", "none")
 MAX_SAMPLES = 1_000_000         # 11 numbers an instant per model, ~90 MB at the limit
 RTOL_RANGE = (1e-19, 1e-1, "the long double's precision at the tightest")
@@ -67,7 +67,7 @@ def _times(v):
     return a
 
 
-Model = Literal["reduced", "truncated", "free"]
+ModelName = registered(M.names)
 Kinematics = Literal["quaternion", "euler_zxz", "none"]
 Method = Annotated[str, PlainValidator(_method)]
 Vector3 = vector(3)
@@ -83,7 +83,7 @@ class SimulationRequest:
     """Everything one run needs, validated (the arguments of ``spinviz.simulate``).
 
     body : Body -- its ``units`` are the units of everything below (``time_unit``, ``omega_unit``).
-    model : "reduced" (2.2)+(2.3), "truncated" (2.5) or "free".
+    model : a registered model ("reduced" (2.2)+(2.3), "truncated" (2.5), "free"; ``physics.models``).
     omega0 : (3,) body-frame angular velocity at t = 0 (rad/s or 1/tau0).
     t_end, samples : ``samples`` instants evenly spaced over [0, t_end]; or
     t_eval : (N,) increasing output times from 0.
@@ -95,7 +95,7 @@ class SimulationRequest:
     """
 
     body: Annotated[Body, PlainValidator(_body)]
-    model: Model
+    model: ModelName
     omega0: Vector3
     t_end: Positive | None = None
     samples: Samples | None = None
@@ -141,6 +141,9 @@ class SimulationRequest:
                                           f"(it supports {', '.join(m.kinematics)})")
             if m.symmetric_only and not self.body.is_symmetric:
                 raise SpecError("method", f"{m.name!r} needs a symmetric top (I1 = I2)")
+            if m.compiled and M.get(self.model).kernel_id is None:
+                raise SpecError("method", f"{m.name!r} runs on compiled kernels, which do not know the model "
+                                          f"{self.model!r}; Taylor's method and SciPy's integrate it")
             if m.fixed_step and self.step is None:
                 raise SpecError("step", f"method {m.name} is fixed-step: give step > 0")
         try:

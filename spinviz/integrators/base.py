@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..physics.equations import System
+from ..physics.models import System
 
 KINEMATICS = ("quaternion", "euler_zxz", "none")
 
@@ -76,6 +76,8 @@ class Integrator:
     description : one line for ``spinviz methods`` and the README.
     rtol_floor : the tolerance below which its error stops following rtol (measured on the
     benchmark's askew bodies, ``spinviz bench``), or None (fixed step, or reported per run).
+    compiled : runs the numba kernels, which know a model by its ``kernel_id``
+    (``physics.models``): a model without one cannot use it.
     """
 
     name: str
@@ -88,6 +90,7 @@ class Integrator:
     stiff: bool = False
     detects_stiffness: bool = False
     rtol_floor: float | None = None
+    compiled: bool = False
 
 
 _REGISTRY: dict[str, Integrator] = {}

@@ -51,9 +51,8 @@ def _flow_coefficients(system):
     """(P, Q, R, S) of the averaged flow (``physics.averaged``) of a spin-unit system of a
     symmetric top (J = (1, 1, J3), coupling g at the angle chi from e3), or None where there is
     none (the free top, a sphere: no precession to average over)."""
-    from ..physics import averaged as AV
-
-    if system.model not in AV.MODELS:
+    averaged = system.spec.averaged
+    if averaged is None:
         return None
     J = [float(x) for x in system.inertia]
     delta = 1.0 - J[2] / J[0]
@@ -61,7 +60,7 @@ def _flow_coefficients(system):
         return None
     g = np.asarray(system.coupling, dtype=float)
     chi = math.atan2(math.hypot(g[0], g[1]), g[2])
-    return AV.coefficients(system.model, delta, chi)
+    return averaged.coefficients(delta, chi)
 
 
 def predict(system, omega, target: float, t_max: float) -> tuple[float, float]:

@@ -32,7 +32,6 @@ from ..physics import equations as E
 from . import tableaus as T
 from .status import (  # noqa: F401
     INTERRUPTED,
-    MODEL_ID,
     NOT_FINITE,
     OK,
     STEP_UNDERFLOW,
@@ -49,8 +48,10 @@ _truncated = _jit(E.truncated_terms)
 
 @_jit
 def terms(model, w1, w2, w3, J, g, free):
-    """Omega_dot of model 0 (free), 1 (reduced) or 2 (truncated); ``free`` = 0 keeps only the
-    radiation part (see physics.equations.reduced_terms)."""
+    """Omega_dot of the model whose ``kernel_id`` (``physics.models``) is ``model``: 0 free, 1
+    reduced, 2 truncated; ``free`` = 0 keeps only the radiation part (see
+    physics.equations.reduced_terms).  numba dispatches on a number, not on the registry: a
+    model with a compiled kernel adds its branch here."""
     if model == 1:
         return _reduced(w1, w2, w3, J, g, free)
     if model == 2:

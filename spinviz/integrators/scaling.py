@@ -14,7 +14,7 @@ import numpy as np
 
 from .. import units as U
 from ..errors import SpecError
-from ..physics.equations import System
+from ..physics.models import System
 from .base import Problem
 
 # tau0 |Omega0|, the radiation torque relative to the spin: real particles have 1e-25 (rod) to

@@ -38,8 +38,9 @@ import numpy as np
 
 from .. import rotations as R
 from ..interrupt import call_stoppable
-from ..physics.equations import System
+from ..physics import models as M
 from ..physics.free_top import pose_about_L
+from ..physics.models import System
 from . import status as ST
 from .base import Integrator, Problem, Solution, register
 
@@ -90,7 +91,9 @@ def prepare(problem: Problem) -> Setup:
         raise NotApplicable("secular needs a symmetric top (I1 = I2); this body is asymmetric")
     g = np.asarray(s.coupling, dtype=float)
     eps = float(g @ g)
-    if eps > EPS_MAX and s.model != "free":
+    if s.spec.kernel_id is None:
+        raise NotApplicable(f"the model {s.model!r} has no compiled kernel, which secular's slow flow runs on")
+    if eps > EPS_MAX and s.spec.brakes:
         raise NotApplicable(f"tau0 |Omega0| = {eps:.3g} > {EPS_MAX:g}: the radiation changes the spin within a few "
                             f"turns, so there is no fast motion to average over; use a resolving method")
     w0 = np.asarray(problem.omega0, dtype=float)
@@ -124,9 +127,9 @@ def resonance_kicks(setup: Setup, crossings) -> list[dict]:
     J = tuple(float(x) for x in s.inertia)
     g = tuple(float(x) for x in s.coupling)
     J3, delta = setup.J3, setup.delta
-    model = ST.MODEL_ID[s.model]
-    M = SF.M_PHASES
-    cM, sM = SF.phase_nodes(M)
+    model = M.kernel_id(s.model, "secular")
+    nodes = SF.M_PHASES
+    cM, sM = SF.phase_nodes(nodes)
     out = []
     for t, wp, w3, m in crossings:
         Lc = math.hypot(wp, J3 * w3)
@@ -136,7 +139,7 @@ def resonance_kicks(setup: Setup, crossings) -> list[dict]:
         Fdot = abs((wp * dwp + J3 * J3 * w3 * dw3) / Lc - m * delta * dw3)
         if Fdot == 0.0:
             continue
-        c = SF.torque_harmonic(model, J, g, wp, w3, int(m), M)
+        c = SF.torque_harmonic(model, J, g, wp, w3, int(m), nodes)
         out.append({"m": int(m), "t": float(t), "kick_rad": float(c / Lc * math.sqrt(2.0 * math.pi / Fdot))})
     return out
 
@@ -178,8 +181,8 @@ def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, st
     J = tuple(float(x) for x in s.inertia)
     g = tuple(float(x) for x in s.coupling)
     out, cnt, switches, recorded, status = call_stoppable(
-        SF.integrate_hybrid, ST.MODEL_ID[s.model], J, g, setup.w0, t, float(rtol), float(atol), MU_STAR, setup.equivariant,
-        MAX_STEPS, _phi0(setup), *KN.DP853_ARRAYS)
+        SF.integrate_hybrid, M.kernel_id(s.model, "secular"), J, g, setup.w0, t, float(rtol), float(atol), MU_STAR,
+        setup.equivariant, MAX_STEPS, _phi0(setup), *KN.DP853_ARRAYS)
     stats = _stats(setup, cnt, switches, rtol, t)
     if status != ST.OK:
         if status == ST.TOO_MANY_STEPS and cnt[8] >= REGIME5_SIGN_CHANGES:
@@ -303,7 +306,7 @@ def _stats(setup: Setup, cnt, switches, rtol: float, t) -> dict:
 
 
 register(Integrator(
-    name="secular", order=None, fixed_step=False, solve=solve_secular, symmetric_only=True,
+    name="secular", order=None, fixed_step=False, solve=solve_secular, symmetric_only=True, compiled=True,
     description="symmetric top over real horizons: body-frame equation in full where the precession is slow, averaged "
                 "(with a near-identity transform) where it is fast; L_world fixed, resonances checked",
 ))

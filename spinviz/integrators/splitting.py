@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..interrupt import call_stoppable
+from ..physics import models as M
 from . import status as ST
 from . import tableaus as T
 from .base import Integrator, Problem, Solution, register
@@ -36,7 +37,7 @@ def _args(problem: Problem):
     w0 = np.asarray(problem.omega0, dtype=float)
     q0 = np.asarray(problem.q0 if problem.q0 is not None else (1.0, 0.0, 0.0, 0.0), dtype=float)
     t = np.asarray(problem.t_eval, dtype=float)
-    return ST.MODEL_ID[s.model], J, g, w0, q0, t, problem.kinematics == "quaternion"
+    return M.kernel_id(s.model, "split"), J, g, w0, q0, t, problem.kinematics == "quaternion"
 
 
 def _solution(problem, w, q, status, stats):
@@ -75,7 +76,7 @@ def _solver(order: int):
 _NAMES = {2: "Strang", 4: "Yoshida triple jump", 6: "Kahan-Li s9", 8: "Kahan-Li s17"}
 for _p in (2, 4, 6, 8):
     register(Integrator(
-        name=f"split{_p}", order=_p, fixed_step=True, solve=_solver(_p), symmetric_only=True,
+        name=f"split{_p}", order=_p, fixed_step=True, solve=_solver(_p), symmetric_only=True, compiled=True,
         description=f"exact free flow of the symmetric top composed with the radiation torque, {_NAMES[_p]} "
                     f"(order {_p}); compiled",
     ))

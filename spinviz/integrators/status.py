@@ -30,5 +30,3 @@ def runaway_bound(eps: float) -> float:
     """The largest |omega| in spin units (|omega(0)| = 1, coupling |g|^2 = eps) before a run is
     called a runaway."""
     return RUNAWAY_FACTOR * max(1.0, 1.0 / eps) if eps > 0 else float("inf")
-
-MODEL_ID = {"free": 0, "reduced": 1, "truncated": 2}

@@ -43,6 +43,7 @@ import numpy as np
 
 from ..interrupt import call_stoppable
 from ..physics import equations as E
+from ..physics import models as M
 from . import cache
 from . import status as ST
 from .base import Integrator, Problem, Solution, register
@@ -83,12 +84,12 @@ def _layout(model: str, symmetric: bool) -> _Layout:
     hy = _hy()
     par = hy.par
     if symmetric:
-        f = E.SYMMETRIC_RATES[model]
+        f = M.get(model).symmetric_rate
         return _Layout((par[S_N1], 0.0, par[S_N3]), par[S_C], par[S_W2MAX], par[S_ETA2], N_PARS_SYMMETRIC,
                        lambda w: f(w[0], w[1], w[2], par[S_DELTA], par[S_N1], par[S_N3]))
     J = (par[J1], par[J2], par[J3])
     g = (par[G1], par[G2], par[G3])
-    f = E.rate_function(model)
+    f = M.rate_function(model)
     return _Layout(g, par[C], par[W2MAX], par[ETA2], N_PARS, lambda w: f(w[0], w[1], w[2], J, g))
 
 
@@ -102,9 +103,8 @@ def equations(model: str, kinematics: str = "quaternion", symmetric: bool = Fals
     layout ``S_*``), for the atlas's Euler-only runs.
     """
     hy = _hy()
-    E.rate_function(model)                               # validates the name
-    if symmetric and (model == "free" or kinematics != "none"):
-        raise ValueError("the symmetric form serves the atlas: Euler-only runs of the reduced or truncated model")
+    if symmetric and (M.get(model).symmetric_rate is None or kinematics != "none"):
+        raise ValueError("the symmetric form serves the atlas: Euler-only runs of a model with a symmetric rate")
     lay = _layout(model, symmetric)
     u = hy.make_vars("u1", "u2", "u3")
     s1 = (1.0 + lay.c * hy.time) ** -0.5                 # 1 / sigma

@@ -32,7 +32,6 @@ import math
 import numpy as np
 
 from . import closed_forms as CF
-from . import presets as P
 
 NAN = float("nan")
 
@@ -238,32 +237,7 @@ def truncated_averaged(delta: float, chi: float) -> dict:
             "T2_alpha": -b / (2.0 * e) if e > 0 else NAN, "frozen": bool(beta_t < -1.0)}
 
 
-# --- the DAST families of figure 5 ------------------------------------------------------
-def dast_families() -> list[dict]:
-    """The two families of axially symmetric DAST boxes (section 6.2, figure 5) as lines of
-    the diagram, derived from the crystal data (``presets.DAST``: the dipole lies in the
-    a-c plane at 35 deg from the a axis, e1):
-
-    * family 1, a = b != c: the symmetry axis is c, so chi = 90 - 35 = 55 deg whatever c/a,
-      and delta = 1 - I3/I1 = (c^2 - a^2)/(c^2 + a^2) runs over (-1, 1): a horizontal line
-      (the paper's solid line; a = b = 100 nm, c = 50 nm is delta = -0.6);
-    * family 2, a != b = c: the symmetry axis is a (e1), so chi = 35 deg, and
-      delta = (a^2 - b^2)/(a^2 + b^2) again covers (-1, 1): a second horizontal line (the
-      dash-dotted one).  The box inertia of a b = c box is I_a = m 2b^2/12,
-      I_b = I_c = m (a^2 + b^2)/12, hence that delta.
-
-    At delta = 0 (the cube) both meet the degenerate case where any axes are principal and
-    e3 may be taken along d (chi = 0)."""
-    t = P.DAST.dipole_angle_from_e1_deg
-    d = np.linspace(-1.0, 1.0, 201)[1:-1]
-    return [
-        {"name": f"DAST family 1 (a = b, chi = {90.0 - t:g} deg)", "short": "DAST family 1 (a = b)", "delta": d,
-         "chi": np.full_like(d, math.radians(90.0 - t)), "style": "-"},
-        {"name": f"DAST family 2 (b = c, chi = {t:g} deg)", "short": "DAST family 2 (b = c)", "delta": d,
-         "chi": np.full_like(d, math.radians(t)), "style": "-."},
-    ]
-
-
+# --- the DAST boxes of figure 5 ---------------------------------------------------------
 def box_delta(sym: float, other: float) -> float:
     """delta = 1 - I_sym/I_perp of a box whose two equal edges are ``other`` and whose third
     edge ``sym`` lies along the symmetry axis: I_sym = m 2 other^2/12, I_perp = m (sym^2 +

@@ -8,9 +8,9 @@ n3 = cos chi, xi = tan^2 chi; z = omega1 + i omega2 = omega_perp e^{i phi}.  Pur
 complex conjugate; reduced (4.2)-(4.4): exactly cubic; truncated (2.5): its cubic, leading
 order in |omega| -- the Sherman-Morrison denominator 1 + n1 n3 delta omega2/(1 - delta) adds
 terms smaller by O(|omega|)).  A monomial turns as e^{i m phi}, m = j - k, while the free
-precession turns z as e^{i nu tau}, nu = -delta omega3.  ``HARMONICS`` lists them
-(``tests/test_averaged.py`` rebuilds them from ``physics.equations``' rates by a Fourier
-transform over phi, so a change of either rate cannot leave them behind).
+precession turns z as e^{i nu tau}, nu = -delta omega3.  Each model's ``Averaged.harmonics``
+(``physics.harmonics``) lists them (``tests/test_averaged.py`` rebuilds them from the models'
+rates by a Fourier transform over phi, so a change of either rate cannot leave them behind).
 
 **The averaged flows.**  First-order averaging keeps the m = 1 terms of z' and the m = 0 terms
 of omega3':
@@ -59,85 +59,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import asymptotics as FM
-from . import closed_forms as CF
-
-MODELS = ("reduced", "truncated")
-
-# (m, j, k, l, coefficient(delta, n1, n3)) of the radiation part of z' and w3'
-# (m = j - k: the harmonic; each term is c z^j zb^k w3^l)
-HARMONICS = {
-    "reduced": {
-        "z": (
-            (-1, 1, 2, 0, lambda d, a, b: 0.5 * a * a),
-            (-1, 0, 1, 2, lambda d, a, b: 0.5 * a * a * (d * d + d + 1.0)),
-            (0, 1, 1, 1, lambda d, a, b: 0.5 * a * b * (d + 2.0)),
-            (0, 0, 0, 3, lambda d, a, b: a * b),
-            (1, 2, 1, 0, lambda d, a, b: -0.5 * a * a - b * b),
-            (1, 1, 0, 2, lambda d, a, b: -(b * b * (1.0 - d) ** 2 + 0.5 * a * a * (1.0 + d + d * d))),
-            (2, 2, 0, 1, lambda d, a, b: 1.5 * d * a * b),
-        ),
-        "w3": (
-            (-2, 0, 2, 1, lambda d, a, b: 0.75 * d * a * a / (d - 1.0)),
-            (-1, 1, 2, 0, lambda d, a, b: -a * b / (2.0 * d - 2.0)),
-            (-1, 0, 1, 2, lambda d, a, b: 0.5 * a * b * (1.0 - d)),
-            (0, 1, 1, 1, lambda d, a, b: 0.5 * a * a * (d + 2.0) / (d - 1.0)),
-            (0, 0, 0, 3, lambda d, a, b: a * a / (d - 1.0)),
-            (1, 2, 1, 0, lambda d, a, b: -a * b / (2.0 * d - 2.0)),
-            (1, 1, 0, 2, lambda d, a, b: 0.5 * a * b * (1.0 - d)),
-            (2, 2, 0, 1, lambda d, a, b: 0.75 * d * a * a / (d - 1.0)),
-        ),
-    },
-    "truncated": {
-        "z": (
-            (-1, 1, 2, 0, lambda d, a, b: 0.25 * a * a),
-            (-1, 0, 1, 2, lambda d, a, b: -0.5 * d * a * a),
-            (0, 1, 1, 1, lambda d, a, b: a * b * (d + 1.0)),
-            (1, 2, 1, 0, lambda d, a, b: -0.5 * a * a - b * b),
-            (1, 1, 0, 2, lambda d, a, b: -0.5 * a * a * (d + 2.0)),
-            (2, 2, 0, 1, lambda d, a, b: a * b),
-            (3, 3, 0, 0, lambda d, a, b: 0.25 * a * a),
-        ),
-        "w3": (
-            (-2, 0, 2, 1, lambda d, a, b: -a * a / (4.0 * d - 4.0)),
-            (-1, 0, 1, 2, lambda d, a, b: 0.5 * a * b * (d - 2.0) / (d - 1.0)),
-            (0, 1, 1, 1, lambda d, a, b: (-d * b * b + 0.5 * a * a + b * b) / (d - 1.0)),
-            (0, 0, 0, 3, lambda d, a, b: a * a / (d - 1.0)),
-            (1, 1, 0, 2, lambda d, a, b: 0.5 * a * b * (d - 2.0) / (d - 1.0)),
-            (2, 2, 0, 1, lambda d, a, b: -a * a / (4.0 * d - 4.0)),
-        ),
-    },
-}
-
-
-def coefficients_eq4_12(delta: float, chi: float) -> tuple[float, float, float, float]:
-    """(P, Q, R, S) of the reduced averaged flow (4.12): d wp/dtau = -wp (P wp^2 + Q w3^2),
-    d w3/dtau = -w3 (R wp^2 + S w3^2), read off the paper's printed form
-    (``closed_forms.averaged_rate_eq4_12``) at unit amplitudes:
-    P = n3^2 + n1^2/2, Q = n3^2 (1 - delta)^2 + n1^2 (1 + delta + delta^2)/2,
-    R = n1^2 (2 + delta)/(2 (1 - delta)), S = n1^2/(1 - delta)."""
-    P = -CF.averaged_rate_eq4_12(1.0, 0.0, delta, chi)[0]
-    S = -CF.averaged_rate_eq4_12(0.0, 1.0, delta, chi)[1]
-    dwp, dw3, _ = CF.averaged_rate_eq4_12(1.0, 1.0, delta, chi)
-    return P, -dwp - P, -dw3 - S, S
-
-
-def coefficients(model: str, delta: float, chi: float) -> tuple[float, float, float, float]:
-    """(P, Q, R, S) of ``model``'s averaged flow: (4.12) for the reduced model, spinviz's
-    derived truncated flow (``asymptotics.truncated_averaged``) for the truncated one."""
-    if model == "reduced":
-        return coefficients_eq4_12(delta, chi)
-    if model != "truncated":
-        raise ValueError(f"unknown model {model!r}; valid: {', '.join(MODELS)}")
-    t = FM.truncated_averaged(delta, chi)
-    # truncated_averaged states the flow through its late states: T4_A2 = 1/(2P),
-    # T4_beta = -R/(2P), T2_B2 = 1/(2S), T2_alpha = -Q/(2S)
-    P = 1.0 / (2.0 * t["T4_A2"])
-    R = -2.0 * P * t["T4_beta"]
-    if not math.isfinite(t["T2_B2"]):              # chi = 0: no n1, no S, no Q
-        return P, 0.0, R, 0.0
-    S = 1.0 / (2.0 * t["T2_B2"])
-    return P, -2.0 * S * t["T2_alpha"], R, S
+from . import models as M
 
 
 @dataclass(frozen=True)
@@ -180,14 +102,15 @@ class Flow:
     Arrays broadcast; z complex (omega1 + i omega2), omega3 real."""
 
     def __init__(self, model: str, delta: float, chi: float):
-        if model not in MODELS:
-            raise ValueError(f"unknown model {model!r}; valid: {', '.join(MODELS)}")
+        av = M.get(model).averaged
+        if av is None:
+            raise ValueError(f"the model {model!r} has no averaged flow")
         self.model, self.delta, self.chi = model, float(delta), float(chi)
         d, n1, n3 = self.delta, math.sin(chi), math.cos(chi)
         self.n1, self.n3 = n1, n3
-        self.z_terms = tuple((m, j, k, l, f(d, n1, n3)) for m, j, k, l, f in HARMONICS[model]["z"])
-        self.w3_terms = tuple((m, j, k, l, f(d, n1, n3)) for m, j, k, l, f in HARMONICS[model]["w3"])
-        self.P, self.Q, self.R, self.S = coefficients(model, d, chi)
+        self.z_terms = tuple((m, j, k, l, f(d, n1, n3)) for m, j, k, l, f in av.harmonics["z"])
+        self.w3_terms = tuple((m, j, k, l, f(d, n1, n3)) for m, j, k, l, f in av.harmonics["w3"])
+        self.P, self.Q, self.R, self.S = av.coefficients(d, chi)
         # the forcing of z at z = 0: reduced n1 n3 w3^3, truncated none
         self.F = sum(c for m, j, k, l, c in self.z_terms if (j, k) == (0, 0))
 

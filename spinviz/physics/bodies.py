@@ -20,7 +20,8 @@ import numpy as np
 from .. import units as U
 from ..errors import SpecError, SpecTypeError, brief
 from ..rotations import world_from_body
-from .equations import System, is_symmetric
+from .equations import is_symmetric
+from .models import System
 
 
 class BodyError(SpecError):

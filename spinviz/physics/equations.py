@@ -11,18 +11,15 @@ The rate functions take and return components ``(w1, w2, w3)``.  Written compone
 one implementation works on Python floats (the fast path inside the ODE right-hand
 side, free of NumPy's per-call overhead on 3-vectors), on NumPy arrays of any shape
 (vectorized evaluation along a trajectory) and on complex numbers (exact Jacobians by
-complex-step differentiation, see ``jacobian``).
+complex-step differentiation, see ``models.jacobian``).  The models by name -- which rate
+is which equation, and what else spinviz knows of each -- are ``physics.models``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ..rotations import world_from_body
-
-MODELS = ("reduced", "truncated", "free")
 
 
 def free_rate(w1, w2, w3, J, g):
@@ -158,76 +155,6 @@ def symmetric_truncated_rate(w1, w2, w3, delta, n1, n3):
     return f1 + s1 - k * n1, f2 + s2, s3 - k * n3 / e
 
 
-SYMMETRIC_RATES = {"reduced": symmetric_reduced_rate, "truncated": symmetric_truncated_rate}
-
-
-_RATES = {"reduced": reduced_rate, "truncated": truncated_rate, "free": free_rate}
-_TERMS = {"reduced": reduced_terms, "truncated": truncated_terms, "free": free_terms}
-
-
-def rate_function(model: str):
-    """The Omega_dot function of a model name ("reduced", "truncated" or "free")."""
-    try:
-        return _RATES[model]
-    except KeyError:
-        raise ValueError(f"unknown model {model!r}; valid: {', '.join(MODELS)}") from None
-
-
-def radiation_function(model: str):
-    """(w1, w2, w3, J, g) -> the radiation part of Omega_dot alone (rate minus free rate,
-    computed without the cancellation of subtracting them)."""
-    rate_function(model)
-    terms = _TERMS[model]
-    return lambda w1, w2, w3, J, g: terms(w1, w2, w3, J, g, 0.0)
-
-
-def omega_dot(model: str, omega_body, J, g) -> np.ndarray:
-    """The model's angular acceleration at many states at once.
-
-    Parameters
-    ----------
-    model : {"reduced", "truncated", "free"}
-        (2.2)+(2.3), (2.5) or the torque-free top (2.3a).
-    omega_body : array_like, shape (..., 3)
-        Body-frame angular velocity, rad/s (CGS) or 1/tau0 (4.1), matching ``J`` and ``g``.
-    J : sequence of 3 float
-        Principal moments (g cm^2, or relative to I1).
-    g : sequence of 3 float
-        Body-frame radiation coupling sqrt(2/3c^3) d (the unit dipole direction in (4.1)).
-
-    Returns
-    -------
-    ndarray, shape (..., 3)
-        Body-frame Omega_dot, rad/s^2 or 1/tau0^2.
-    """
-    omega_body = np.asarray(omega_body, dtype=float)
-    out = rate_function(model)(omega_body[..., 0], omega_body[..., 1], omega_body[..., 2], tuple(J), tuple(g))
-    return np.stack(np.broadcast_arrays(*out), axis=-1)
-
-
-def jacobian(model: str, omega_body, J, g) -> np.ndarray:
-    """d Omega_dot / d Omega at one body-frame state ``omega_body`` (3,), shape (3, 3), in
-    the units of ``J`` and ``g`` (see ``omega_dot``); exact to round-off.
-
-    Complex-step differentiation of the model's own formula: for a real-analytic f,
-    f(x + i h e_k) = f(x) + i h df/dx_k + O(h^2), with no subtraction, so with h = 1e-30
-    |omega| the imaginary part is the derivative to the last bit.  Every model is a
-    polynomial or rational function of Omega, so this is the analytic Jacobian without
-    a hand-expanded (and error-prone) copy of (2.2).
-    """
-    f = rate_function(model)
-    w = np.asarray(omega_body, dtype=float)
-    h = 1e-30 * max(float(np.max(np.abs(w))), 1e-300)
-    Jt, gt = tuple(J), tuple(g)
-    out = np.empty((3, 3))
-    for k in range(3):
-        z = [complex(w[0]), complex(w[1]), complex(w[2])]
-        z[k] += 1j * h
-        col = f(z[0], z[1], z[2], Jt, gt)
-        out[:, k] = [c.imag / h for c in col]
-    return out
-
-
 def quat_rate(q0, q1, q2, q3, w1, w2, w3):
     """q_dot = 1/2 q (x) (0, Omega_body), scalar-first q = (w, x, y, z); O = R(q) body->world."""
     return (
@@ -256,83 +183,6 @@ def is_symmetric(inertia) -> bool:
     Body in g cm^2 and for a System's relative moments alike)."""
     I1, I2 = float(inertia[0]), float(inertia[1])
     return abs(I1 - I2) <= 1e-12 * max(abs(I1), abs(I2))
-
-
-@dataclass(frozen=True)
-class System:
-    """What the integrators see: a model and the dimensionless body (4.1).
-
-    inertia : (J1, J2, J3), principal moments scaled by I1 (J1 = 1 for a physical body).
-    coupling : (g1, g2, g3), body-frame radiation coupling, |g|^2 / J1 = tau0 = 1.
-    model : "reduced", "truncated" or "free".
-    """
-
-    model: str
-    inertia: tuple[float, float, float]
-    coupling: tuple[float, float, float]
-
-    def __post_init__(self):
-        rate_function(self.model)  # validates the name
-
-    @property
-    def is_symmetric(self) -> bool:
-        """J1 = J2 to 1e-12 relative: the paper's symmetric top (``is_symmetric``)."""
-        return is_symmetric(self.inertia)
-
-    def rate(self):
-        """Closure (w1, w2, w3) -> Omega_dot components, parameters bound."""
-        f = rate_function(self.model)
-        J, g = tuple(map(float, self.inertia)), tuple(map(float, self.coupling))
-        return lambda w1, w2, w3: f(w1, w2, w3, J, g)
-
-    def radiation(self):
-        """Closure (w1, w2, w3) -> the radiation part of Omega_dot alone."""
-        f = radiation_function(self.model)
-        J, g = tuple(map(float, self.inertia)), tuple(map(float, self.coupling))
-        return lambda w1, w2, w3: f(w1, w2, w3, J, g)
-
-    def omega_dot(self, omega_body) -> np.ndarray:
-        """Body-frame Omega_dot (..., 3) at body-frame states ``omega_body`` (..., 3), 1/tau0^2
-        and 1/tau0 (4.1): the module function ``omega_dot`` with this system's J and g."""
-        return omega_dot(self.model, omega_body, self.inertia, self.coupling)
-
-    def jacobian(self, omega_body) -> np.ndarray:
-        """Exact d Omega_dot / d Omega, shape (3, 3), at one body-frame state (3,), (4.1) units."""
-        return jacobian(self.model, omega_body, self.inertia, self.coupling)
-
-    def rhs(self):
-        """f(t, y) for y = (w1, w2, w3, q0, q1, q2, q3): Euler equation + quaternion kinematics."""
-        rate = self.rate()
-
-        def f(t, y):
-            w1, w2, w3, q0, q1, q2, q3 = y.tolist()
-            a1, a2, a3 = rate(w1, w2, w3)
-            d0, d1, d2, d3 = quat_rate(q0, q1, q2, q3, w1, w2, w3)
-            return np.array((a1, a2, a3, d0, d1, d2, d3))
-
-        return f
-
-    def rhs_jacobian(self):
-        """J(t, y), shape (7, 7), of ``rhs``: exact Euler block, exact kinematics blocks."""
-        model, inertia, coupling = self.model, self.inertia, self.coupling
-
-        def jac(t, y):
-            w = y[:3]
-            q0, q1, q2, q3 = y[3:].tolist()
-            w1, w2, w3 = w.tolist()
-            out = np.zeros((7, 7))
-            out[:3, :3] = jacobian(model, w, inertia, coupling)
-            # d q_dot / d omega = 1/2 [q]_L restricted to the vector part
-            out[3:, :3] = 0.5 * np.array(
-                [[-q1, -q2, -q3], [q0, -q3, q2], [q3, q0, -q1], [-q2, q1, q0]]
-            )
-            # d q_dot / d q = 1/2 [(0, omega)]_R
-            out[3:, 3:] = 0.5 * np.array(
-                [[0.0, -w1, -w2, -w3], [w1, 0.0, w3, -w2], [w2, -w3, 0.0, w1], [w3, w2, -w1, 0.0]]
-            )
-            return out
-
-        return jac
 
 
 def kinetic_energy(omega_body, J) -> np.ndarray:

@@ -23,7 +23,8 @@ Eliminating t gives the laws a detector can test without knowing the start:
 * reduced:   P = K f^2 (f^2 - f_inf^2) with f_inf = sqrt(b) / 2 pi = eps |Omega3| / 2 pi, the line
   the reduced top levels off at (5 GHz for the DAST cube of section 6.2 spun at pi 1e10 rad/s).
 
-Pure NumPy, vectorized over any broadcastable shapes.
+Pure NumPy, vectorized over any broadcastable shapes.  Each model's ``models.LineLaw`` holds
+its state and law from here, so a caller asks the model (``models.get(name).line``).
 """
 
 from __future__ import annotations
@@ -31,8 +32,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
-MODELS = ("reduced", "truncated")
 
 
 def has_line_law(delta: float, chi: float, symmetric: bool, tol: float = 1e-9) -> bool:
@@ -53,36 +52,56 @@ def start_state(omega_body, dipole_direction, epsilon: float) -> tuple[float, fl
     return float(perp @ perp), float(epsilon**2 * par**2)
 
 
-def state(model: str, t, u0, b0, tau0):
-    """(u, b) at times t (s) from the start (u0, b0) (rad^2/s^2) under (5.2) ("reduced") or (5.4)
-    ("truncated"); everything broadcasts.  The reduced form is evaluated as
-    u0 / (1 + 2 tau0 (u0 + b) t expm1(x)/x), x = 2 tau0 b t, which keeps its b -> 0 limit (3.9)."""
-    t, u0, b0, tau0 = (np.asarray(a, dtype=float) for a in (t, u0, b0, tau0))
-    if model == "truncated":
-        F2 = 1.0 + 2.0 * tau0 * u0 * t
-        return u0 / F2, b0 / F2
-    if model != "reduced":
-        raise ValueError(f"unknown model {model!r}; valid: {', '.join(MODELS)}")
+def _arrays(*a):
+    """Float arrays, or complex ones where a value is complex (``decide`` differentiates the
+    states by complex steps)."""
+    return tuple(np.asarray(x, dtype=complex if np.iscomplexobj(x) else float) for x in a)
+
+
+def reduced_state(t, u0, b0, tau0):
+    """(u, b) at times t (s) from the start (u0, b0) (rad^2/s^2) under (5.2); everything
+    broadcasts.  Evaluated as u0 / (1 + 2 tau0 (u0 + b) t expm1(x)/x), x = 2 tau0 b t, which
+    keeps its b -> 0 limit (3.9) (x below 1e-8: its series 1 + x/2)."""
+    t, u0, b0, tau0 = _arrays(t, u0, b0, tau0)
     x = 2.0 * tau0 * b0 * t
+    small = np.abs(x) < 1e-8
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):     # expm1 -> inf: u -> 0, its limit
-        ratio = np.where(x != 0.0, np.expm1(x) / np.where(x != 0.0, x, 1.0), 1.0)
+        ratio = np.where(small, 1.0 + 0.5 * x, np.expm1(x) / np.where(small, 1.0, x))
     u = u0 / (1.0 + 2.0 * tau0 * (u0 + b0) * t * ratio)
     return u, np.broadcast_to(b0, u.shape)
 
 
-def line(model: str, t, u0, b0, tau0):
+def truncated_state(t, u0, b0, tau0):
+    """(u, b) at times t (s) from the start (u0, b0) (rad^2/s^2) under (5.4): both fall as
+    1/F^2, F^2 = 1 + 2 tau0 u0 t; everything broadcasts."""
+    t, u0, b0, tau0 = _arrays(t, u0, b0, tau0)
+    F2 = 1.0 + 2.0 * tau0 * u0 * t
+    return u0 / F2, b0 / F2
+
+
+def reduced_drift(u, b, tau0):
+    """(df/dt / f, d2f/dt2 / f) of the reduced line (5.2): -tau0 u and tau0^2 u (3u + 2b)."""
+    return -tau0 * u, tau0 * tau0 * u * (3.0 * u + 2.0 * b)
+
+
+def truncated_drift(u, b, tau0):
+    """(df/dt / f, d2f/dt2 / f) of the truncated line (5.4): -tau0 u and 3 tau0^2 u^2."""
+    return -tau0 * u, 3.0 * tau0 * tau0 * u * u
+
+
+def line_from_state(u, b):
     """(f, shape): the line's frequency f = omega_L / 2 pi (Hz) and its power up to a constant,
-    shape = Omega_perp^2 omega_L^2 (rad^4/s^4), at times t (``state``)."""
-    u, b = state(model, t, u0, b0, tau0)
+    shape = Omega_perp^2 omega_L^2 (rad^4/s^4), of the state (u, b)."""
     w2 = u + b
     return np.sqrt(w2) / (2.0 * math.pi), u * w2
 
 
-def law(model: str, f, f_inf=0.0):
-    """The P-f law up to a constant: f^4 (truncated) or f^2 (f^2 - f_inf^2) (reduced)."""
+def reduced_law(f, f_inf=0.0):
+    """The reduced P-f law up to a constant: f^2 (f^2 - f_inf^2)."""
     f = np.asarray(f, dtype=float)
-    if model == "truncated":
-        return f**4
-    if model != "reduced":
-        raise ValueError(f"unknown model {model!r}; valid: {', '.join(MODELS)}")
     return f**2 * (f**2 - np.asarray(f_inf, dtype=float) ** 2)
+
+
+def truncated_law(f, f_inf=0.0):
+    """The truncated P-f law up to a constant: f^4 (``f_inf`` is ignored: the line does not level off)."""
+    return np.asarray(f, dtype=float) ** 4

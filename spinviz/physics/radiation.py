@@ -43,7 +43,8 @@ import numpy as np
 
 from .. import units as U
 from ..rotations import unit_vector, world_from_body
-from .equations import free_rate, radiation_function, rate_function
+from .equations import free_rate
+from .models import radiation_function, rate_function
 
 
 def _components(fn, w, J, g):

@@ -348,7 +348,7 @@ class _LazyCluster:
         process instead, in threads (``cluster.InProcess``), unless a cluster is already up."""
         scheduler, workers, _ = self.args
         if small and self.cl is None and scheduler is None and workers is None:
-            from ..inputs.render import usable_cores
+            from ..executors.processes import usable_cores
             from .inprocess import InProcess
 
             here = InProcess(usable_cores())
@@ -356,10 +356,10 @@ class _LazyCluster:
                 self.where = here.describe
             return here
         if self.cl is None:
-            from .cluster import Cluster
+            from .cluster import atlas_cluster
 
             scheduler, workers, processes = self.args
-            self.cl = self.stack.enter_context(Cluster(scheduler, workers, processes=processes))
+            self.cl = self.stack.enter_context(atlas_cluster(scheduler, workers, processes=processes))
             self.where = self.cl.describe          # asked now: a cluster lost later cannot answer
         return self.cl
 

@@ -41,9 +41,9 @@ def _noop(x):
 
 def task_cost(n: int = 200, workers: int = 2) -> float:
     """Milliseconds per empty task (submit, schedule, run, gather) on a local cluster."""
-    from .cluster import Cluster
+    from .cluster import atlas_cluster
 
-    with Cluster(None, workers) as cl:
+    with atlas_cluster(None, workers) as cl:
         cl.client.gather(cl.client.map(_noop, range(10), pure=False))         # warm
         t0 = time.perf_counter()
         cl.client.gather(cl.client.map(_noop, range(n), pure=False))

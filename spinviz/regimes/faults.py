@@ -1,10 +1,6 @@
 """How the atlas fails, in one line each (kept apart from ``spinviz.errors``: these are the
 atlas's own, and their text names library parameters, never command-line flags).
 
-* ``OptionError`` -- a value of ``atlas()``'s ``scheduler=`` that cannot be used (no
-  scheduler there, no worker, another spinviz version), with the value: a ``SpecError``
-  about that argument, which the command line names by its option.  (Values wrong in
-  themselves -- ``workers=`` beyond the cores -- are the schema's, ``spinviz.inputs.atlas``.)
 * ``StoreDamaged`` -- a store whose metadata do not match their checksums (or carry none):
   runs can be recomputed, a damaged catalogue cannot.
 * ``AtlasIncomplete`` -- the atlas ended with runs not computed because the cluster failed
@@ -23,23 +19,10 @@ here: it is a result, recorded in the store with its reason.
 
 from __future__ import annotations
 
-from ..errors import SpecError, SpinvizError, UsageError, printable
+from ..errors import SpinvizError, UsageError, printable
 
 EXIT_CLUSTER_LOST = 75         # sysexits.h EX_TEMPFAIL: the cluster failed, the same command again resumes
 EXIT_TASKS_FAILED = 1          # tasks failed as a whole: rerunning retries them, but they may fail again
-
-
-class OptionError(SpecError):
-    """``name=value`` refused; ``reason`` says why.  A ``SpecError`` about the argument
-    ``name``, so the command line names it by its option like any other."""
-
-    def __init__(self, name: str, value, reason: str):
-        super().__init__(name, f"{printable(value, 100)}: {reason}")
-        self.value = value
-        self.args = (f"{name}={printable(repr(value), 100)}: {reason}",)
-
-    def __str__(self) -> str:
-        return self.args[0]
 
 
 class StoreDamaged(UsageError):

@@ -14,22 +14,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import units as U
+from ..presentation import style as model_style
 
-# (heading, equation numbers) per model and register
-HEADINGS = {
-    "outreach": {"reduced": ("Reduced equation", "(2.2)+(2.3)"), "truncated": ("Truncated equation", "(2.5)"),
-                 "free": ("No radiation", "(2.3a)")},
-    "physics": {"reduced": ("reduced", "(2.2)+(2.3)"), "truncated": ("truncated", "(2.5)"), "free": ("free", "d = 0")},
-}
-# what each model predicts, in general (a scene's [render].subtitles says it for its own case)
-SUBTITLES = {
-    "outreach": {"reduced": "radiation slows the tumbling; a spin about the dipole can last",
-                 "truncated": "radiation slows every rotation, all the way to rest",
-                 "free": "no braking: the top turns freely"},
-    "physics": {"reduced": "Ω̇, Ω̈ in the torque taken from the free motion",
-                "truncated": "textbook torque without the Schott-like term",
-                "free": "torque-free Euler top"},
-}
 ARROW_NAMES = {"dipole": ("d", "dipole"), "L": ("L", "angular momentum"), "omega": ("Ω", "rotation")}
 
 # the unit the power plot is drawn in: W for CGS scenes (the physics stays in erg/s), and the
@@ -184,14 +170,14 @@ class Captions:
     def heading(self, k: int) -> tuple[str, str]:
         """(heading, secondary text: the equation numbers) of panel k."""
         model = self.plan.panels[k].model
-        return HEADINGS[self.register].get(model, (model, ""))
+        return model_style(model).heading.get(self.register, (model, ""))
 
     def subtitle(self, k: int) -> str:
         """Panel k's plain-words line: the scene's ``[render].subtitles``, or what its model predicts."""
         subs = self.spec.subtitles
         if k < len(subs):
             return subs[k]
-        return SUBTITLES[self.register].get(self.plan.panels[k].model, "")
+        return model_style(self.plan.panels[k].model).subtitle.get(self.register, "")
 
     def readouts(self, k: int, f: int) -> list[str]:
         """Panel k's numbers at frame f: its spin rate and the angle between d and L."""

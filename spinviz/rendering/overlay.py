@@ -21,9 +21,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import units as U
+from ..presentation import style as model_style
 from .captions import decade
 from .layout import NOTE_SEP, PLOT_LABEL_SAMPLE, Layout, TextMetrics
-from .style import MODEL_COLORS, Palette
+from .style import Palette
 
 WHITE = (255, 255, 255)
 POWER_DECADES = 12      # the power plot's depth: a reduced run's P may fall to 0 (its residual rotation is dark)
@@ -186,7 +187,7 @@ def _headings(plan, lay: Layout, pal: Palette, metrics: TextMetrics) -> list[Tex
     for k, items in enumerate(lay.headings):
         x0 = lay.panel_x(k) + lay.pad
         right = lay.panel_x(k) + lay.panel_width - lay.pad
-        model_color = MODEL_COLORS.get(plan.panels[k].model, pal.fg) if pal.bg[0] > 128 else pal.fg
+        model_color = model_style(plan.panels[k].model).color if pal.bg[0] > 128 else pal.fg
         clip = (x0, 0, right, lay.H)
         for text, role, y, extra in items:
             out.append(Text(text, (x0, y), model_color if role == "main" else pal.muted, role=role, clip=clip))
@@ -299,7 +300,7 @@ def _inset(plan, texts, lay: Layout, row, bar: TimeBar | None, metrics: TextMetr
                          Text(bottom, (bx0 - pad // 2, by1), pal.muted, anchor="rd")]
     # which colour is which model, right-aligned on the title line of the last plot, where it
     # clears that plot's title (the panels' headings say it in the same colours anyway)
-    names = [(p.model, MODEL_COLORS.get(p.model, pal.fg)) for p in plan.panels]
+    names = [(p.model, model_style(p.model).color) for p in plan.panels]
     width = sum(metrics.width(m) for m, _ in names) + lay.sizes.size * (len(names) - 1)
     x = boxes[-1][2]
     if x - width >= boxes[-1][0] + metrics.width(titles[plots[-1]]) + lay.sizes.size:
@@ -316,7 +317,7 @@ def _plot_series(name: str, plan, pal: Palette) -> list:
     w0 = float(plan.panels[0].omega_mag[0]) or 1.0
     to_display = U.ERG_PER_S_IN_W if plan.units == "cgs" else 1.0
     for p in plan.panels:
-        color = MODEL_COLORS.get(p.model, pal.fg)
+        color = model_style(p.model).color
         if name == "angle":
             band = p.angle_dL_range_deg
             ang = p.angle_dL_deg if p.angle_dL_deg is not None else (band.mean(axis=1) if band is not None else None)

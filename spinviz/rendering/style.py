@@ -1,4 +1,5 @@
-"""Colours and sizes of everything drawn: the 3-D theme, the arrows, the HUD palette, the models.
+"""Colours and sizes of everything drawn: the 3-D theme, the arrows, the HUD palette (each
+model's own colour, line and words are ``spinviz.presentation``'s, shared with the plots).
 
 Plain data; ``theme(background, body_name)`` gathers the colours of one video.  Imports nothing.
 Colours of the 3-D scene are RGB floats in [0, 1]; colours of text and 2-D marks are RGB
@@ -9,9 +10,6 @@ lies on the unit sphere).
 from __future__ import annotations
 
 from dataclasses import dataclass
-
-# one colour per model everywhere: headings and inset of the videos, ``spinviz compare``'s plots
-MODEL_COLORS = {"reduced": (0, 128, 128), "truncated": (136, 60, 180), "free": (120, 120, 120)}
 
 # the 3-D scene per background: sphere cage, its outline (limb), axes, trail; bg_rgb is the clear colour
 COLORS = {

@@ -26,9 +26,10 @@ import html
 import json
 from importlib import resources
 
+from ..presentation import style as model_style
 from .captions import texts_of
 from .gltf import model_offsets, view_gltf
-from .style import ARROW_COLORS, AXIS_LENGTH, COLORS, MODEL_COLORS, VIEW_ANGLE, palette
+from .style import ARROW_COLORS, AXIS_LENGTH, COLORS, VIEW_ANGLE, palette
 
 __all__ = ["page", "csp_hash"]
 
@@ -67,7 +68,7 @@ def page_data(plan, kf) -> dict:
     return {
         "title": texts.footer, "scale": texts.scale,
         "headings": [list(h) for h in texts.headings], "subtitles": list(texts.subtitles),
-        "model_colors": [_hex(MODEL_COLORS.get(p.model, pal.fg)) for p in plan.panels],
+        "model_colors": [_hex(model_style(p.model).color) for p in plan.panels],
         "legend": [{"key": k, "symbol": s, "name": nm, "color": _css_rgb(ARROW_COLORS[k])} for k, s, nm in texts.legend
                    if k in ARROW_COLORS],
         "ticks": [[float(p), str(label)] for p, label in texts.bar_ticks],

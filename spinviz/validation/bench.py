@@ -32,7 +32,7 @@ from ..integrators import get
 from ..integrators.scaling import spin_problem
 from ..physics import cases
 from ..physics.bodies import symmetric_top
-from ..physics.equations import System
+from ..physics.models import System
 
 TARGET_ERROR = 1e-8
 N_OUT = 41

@@ -51,6 +51,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...physics import asymptotics as F
+from ...physics import models as M
 
 VERSION = 3                # bump when a rule changes: stores made by another version are not resumed
 #                            (what each version changed: CHANGELOG.md)
@@ -68,12 +69,17 @@ RES_SLOPE = -0.05          # slope of |omega| above which the run "does not brak
 EXACT_39 = 1e-6            # hypot(omega1, omega3)/|omega| below which a run *is* (3.9)
 MIN_SAMPLES = 12           # samples needed in the window
 
-CLASS_LABEL = {
-    "reduced": {"axial-stopped": "1", "axial-spiral": "2", "balanced-spiral": "3", "transverse-spiral": "4",
-                "libration": "5", "transverse-frozen": "3.9", "residual": "R"},
-    "truncated": {"axial-stopped": "T1", "axial-spiral": "T2", "balanced-spiral": "Tcone", "transverse-spiral": "T4",
-                  "libration": "T5", "transverse-frozen": "TF", "residual": "R"},
-}
+
+
+def class_labels(model: str):
+    """The model's class -> type label (``physics.models``' ``type_labels``: "axial-stopped" is
+    "1" under the reduced model, "T1" under the truncated one); ValueError for a model the
+    atlas cannot map."""
+    labels = M.get(model).type_labels
+    if labels is None:
+        raise ValueError(f"the model {model!r} has no atlas types; valid: {', '.join(M.for_atlas())}")
+    return labels
+
 
 # Every label the atlas can store, with its int8 code (CF flag_values / flag_meanings).  The
 # paper's types keep their number; 0 is Zarr's fill value, so a run not computed yet reads "missing".
@@ -237,8 +243,7 @@ def classify(tau, omega, delta: float, chi: float, model: str = "reduced", windo
     omega = np.asarray(omega, dtype=float)
     if omega.ndim != 2 or omega.shape[1] != 3 or tau.shape != omega.shape[:1]:
         raise ValueError(f"omega must have shape (N, 3) with N = len(tau) = {tau.shape[0]}, got {omega.shape}")
-    if model not in CLASS_LABEL:
-        raise ValueError(f"unknown model {model!r}; valid: {', '.join(CLASS_LABEL)}")
+    class_labels(model)
     if not np.all(np.isfinite(omega)):
         return Verdict("failed", 0.0, "none", "non-finite samples")
     keep = tau > 0.0
@@ -392,7 +397,7 @@ def _verdict(x: dict, scores: dict, delta: float, chi: float, model: str) -> Ver
     conf = scores[best] * (1.0 if exempt else settle * fit_ok) * min(1.0, 0.5 + margin)
     ev.update(settled=settle, fit_rms=fit_rms, fit_quality=math.exp(-fit_rms / 0.02) if math.isfinite(fit_rms) else 0.0,
               score=scores[best], margin=margin)
-    names = CLASS_LABEL[model]
+    names = class_labels(model)
     candidate = _candidate(x, scores, best, names)
     label = names[best] if scores[best] > 0.0 else "other"
     if exact39:
@@ -439,7 +444,7 @@ def _between_1_and_2(x: dict, model: str):
     p, q = S["p"], S["q"]
     if not (x["Y"] > 2.0 * x["X"] and _near(q, -0.5, TOL_HALF) > 0.5 and x["sc"] == 0.0 and p < -0.5 - TOL_SEP):
         return None
-    names = CLASS_LABEL[model]
+    names = class_labels(model)
     if p < -1.0 - 0.5 * TOL_ONE:
         target = "axial-stopped"
     elif p > -1.0 + 0.5 * TOL_ONE:
@@ -457,7 +462,7 @@ def _unsettled(x, scores, best, settle, fit_ok, delta, model, candidate, conf, d
     tolerances of and moving towards (its late half's slopes closer to the class than its early
     half's), or "other"."""
     ev, S = x["ev"], x["S"]
-    names = CLASS_LABEL[model]
+    names = class_labels(model)
     wide = _scores(x, delta, model, relax=RELAX)
     early = _scores(x, delta, model, relax=RELAX, slopes=(S["p_e"], S["q_e"]))
     late = _scores(x, delta, model, relax=RELAX, slopes=(S["p_l"], S["q_l"]))

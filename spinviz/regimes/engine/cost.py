@@ -11,10 +11,10 @@ import os
 from dataclasses import dataclass
 
 from ...errors import SceneError
+from ...executors.processes import usable_cores
 from ...inputs import atlas as IA
 from ...inputs.atlas_spec import AtlasSpec, Settings
 from ...inputs.options import ENGINE_S_PER_RUN, HANDED_S_PER_RUN, MAX_DAYS_ENV, max_days
-from ...inputs.render import usable_cores
 from ...physics.averaged import averaging_holds
 
 # What this process holds for an atlas, measured with tracemalloc around api.plan and the

@@ -1,0 +1,155 @@
+"""What an experiment would see: the front doors ``compare``, ``observe``, ``decide`` and
+``listen`` (public as ``spinviz.compare`` ...), and ``test_measurements``.
+
+Each takes a scene (a ``Scene`` or the path of its TOML), checks its request once -- the
+arguments by the schema (``inputs.experiment``, ``inputs.decide``, ``inputs.options``), the
+receiver's options by ``ReceiverSpec.with_options``, the scene by ``Scene.require`` (the
+models, the body's symmetry and units the command needs) -- and only then simulates.  A bad
+argument is a ``SpecError`` naming it, a scene that lacks what the command needs a
+``SceneError`` naming its file and key.  The command line calls these very functions.
+
+Receiver keywords (``distance_cm=``, ``integration_s=``, any key of
+``inputs.receiver.DETECTOR_KEYS``) override the scene's ``[observe]`` keys of the same name.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+
+from .errors import SpecError
+
+__all__ = ["compare", "observe", "decide", "listen", "test_measurements", "receiver_of"]
+
+DASK_TRIALS = 2000            # from this many trials (or with a scheduler) decide runs on Dask
+
+
+def _scene(source):
+    """A ``Scene`` from a scene or the path of one."""
+    if isinstance(source, (str, os.PathLike)):
+        from .inputs.scene_spec import load_scene
+
+        return load_scene(source)
+    from .inputs.scene_spec import Scene
+
+    if not isinstance(source, Scene):
+        from .errors import SpecTypeError
+
+        raise SpecTypeError("scene", f"must be a Scene or the path of a scene file, got {type(source).__name__}")
+    return source
+
+
+def receiver_of(scene, **options):
+    """The scene's receiver (``[observe]``) with the receiver ``options`` given (None: the
+    scene's) in place of its keys: ``inputs.receiver.ReceiverSpec``."""
+    return _scene(scene).observe.receiver.with_options(**options)
+
+
+def compare(scene, *, samples: int = 800):
+    """Run both models of a two-model scene at the same instants and compare them
+    (``analysis.compare.Comparison``: misorientation, dipole angle, first times above 1° and
+    10°, final states).  ``samples``: evenly spaced plus as many log-spaced instants."""
+    from .analysis import compare as C
+    from .driver import simulate_request
+    from .inputs.experiment import CompareRequest
+
+    samples = CompareRequest(samples=samples).samples
+    sc = _scene(scene).require("compare")
+    times = C.compare_times(sc.t_end, samples)
+    try:
+        trajs = [simulate_request(sc.request(m, t_eval=times)) for m in sc.models]
+    except SpecError as e:                              # the output times are this argument's
+        raise SpecError("samples", e.reason) if e.key == "t_eval" else e from None
+    return C.compare(trajs)
+
+
+def observe(scene, *, samples: int = 800, line_of_sight=None, **receiver):
+    """What the scene's receiver records from both models (``analysis.observe.Observation``:
+    SNR, resolutions, the field at the antenna, when the models part, the P-f test).
+
+    line_of_sight : world-frame direction to the detector (default the scene's [observe], else
+    across L(0)); ``receiver``: receiver keys (``distance_cm=`` ...) in place of the scene's."""
+    from .analysis import observe as OB
+    from .inputs.experiment import ObserveRequest
+
+    req = ObserveRequest(samples=samples, line_of_sight=line_of_sight)
+    sc = _scene(scene)
+    rx = receiver_of(sc, **receiver)
+    obs, _ = OB.run_scene(sc.require("observe"), req.samples, req.line_of_sight, rx)
+    return obs
+
+
+def listen(scene, out: str, *, png: str | None = None, duration: float = 20.0, f0: float = 440.0,
+           time_map: str = "log", pitch: str = "auto", dynamic_range_db: float = 60.0, samples: int = 800,
+           line_of_sight=None, **receiver):
+    """The detector's signal of both models as a stereo WAV (left one model, right the other)
+    at ``out`` and its spectrogram at ``png`` (default beside it), written together, atomically;
+    returns the ``analysis.sonify.Mapping`` (how sound time and pitch follow the run's)."""
+    from .analysis import sonify
+    from .atomic import Outputs
+    from .inputs.options import ListenRequest
+
+    req = ListenRequest(duration=duration, f0=f0, time_map=time_map, pitch=pitch, dynamic_range_db=dynamic_range_db,
+                        samples=samples, out=out, png=png)
+    sc = _scene(scene)
+    rx = receiver_of(sc, **receiver)
+    sc.require("listen")
+    group = Outputs([req.out, req.png_path], [sc.path])
+    with group as (tmp_wav, tmp_png):
+        return sonify.listen_scene(sc, tmp_wav, tmp_png, req, line_of_sight, rx)
+
+
+def decide(scene, *, trials: int = 200, seed: int = 1, spin_range=(0.5, 2.0), tau0: str = "known",
+           workers: int | None = None, scheduler: str | None = None, say=None, **receiver):
+    """How long to watch: a Monte Carlo over noise and unknown starts of the time a
+    likelihood-ratio test needs to tell the scene's two models apart at 5 sigma in 95 % of
+    trials (``analysis.decide.Outcome``).
+
+    Runs on worker processes of this machine (``workers``, default one per core), or on Dask
+    from ``DASK_TRIALS`` trials or with ``scheduler`` (an existing cluster's address);
+    ``say(text)``, if given, hears where it runs."""
+    from .analysis import decide as DC
+    from .inputs.decide import DecideArguments
+
+    spec = DecideArguments(trials=trials, seed=seed, spin_range=spin_range, tau0=tau0, workers=workers,
+                           scheduler=scheduler)
+    sc = _scene(scene)
+    rx = receiver_of(sc, **receiver)
+    setup = DC.setup_from_scene(sc.require("decide"), rx, sc.observe.t_end or sc.t_end, spec.spin_range, spec.tau0)
+    with contextlib.ExitStack() as stack:
+        mapper = _mapper(stack, spec, say)
+        return DC.run(setup, spec.trials, spec.seed, mapper)
+
+
+def _mapper(stack: contextlib.ExitStack, spec, say):
+    """Where decide's trials run: a Dask cluster when large or asked for, worker processes
+    otherwise (None: this process, for a handful of trials on one core)."""
+    from .executors.processes import ProcessMapper, usable_cores
+
+    if spec.scheduler is not None or spec.trials >= DASK_TRIALS:
+        from .executors.cluster import Cluster, mapper
+
+        cl = stack.enter_context(Cluster(spec.scheduler, spec.workers))
+        if say is not None:
+            say(f"decide: {spec.trials} trials on {cl.describe}")
+        return mapper(cl)
+    workers = min(spec.workers or usable_cores(), max(1, spec.trials // 8))
+    return None if workers == 1 else stack.enter_context(ProcessMapper(workers))
+
+
+def test_measurements(scene, measurements):
+    """The start-free P-f test of a file of measured line frequency and power (CSV or JSON;
+    ``inputs.measurements``) against the scene's laws: (law, ``analysis.pftest.PfTest``), or
+    (None, why there is no law for this body)."""
+    from .analysis import pftest as PF
+    from .inputs.measurements import read_measurements
+
+    sc = _scene(scene)
+    law, reason = PF.line_law(sc.body)
+    data, unit = read_measurements(measurements)
+    if law is None:
+        return None, reason
+    return law, PF.fit(PF.from_measurements(data, unit, os.fspath(measurements)))
+
+
+test_measurements.__test__ = False          # a front door named "test_...", not a test for pytest

@@ -248,13 +248,13 @@ def solve(problem: Problem, method: str, *, rtol: float, atol: float, step: floa
     Under ``auto``: a ``secular`` run that declines (a resonance, the oscillating regime) is
     resolved in full by ``taylor`` when ``resolvable`` (affordable), and an explicit method
     that meets stiffness the estimate from the initial state missed is replaced by radau;
-    ``taylor -> secular`` (``integrators.handover``) runs as one method.
+    ``taylor -> secular`` (``integrators.taylor_secular``) runs as one method.
     The solution is checked for non-finite values; ``success`` False keeps its samples so far."""
     kw = {"rtol": rtol, "atol": atol}
     if step is not None:
         kw["step"] = step
     if method == HANDOVER:
-        from .integrators.handover import solve_handover
+        from .integrators.taylor_secular import solve_handover
 
         sol = solve_handover(problem, **kw)
         if sol.success:

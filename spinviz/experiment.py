@@ -49,18 +49,18 @@ def compare(scene, *, samples: int = 800):
     """Run both models of a two-model scene at the same instants and compare them
     (``analysis.compare.Comparison``: misorientation, dipole angle, first times above 1° and
     10°, final states).  ``samples``: evenly spaced plus as many log-spaced instants."""
-    from .analysis import compare as C
+    from .analysis import compare as CMP
     from .driver import simulate_request
     from .inputs.experiment import CompareRequest
 
     samples = CompareRequest(samples=samples).samples
     sc = _scene(scene).require("compare")
-    times = C.compare_times(sc.t_end, samples)
+    times = CMP.compare_times(sc.t_end, samples)
     try:
         trajs = [simulate_request(sc.request(m, t_eval=times)) for m in sc.models]
     except SpecError as e:                              # the output times are this argument's
         raise SpecError("samples", e.reason) if e.key == "t_eval" else e from None
-    return C.compare(trajs)
+    return CMP.compare(trajs)
 
 
 def observe(scene, *, samples: int = 800, line_of_sight=None, **receiver):

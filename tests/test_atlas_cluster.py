@@ -19,7 +19,7 @@ from atlasdata import SPEC, VARIABLES
 from spinviz.errors import UsageError
 from spinviz.inputs.atlas_spec import load_spec
 from spinviz.regimes import api, cluster
-from spinviz.regimes.store import dataset as store
+from spinviz.regimes.store import dataset as DS
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -62,7 +62,7 @@ def test_store_opens_with_plain_xarray(reference):
     meanings = dict(zip(ds["regime"].attrs["flag_values"], ds["regime"].attrs["flag_meanings"].split()))
     labels = {meanings[c] for c in np.unique(ds["regime"].values)}
     assert labels <= {"1", "2", "3", "4", "5", "T2", "T4", "Tcone", "TF", "approaching", "other"}
-    full = store.open_atlas(reference)
+    full = DS.open_atlas(reference)
     # (0.5, 45 deg) reduced: the capture into type 5 happens by 1e8 at |omega0| = 0.05
     assert (full["label"].sel(model="reduced", delta=0.5).isel(chi=1).values == "5").sum() >= 2
 
@@ -79,7 +79,7 @@ def test_interrupted_then_resumed_store_is_identical(spec_path, reference, tmp_p
 
     with pytest.raises(KeyboardInterrupt):
         api.atlas(spec_path, out, workers=1, processes=False, progress=False, runs_per_task=3, on_result=stop)
-    done = store.done_mask(str(out))
+    done = DS.done_mask(str(out))
     assert done.sum() == 6                                      # 2 batches x 3 runs, nothing else
     import xarray as xr
 
@@ -179,7 +179,7 @@ def test_unreachable_scheduler_exit_2_nothing_written(spec_path, tmp_path, monke
 @pytest.mark.slow
 def test_sigterm_stops_cleanly_and_resume_completes(spec_path, reference, tmp_path):
     """The command in a subprocess, stopped by SIGTERM once the first chunk is on disk:
-    exit 143, a one-line note, the cluster gone; the same command then completes the store."""
+    exit 143, a one-line note, the cluster gone; the same command then completes the DS."""
     out = tmp_path / "t.zarr"
     spec = load_spec(spec_path)
     slow = tmp_path / "slow.toml"
@@ -192,7 +192,7 @@ def test_sigterm_stops_cleanly_and_resume_completes(spec_path, reference, tmp_pa
     try:
         t0 = time.monotonic()
         while time.monotonic() - t0 < 60:
-            if (out / "done").exists() and store.done_mask(str(out)).any():
+            if (out / "done").exists() and DS.done_mask(str(out)).any():
                 break
             if p.poll() is not None:
                 break
@@ -206,7 +206,7 @@ def test_sigterm_stops_cleanly_and_resume_completes(spec_path, reference, tmp_pa
         pytest.skip("the atlas finished before the signal")            # a very fast machine
     assert p.returncode == 143, err
     assert "atlas stopped" in err and "Traceback" not in err
-    done = store.done_mask(str(out))
+    done = DS.done_mask(str(out))
     assert 0 < done.sum() < spec.runs
     res = api.atlas(slow, out, workers=1, processes=False, progress=False)       # the same call, in-process
     assert res.reused == int(done.sum()) and res.computed == spec.runs - res.reused
@@ -220,7 +220,7 @@ def test_plots_show_every_member(reference, tmp_path):
 
     from spinviz.regimes.figures import cells, draw, hodographs
 
-    ds = store.open_atlas(reference)
+    ds = DS.open_atlas(reference)
     for model in ("reduced", "truncated"):
         total = sum(cells.shares(ds, model).values())
         assert np.allclose(total, 1.0)

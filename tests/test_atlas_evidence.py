@@ -8,7 +8,7 @@ import pytest
 
 from spinviz.errors import SpecError, SpecTypeError, UsageError
 from spinviz.regimes import api
-from spinviz.regimes.store import dataset as ST
+from spinviz.regimes.store import dataset as DS
 from spinviz.validation.atlas import convergence as CV
 from spinviz.validation.atlas import evidence
 
@@ -67,7 +67,7 @@ def test_tolerance_rows_against_the_tightest_rtol():
 def test_handover_evidence_row_against_brute_force():
     """One point of the hand-over evidence: engine and brute force on the same starts, the
     labels compared, every handed-over end state within its bound of brute force's."""
-    from spinviz.validation.atlas import handover as HV
+    from spinviz.validation.atlas import against_brute_force as HV
 
     row = HV.compare_point("3 deep", "reduced", 0.8, 11.4, 0.1, 4, 1e10, 1e-10)
     assert row["agreement"] == {"same": 4} and row["engine"] == {"3": 4} and row["handed_over"] == 4
@@ -84,11 +84,11 @@ def test_convergence_rows_kept_in_the_store_which_stays_verifiable(tmp_path):
     api.atlas(str(spec), out, workers=1, processes=False, progress=False)
     rows = [{"point": "x", "labels": {"1e10": {"3": 1.0}}}]
     CV.record(out, rows)
-    assert ST.verify(out).clean
-    assert json.loads(ST.open_atlas(out).attrs["convergence"]) == rows
+    assert DS.verify(out).clean
+    assert json.loads(DS.open_atlas(out).attrs["convergence"]) == rows
     with open(f"{out}/.zgroup", "a") as f:                       # metadata damaged: nothing blessed
         f.write(" ")
     with pytest.raises(ValueError, match="do not match their checksums"):
         CV.record(out, rows)
-    assert not ST.verify(out).clean
-    assert np.isfinite(ST.open_atlas(out)["confidence"].values).all()
+    assert not DS.verify(out).clean
+    assert np.isfinite(DS.open_atlas(out)["confidence"].values).all()

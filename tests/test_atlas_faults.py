@@ -33,7 +33,7 @@ from spinviz.regimes import api
 from spinviz.regimes import cluster as atlas_cluster
 from spinviz.regimes.engine import runs as RN
 from spinviz.regimes.faults import AtlasIncomplete, StoreDamaged
-from spinviz.regimes.store import dataset as store
+from spinviz.regimes.store import dataset as DS
 from spinviz.regimes.store import integrity, levels
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -67,7 +67,7 @@ def same_numbers(a, b):
 
 def done_runs_match(path, reference):
     """Every run the store marks done holds the reference's numbers (nothing lost was written)."""
-    done = store.done_mask(str(path))
+    done = DS.done_mask(str(path))
     (x, _), (r, _) = arrays(path), arrays(reference)
     for v in VARIABLES:
         if x[v].ndim >= 4:
@@ -164,9 +164,9 @@ def test_verify_a_clean_store(reference, capsys):
     chunks, the runs the spec implies, the verdict; exit 0."""
     rc, lines = verify(reference, capsys)
     assert rc == 0
-    sha = store.identity(levels.recorded_spec(str(reference)))
+    sha = DS.identity(levels.recorded_spec(str(reference)))
     assert lines == ["metadata: ok", f"spec: ok (sha256 {sha[:12]}, [refine] levels = 0)"] + [
-        f"{v}: ok (4 chunks)" for v in store.run_variables(str(reference))] + [
+        f"{v}: ok (4 chunks)" for v in DS.run_variables(str(reference))] + [
         "runs: all 36 computed", f"{reference}: ok: 36 runs verified"]
 
 
@@ -221,7 +221,7 @@ def test_write_cut_before_its_checksums_is_recomputed(spec_path, reference, tmp_
     with pytest.raises(KeyboardInterrupt):
         api.atlas(spec_path, s, workers=1, processes=False, progress=False, runs_per_task=3)
     monkeypatch.setattr(integrity, "record", real)
-    assert store.done_mask(str(s))[0, 1].all()                          # the cut chunk says "done"
+    assert DS.done_mask(str(s))[0, 1].all()                          # the cut chunk says "done"
     res = api.atlas(spec_path, s, workers=1, processes=False, progress=False, runs_per_task=3)
     assert capsys.readouterr().err.strip() == (f"spinviz: {s}: 1 unverified chunk (.checksums/chunks/0.1.0.0.json "
                                                f"(no record)); its 9 runs are recomputed")
@@ -365,7 +365,7 @@ def wait_for_done(out: Path, proc, at_least: int = 1, timeout: float = 90.0) -> 
     while time.monotonic() < end and proc.poll() is None:
         if (out / "done").exists():
             with contextlib.suppress(Exception):
-                n = int(store.done_mask(str(out)).sum())
+                n = int(DS.done_mask(str(out)).sum())
                 if n >= at_least:
                     return n
         time.sleep(0.02)
@@ -400,7 +400,7 @@ def test_scheduler_killed_mid_atlas_fails_in_one_line_and_resumes(spec_path, ref
     assert p.returncode == 75, err
     assert err.strip() == (f"spinviz: atlas incomplete: the scheduler at {ext.addr} went away: {36 - n} of 36 runs not "
                            f"computed; {out} holds the {n} finished; rerun the same command to resume")
-    assert 0 < n < 36 and store.verify(str(out)).clean
+    assert 0 < n < 36 and DS.verify(str(out)).clean
     res = api.atlas(spec_path, out, workers=1, processes=False, progress=False)       # the same command, resumed
     assert (res.reused, res.computed) == (n, 36 - n)
     same_numbers(out, reference)
@@ -495,7 +495,7 @@ def test_task_error_that_never_reaches_the_client(spec_path, reference, tmp_path
     """A task whose error report distributed cannot read on the client (a RecursionError: its
     deep traceback fails distributed's check, and the future would stay pending forever):
     after ``STALL_S`` without a result (here 1 s) the scheduler's log is asked, the task
-    counted as failed, the others computed; exit status 1; the same call completes the store."""
+    counted as failed, the others computed; exit status 1; the same call completes the DS."""
     monkeypatch.setattr(atlas_cluster, "STALL_S", 1.0)
     deep = tmp_path / "deep.py"
     deep.write_text(DEEP)
@@ -549,7 +549,7 @@ def test_command_killed_at_random_points_resumes_to_the_same_numbers(spec_path, 
     out = tmp_path / "k.zarr"
     cut = []                                          # runs on disk after each kill
     for _ in range(3):
-        before = int(store.done_mask(str(out)).sum()) if (out / "done").exists() else 0
+        before = int(DS.done_mask(str(out)).sum()) if (out / "done").exists() else 0
         if before == 36:
             break
         p = command(spec_path, out, "--workers", "2", "--runs-per-task", "1", cwd=tmp_path)
@@ -560,13 +560,13 @@ def test_command_killed_at_random_points_resumes_to_the_same_numbers(spec_path, 
             with contextlib.suppress(ProcessLookupError):
                 os.killpg(p.pid, signal.SIGKILL)
             p.communicate(timeout=30)
-        cut.append(int(store.done_mask(str(out)).sum()))
+        cut.append(int(DS.done_mask(str(out)).sum()))
     assert sum(0 < n < 36 for n in cut) >= 2, cut          # killed mid-atlas, not after it
     p = command(spec_path, out, "--workers", "2", cwd=tmp_path)
     _, err = p.communicate(timeout=120)
     assert p.returncode == 0, err
     same_numbers(out, reference)
-    assert store.verify(str(out)).clean and partials(tmp_path) == []
+    assert DS.verify(str(out)).clean and partials(tmp_path) == []
 
 
 # --- stop signals ---------------------------------------------------------------------------------
@@ -597,7 +597,7 @@ def test_stop_signal_mid_atlas(spec_path, reference, tmp_path, sig, to_group):
     assert gone(p.pid) == []
     assert partials(tmp_path) == []
     n = int(done_runs_match(out, reference).sum())
-    assert 0 < n < 36 and store.verify(str(out)).clean
+    assert 0 < n < 36 and DS.verify(str(out)).clean
     if sig == signal.SIGHUP and to_group:
         res = api.atlas(spec_path, out, workers=1, processes=False, progress=False)
         assert (res.reused, res.computed) == (n, 36 - n)

@@ -2,7 +2,7 @@
 children of exactly the cells ``refine.flags`` marks, keeps each level as a store of its own
 inside the atlas, resumes level by level, and ``--verify`` covers every level.  (The spec pins
 the brute-force engine: these are the store's mechanics, on a flagged pattern whose damaged
-chunk holds only computed runs; refinement on the limit labels: test_handover.py.)"""
+chunk holds only computed runs; refinement on the limit labels: test_handover_engine.py.)"""
 
 import os
 import shutil
@@ -14,7 +14,7 @@ import zarr
 from spinviz.commands import atlas as command
 from spinviz.regimes import api
 from spinviz.regimes.engine import refine as RF
-from spinviz.regimes.store import dataset as ST
+from spinviz.regimes.store import dataset as DS
 from spinviz.regimes.store import levels as LV
 
 SPEC = """title = "refine test"
@@ -57,7 +57,7 @@ def test_level_one_computes_exactly_the_children_of_flagged_cells(refined):
     maj, share = RF.majority(types)
     flagged = RF.flags(maj, share, done0, RF.effective([maj], [done0]))
     assert 0 < flagged.sum() < flagged.size                   # a boundary crosses the 4 x 4 grid, not everywhere
-    level1 = ST.level_path(out, 1)
+    level1 = DS.level_path(out, 1)
     _, done1 = LV.level_types(level1, 0)
     np.testing.assert_array_equal(done1, RF.children(flagged))
     g = zarr.open_group(level1, mode="r", zarr_format=2)
@@ -76,10 +76,10 @@ def test_rerun_computes_nothing_and_a_lost_level_is_recomputed_identically(refin
     shutil.copytree(out, copy)
     again = api.atlas(spec, copy, workers=1, processes=False, progress=False)
     assert again.computed == 0 and again.reused == res.total
-    shutil.rmtree(ST.level_path(copy, 1))
+    shutil.rmtree(DS.level_path(copy, 1))
     third = api.atlas(spec, copy, workers=1, processes=False, progress=False)
     assert third.computed == res.total - 64 and third.reused == 64
-    np.testing.assert_array_equal(regime(ST.level_path(copy, 1)), regime(ST.level_path(out, 1)))
+    np.testing.assert_array_equal(regime(DS.level_path(copy, 1)), regime(DS.level_path(out, 1)))
 
 
 @pytest.mark.slow
@@ -87,10 +87,10 @@ def test_verify_covers_every_level_and_resume_repairs_a_damaged_one(refined, tmp
     spec, out, res = refined
     copy = str(tmp_path / "r.zarr")
     shutil.copytree(out, copy)
-    assert ST.stored_levels(copy) == [copy, ST.level_path(copy, 1)]
+    assert DS.stored_levels(copy) == [copy, DS.level_path(copy, 1)]
     assert command.verify(copy) == 0
     assert capsys.readouterr().out.rstrip().endswith(f"ok: {res.total} runs verified over 2 refinement levels")
-    level1 = ST.level_path(copy, 1)
+    level1 = DS.level_path(copy, 1)
     chunk = os.path.join(level1, "regime", "0.0.0.0")
     with open(chunk, "r+b") as f:                             # one flipped byte in level 1
         b = f.read(1)
@@ -101,8 +101,8 @@ def test_verify_covers_every_level_and_resume_repairs_a_damaged_one(refined, tmp
     assert "level 1: regime: DAMAGED (1 chunk" in said and "level 0: regime: ok" in said
     fixed = api.atlas(spec, copy, workers=1, processes=False, progress=False)
     assert fixed.repaired > 0 and fixed.computed == fixed.repaired
-    np.testing.assert_array_equal(regime(level1), regime(ST.level_path(out, 1)))
-    assert ST.verify(level1).clean
+    np.testing.assert_array_equal(regime(level1), regime(DS.level_path(out, 1)))
+    assert DS.verify(level1).clean
 
 
 @pytest.mark.slow
@@ -126,7 +126,7 @@ def test_diagram_tiles_the_plane_once_finer_cells_over_coarser(refined):
         s = 2 ** (1 - c["level"])
         cover[c["i"] * s:(c["i"] + 1) * s, c["j"] * s:(c["j"] + 1) * s] += 1
     assert (cover == 1).all()
-    _, done1 = LV.level_types(ST.level_path(out, 1), 0)
+    _, done1 = LV.level_types(DS.level_path(out, 1), 0)
     assert {(c["i"], c["j"]) for c in cells if c["level"] == 1} == {tuple(int(v) for v in ij) for ij in zip(*np.nonzero(done1))}
 
     plt = pyplot()

@@ -9,8 +9,8 @@ import pytest
 from spinviz.driver import simulate
 from spinviz.errors import SpecError
 from spinviz.integrators import auto as A
-from spinviz.integrators import handover as H
 from spinviz.integrators import secular as SC
+from spinviz.integrators import taylor_secular as TS
 from spinviz.integrators.scaling import body_spin_problem
 from spinviz.physics import bodies as B
 from spinviz.physics import closed_forms as CF
@@ -124,13 +124,13 @@ def test_the_predicted_handover_is_where_the_run_hands_over():
         for chi in (0.02, 0.7, 1.2):
             top = B.symmetric_top(0.3, chi)
             problem, eps = body_spin_problem(top, model, W0, np.linspace(0.0, 1e9, 3))
-            t_h, turns = H.plan(problem)
+            t_h, turns = TS.plan(problem)
             assert math.isfinite(t_h) and 0 < turns < 3e5
             if chi == 0.02 and model == "reduced":
                 continue                                 # 2.5e5 turns in full: ~4 s, the slow test's
-            sol = H.solve_handover(problem)
+            sol = TS.solve_handover(problem)
             assert sol.success and sol.stats["full_stage"]["chunks"] == 1
-            assert sol.stats["handover_eps_rad"] == pytest.approx(H.TARGET_MARGIN * SC.EPS_MAX, rel=1e-2)
+            assert sol.stats["handover_eps_rad"] == pytest.approx(TS.TARGET_MARGIN * SC.EPS_MAX, rel=1e-2)
 
 
 def test_asymmetric_body_still_gets_taylor_and_the_same_refusal():
@@ -162,7 +162,7 @@ def test_no_handover_where_braking_never_makes_the_spin_fast():
     top = B.symmetric_top(0.3, 0.0)
     w0 = (0.0, 0.006, 0.005)
     problem, _ = body_spin_problem(top, "reduced", w0, np.linspace(0.0, 1e12, 2))
-    assert H.plan(problem)[0] == math.inf
+    assert TS.plan(problem)[0] == math.inf
     assert A.choose_method(top, "reduced", w0, 1e12)[0] == "taylor"
     with pytest.raises(SpecError, match="nor does braking bring it to 0.001 by t_end"):
         simulate(top, "reduced", w0, t_end=1e12, samples=11)

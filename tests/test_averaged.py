@@ -205,7 +205,7 @@ def test_small_parameter():
 # --- against full integration (slow: Taylor runs at tol 1e-15) -------------------------------
 def full_run(model, delta, chi, omega0, taus, tol=1e-15):
     """omega at ``taus`` by heyoka at ``tol`` on the scaled variable (the atlas's template)."""
-    from spinviz.validation.atlas.handover import full_run as run
+    from spinviz.validation.atlas.against_brute_force import full_run as run
 
     return run(model, delta, chi, omega0, taus, tol)
 
@@ -218,7 +218,7 @@ def test_averaged_flow_against_full_integration_within_its_bound_and_second_orde
     (the full run, tol 1e-15, read through the same transform) differ by at most the engine's
     stated 0.2 mu_h^2 |(a, b)|, and falls with mu_h with a fitted order above 1.5 (the
     transform's second order; its constant depends on the phase at hand-over)."""
-    from spinviz.regimes.engine import handover as HO
+    from spinviz.regimes.engine import handover_engine as HO
 
     f = AV.Flow(model, delta, chi)
     omega0 = np.array([0.06, -0.05, 0.05])

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from spinviz import plotting as PL
-from spinviz.analysis import compare as C
+from spinviz.analysis import compare as CMP
 from spinviz.commands import main
 from spinviz.driver import simulate
 from spinviz.physics import bodies as B
@@ -20,17 +20,17 @@ SCENES = Path(__file__).resolve().parents[1] / "scenes"
 def test_first_crossing_interpolates():
     t = np.array([0.0, 1.0, 2.0, 3.0])
     a = np.array([0.0, 0.5, 1.5, 20.0])
-    assert C.first_crossing(t, a, 1.0) == pytest.approx(1.5)
-    assert C.first_crossing(t, a, 10.0) == pytest.approx(2.0 + 8.5 / 18.5)
-    assert C.first_crossing(t, a, 50.0) is None
+    assert CMP.first_crossing(t, a, 1.0) == pytest.approx(1.5)
+    assert CMP.first_crossing(t, a, 10.0) == pytest.approx(2.0 + 8.5 / 18.5)
+    assert CMP.first_crossing(t, a, 50.0) is None
 
 
 def test_resolved_askew_comparison_grows_from_zero():
     """Same start, two models: the orientations agree at t = 0 and part later, 1 deg before 10 deg."""
     body = B.symmetric_top(-0.6, math.radians(55.0))
-    t = C.compare_times(200.0, 200)
+    t = CMP.compare_times(200.0, 200)
     trajs = [simulate(body, m, (0.05, 0.1, 0.2), t_eval=t) for m in ("reduced", "truncated")]
-    c = C.compare(trajs)
+    c = CMP.compare(trajs)
     assert c.phase_resolved
     assert c.misorientation_deg[0] == 0.0 and c.dipole_angle_deg[0] == 0.0
     one, ten = c.first_exceed["misorientation"]["1 deg"], c.first_exceed["misorientation"]["10 deg"]
@@ -45,9 +45,9 @@ def test_dast_cube_final_states_residual_rotation_vs_rest():
     cube = P.dast_cube()
     W = math.pi * 1e10
     Th = 1.0 / (cube.tau0 * W**2)
-    t = C.compare_times(6.0 * Th, 200)
+    t = CMP.compare_times(6.0 * Th, 200)
     trajs = [simulate(cube, m, (0.0, W, W), t_eval=t) for m in ("reduced", "truncated")]
-    c = C.compare(trajs)
+    c = CMP.compare(trajs)
     assert not c.phase_resolved and c.misorientation_deg is None       # 1e16 turns: not comparable turn by turn
     red, tru = c.models
     assert red.final_state.startswith("residual rotation about the dipole")
@@ -83,12 +83,12 @@ def test_compare_plots_units_colours_thresholds_and_shared_hodograph_axes(monkey
     (no symlog "0" over "10⁻³") in τ₀ here, the 1° and 10° lines are labelled, each model has one
     colour on every panel (the videos' colour), and the two hodographs share their axis ranges."""
     figs = []
-    monkeypatch.setattr(C, "save", lambda fig, path: figs.append(fig))
+    monkeypatch.setattr(CMP, "save", lambda fig, path: figs.append(fig))
     body = B.symmetric_top(-0.6, math.radians(55.0))
-    t = C.compare_times(300.0, 150)
-    c = C.compare([simulate(body, m, (0.05, 0.1, 0.2), t_eval=t) for m in ("reduced", "truncated")])
-    C.plot(c, "unused.png", "askew")
-    C.plot_hodograph(c, "unused.png", "askew")
+    t = CMP.compare_times(300.0, 150)
+    c = CMP.compare([simulate(body, m, (0.05, 0.1, 0.2), t_eval=t) for m in ("reduced", "truncated")])
+    CMP.plot(c, "unused.png", "askew")
+    CMP.plot_hodograph(c, "unused.png", "askew")
     fig, hodo = figs
     axes = fig.axes
     for ax in axes:

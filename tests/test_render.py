@@ -164,7 +164,7 @@ def test_video_has_the_expected_frames_and_size(tmp_path):
 
 def test_failed_render_leaves_the_previous_file_intact(tmp_path, monkeypatch):
     """An error in the middle of a render deletes the partial output and keeps the old file."""
-    from spinviz.rendering import session as S
+    from spinviz.rendering import session as SE
 
     sc = askew(w=64, h=48)
     plan = pipeline.plan(sc)
@@ -172,7 +172,7 @@ def test_failed_render_leaves_the_previous_file_intact(tmp_path, monkeypatch):
     out.write_bytes(b"previous video")
     (tmp_path / "old.png").write_bytes(b"previous poster")
     calls = {"n": 0}
-    original = S.RenderSession.frame
+    original = SE.RenderSession.frame
 
     def failing(self, f):
         calls["n"] += 1
@@ -180,7 +180,7 @@ def test_failed_render_leaves_the_previous_file_intact(tmp_path, monkeypatch):
             raise RuntimeError("disk on fire")
         return original(self, f)
 
-    monkeypatch.setattr(S.RenderSession, "frame", failing)
+    monkeypatch.setattr(SE.RenderSession, "frame", failing)
     with pytest.raises(RenderError, match="rendering frame 4 failed: disk on fire"):
         render_video(plan, str(out), workers=1, progress=False)
     assert out.read_bytes() == b"previous video"
@@ -205,18 +205,18 @@ def test_only_listed_actors_are_built():
 
 def test_hodograph_only_scene_integrates_no_orientation(monkeypatch):
     """show = ["hodograph"]: the trajectories carry no orientation (kinematics "none")."""
-    import spinviz.pipeline as V
+    import spinviz.pipeline as PIPE
 
     seen = []
-    real = V.simulate_request
+    real = PIPE.simulate_request
 
     def spy(request):
         seen.append(request.kinematics)
         return real(request)
 
-    monkeypatch.setattr(V, "simulate_request", spy)
+    monkeypatch.setattr(PIPE, "simulate_request", spy)
     sc = askew(models='models = ["reduced", "truncated"]', show='["hodograph", "axes"]', w=128, h=64)
-    trajs = V.scene_trajectories(sc, sc.render)
+    trajs = PIPE.scene_trajectories(sc, sc.render)
     assert seen == ["none", "none"] and all(t.q is None for t in trajs)
     plan = timeline.plan_frames(sc.render, trajs)
     (img,), session = render_frames(plan, [plan.frames - 1])
@@ -455,18 +455,18 @@ def test_angle_between_d_and_L_is_the_true_one_or_its_swing():
 
 
 def test_numbers_for_people():
-    from spinviz.rendering import captions as C
+    from spinviz.rendering import captions as CAP
 
-    assert C.sci(3.8e15) == "3.8 × 10¹⁵" and C.sci(1.2e-7) == "1.2 × 10⁻⁷" and C.sci(42.0) == "42"
-    assert C.words(5.0e9) == "5 billion" and C.words(1.34e6) == "1.3 million" and C.words(870) == "870"
+    assert CAP.sci(3.8e15) == "3.8 × 10¹⁵" and CAP.sci(1.2e-7) == "1.2 × 10⁻⁷" and CAP.sci(42.0) == "42"
+    assert CAP.words(5.0e9) == "5 billion" and CAP.words(1.34e6) == "1.3 million" and CAP.words(870) == "870"
     year = 365.25 * 86400
-    assert C.people_time(1.34e6 * year) == "1.3 million years" and C.people_time(4.2 * 86400) == "4.2 days"
-    assert C.people_time(22.7 * 60) == "23 minutes"
+    assert CAP.people_time(1.34e6 * year) == "1.3 million years" and CAP.people_time(4.2 * 86400) == "4.2 days"
+    assert CAP.people_time(22.7 * 60) == "23 minutes"
 
 
 def test_captions_key_is_validated():
     from spinviz.errors import SpecError
-    from spinviz.rendering.spec import RenderSpec
+    from spinviz.inputs.render import RenderSpec
 
     assert RenderSpec(captions="physics").captions == "physics"
     with pytest.raises(SpecError, match="captions: unknown value 'poetry'; valid: outreach, physics"):

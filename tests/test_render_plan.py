@@ -14,6 +14,7 @@ import pytest
 
 from spinviz import pipeline
 from spinviz import units as U
+from spinviz.inputs.render import RenderSpec
 from spinviz.presentation import style as model_style
 from spinviz.rendering.camera import Camera
 from spinviz.rendering.captions import texts_of
@@ -22,7 +23,6 @@ from spinviz.rendering.frameplan import FramePlan, Panel, ShapeInfo
 from spinviz.rendering.layout import TextSizes
 from spinviz.rendering.overlay import Fill, Text
 from spinviz.rendering.picture import plan_picture
-from spinviz.rendering.spec import RenderSpec
 from spinviz.rendering.stage import ARROW_VECTORS, EDGE_PX, arrow_length, content_points
 from spinviz.rendering.style import theme
 from spinviz.rendering.timeline import frame_times

@@ -142,9 +142,9 @@ def test_driver_switches_to_radau_when_the_explicit_method_detects_stiffness(mon
     """If the up-front estimate misses stiffness, taylor's stiffness watch (steps below 1e-5 rad
     of spin over 4 x 512 steps) fires and the driver reruns with radau, saying so.  The body:
     I3/I1 = 1e-6, d at 30 deg, |omega| = 4.2: decay/spin 1.6e6, where radau is 2x faster."""
-    import spinviz.driver as S
+    import spinviz.driver as DR
 
-    monkeypatch.setattr(S, "choose_method", lambda *a, **k: ("taylor", "forced for the test"))
+    monkeypatch.setattr(DR, "choose_method", lambda *a, **k: ("taylor", "forced for the test"))
     thin = B.custom((1.0, 1.0, 1e-6), (0.5, 0.0, math.sqrt(0.75)), units="dimensionless")
     tr = simulate(thin, "reduced", (0.0, 3.0, 3.0), t_end=2.0, samples=11)
     assert tr.stats["method"] == "radau"

@@ -147,7 +147,7 @@ def test_verify_names_a_special_file_planted_in_the_store(store, tmp_path, capsy
 def test_resume_recomputes_a_chunk_a_fifo_replaced(store, small_atlas_spec, tmp_path, capsys):
     """The resume treats the FIFO as damage: removed, its runs computed again, the same numbers."""
     from spinviz.regimes import api
-    from spinviz.regimes.store import dataset as ST
+    from spinviz.regimes.store import dataset as DS
 
     s = tmp_path / "s.zarr"
     shutil.copytree(store, s)
@@ -161,7 +161,7 @@ def test_resume_recomputes_a_chunk_a_fifo_replaced(store, small_atlas_spec, tmp_
 
     at_once(run, s / "regime/0.1.0.0")
     assert box["res"].repaired == 9 and box["res"].computed == 9
-    assert np.array_equal(ST.regime_codes(str(s)), ST.regime_codes(str(store)))
+    assert np.array_equal(DS.regime_codes(str(s)), DS.regime_codes(str(store)))
     assert "regime/0.1.0.0 (is a named pipe (FIFO), not a regular file)" in capsys.readouterr().err
 
 

@@ -18,7 +18,7 @@ import zarr
 from spinviz.commands import main
 from spinviz.regimes import api
 from spinviz.regimes.faults import ForeignLevel, StoreBusy
-from spinviz.regimes.store import dataset as ST
+from spinviz.regimes.store import dataset as DS
 from spinviz.regimes.store import levels as LV
 from spinviz.regimes.store.lock import StoreLock, lock_path
 
@@ -36,7 +36,7 @@ def same_atlas(a, b) -> None:
     la, lb = LV.found(a), LV.found(b)
     assert la == lb, (la, lb)
     for k in [0, *lb]:
-        pa, pb = ST.level_path(str(a), k), ST.level_path(str(b), k)
+        pa, pb = DS.level_path(str(a), k), DS.level_path(str(b), k)
         va, vb = variables(pa), variables(pb)
         assert va.keys() == vb.keys()
         for name in vb:
@@ -182,7 +182,7 @@ def test_an_incomplete_store_is_not_ok(refined_atlas, tmp_path, capsys):
 
     with pytest.raises(KeyboardInterrupt):
         resume(refined_atlas, out, on_result=stop)
-    done = int(ST.done_mask(str(out)).sum())
+    done = int(DS.done_mask(str(out)).sum())
     code, lines = verify(out, capsys)
     n0 = counts(refined_atlas)[0]
     assert code == 1 and 0 < done < n0

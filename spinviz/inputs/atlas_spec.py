@@ -76,7 +76,7 @@ class Settings:
     a decade.  rtol : Taylor tolerance on the scaled omega sqrt(1 + tau/T) / |omega0|.
     max_steps : step budget of one run (of its SIMD batch).  window : decades the classifier analyses.
     engine : "handover" (full integration until the averaged flow holds, then the averaged
-    flow: ``regimes.engine.handover``) or "taylor" (every run integrated to tau_end).
+    flow: ``regimes.engine.handover_engine``) or "taylor" (every run integrated to tau_end).
     """
 
     tau_end: float = 1e10

@@ -5,7 +5,7 @@ of ``render``, ``render_frame``, ``Renderer`` -- is this one class: ``RenderSpec
 ``spec.with_(...)`` and ``dataclasses.replace`` validate every field (``SpecError(key,
 reason)`` naming the field, which is also the TOML key and the keyword); ``check_output`` /
 ``check_horizon`` check what depends on the output format or the run.  It lives below both
-the scenes and the rendering package (``spinviz.rendering.spec`` re-exports it), so that a
+the scenes and the rendering package (which imports it from here), so that a
 scene validates its ``[render]`` table without importing rendering.
 
 To add a setting: one annotated field below (type, range, default, docstring line); the

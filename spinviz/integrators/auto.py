@@ -8,9 +8,9 @@ import numpy as np
 
 from ..errors import SpecError
 from .base import get
-from .handover import NAME as HANDOVER
 from .scaling import body_spin_problem
 from .secular import EPS_MAX
+from .taylor_secular import NAME as HANDOVER
 
 MAX_RESOLVED_TURNS = 1e6     # beyond this, resolving every turn costs more than ~10 s
 HARD_MAX_TURNS = 5e7         # taylor resolves an askew asymmetric body at ~17 us a turn (rtol 1e-10, 7.7 steps a turn): ~15 min
@@ -82,7 +82,7 @@ def _handover_note(body, model: str, omega0, t_end: float, spin=None) -> str:
     problem, eps = spin if spin is not None else body_spin_problem(body, model, omega0)
     if not eps > EPS_MAX or model == "free":
         return ""
-    from .handover import TARGET_MARGIN, predict, target_norm
+    from .taylor_secular import TARGET_MARGIN, predict, target_norm
 
     S = float(t_end) * eps / body.tau0
     t_h, turns_full = predict(problem.system, problem.omega0, TARGET_MARGIN * target_norm(problem), S)
@@ -108,7 +108,7 @@ def estimated_turns(body, model: str, omega0, t_end: float, spin=None) -> float:
     else:
         turns = (math.sqrt(1.0 + 2.0 * k * S) - 1.0) / (2.0 * math.pi * k)
     if body.is_symmetric and model != "free":
-        from .handover import predict
+        from .taylor_secular import predict
 
         turns = max(turns, predict(problem.system, problem.omega0, 0.0, S)[1])
     return turns
@@ -185,7 +185,7 @@ def _handover_choice(body, model: str, omega0, t_end: float, problem, eps: float
     ``EPS_MAX``) whose braking, as the averaged flow predicts it (``handover.plan``), brings
     tau0 |Omega| to ``EPS_MAX`` before t_end after at most ``HARD_MAX_TURNS`` turns in full;
     None otherwise (then it is resolved in full, within the usual limit)."""
-    from .handover import TARGET_MARGIN, predict, target_norm
+    from .taylor_secular import TARGET_MARGIN, predict, target_norm
 
     S = float(t_end) * eps / body.tau0
     t_h, turns_full = predict(problem.system, problem.omega0, TARGET_MARGIN * target_norm(problem), S)

@@ -31,7 +31,7 @@ from ..interrupt import check, deferred
 from .engine import runs as RN
 from .engine.cost import check_feasible, run_cost_s
 from .faults import AtlasIncomplete, ForeignLevel, StoreDamaged
-from .store import dataset as ST
+from .store import dataset as DS
 from .store import integrity as IN
 from .store import levels as LV
 from .store.lock import StoreLock
@@ -75,7 +75,7 @@ class AtlasResult:
     @property
     def dataset(self):
         """The atlas (``store.open_atlas``: labels decoded, evidence unpacked)."""
-        return ST.open_atlas(self.path)
+        return DS.open_atlas(self.path)
 
     def summary(self) -> str:
         """One line for people: runs reused, computed and failed, time, where, and where the time went."""
@@ -229,7 +229,7 @@ def _compute(spec, out, scheduler, workers, processes, runs_per_task, flush_s, r
                 cells = LV.wanted(spec, [x.out for x in levels], k)
                 if not cells.any():
                     break
-                lv = Level(LV.level_spec(spec, k), ST.level_path(out, k), cells)
+                lv = Level(LV.level_spec(spec, k), DS.level_path(out, k), cells)
                 _prepare_level(lv, k, say, notices)
             levels.append(lv)
             s = _run_level(lv, cluster, runs_per_task, flush_s, retry_failed, on_result, progress, say, notices, totals)
@@ -240,13 +240,13 @@ def _compute(spec, out, scheduler, workers, processes, runs_per_task, flush_s, r
                     if s.incomplete.cluster_lost:
                         cluster.close_fast()
                     inc = s.incomplete
-                    done = ST.done_mask(lv.out)
+                    done = DS.done_mask(lv.out)
                     done = int((done if lv.wanted is None else done & lv.wanted[..., None]).sum())
                     raise AtlasIncomplete(lv.out, inc.cause, lv.runs - done, lv.runs, done, inc.cluster_lost)
         for k in LV.found(out):
             if k >= len(levels):
-                line = (f"{ST.level_path(out, k)}: not a level this atlas implies (the labels of level {len(levels) - 1} "
-                        f"flag no cell for it); left as it is: rm -r {ST.level_path(out, k)} removes it")
+                line = (f"{DS.level_path(out, k)}: not a level this atlas implies (the labels of level {len(levels) - 1} "
+                        f"flag no cell for it); left as it is: rm -r {DS.level_path(out, k)} removes it")
                 notices.append(line)
                 say(line)
     seconds = time.perf_counter() - t0
@@ -266,15 +266,15 @@ def _check_store(spec: AtlasSpec, out: str) -> None:
     if skeleton is None:
         if not os.path.exists(os.path.join(out, ".zgroup")):
             raise UsageError(f"{out}: exists and is not an atlas store (no .zgroup); choose another store path")
-        ST.check_identity(spec, out)                 # another Zarr store, or another spec: said as such
+        DS.check_identity(spec, out)                 # another Zarr store, or another spec: said as such
         raise StoreDamaged(f"{out}: carries no checksums (made by an earlier spinviz, or its {IN.DIR} was deleted), "
                            f"so its runs cannot be trusted; move it away and compute the atlas again")
     if skeleton:
         raise StoreDamaged(f"{out}: its metadata are damaged ({IN.summary(skeleton, 4)}); they cannot be "
                            f"recomputed from the runs: move it away and compute the atlas again")
-    ST.check_identity(spec, out)
+    DS.check_identity(spec, out)
     for k in LV.found(out):
-        path = ST.level_path(out, k)
+        path = DS.level_path(out, k)
         if k > spec.refine_levels:
             raise ForeignLevel(f"{path}: not a refinement level of this spec ([refine] levels = {spec.refine_levels}); "
                                f"refusing to mix it in: remove it (rm -r {path}) and run the same command again")
@@ -290,7 +290,7 @@ def _prepare_level(lv: Level, k: int, say, notices: list) -> None:
     """Level ``k``'s store before its runs: a damaged one (no .zgroup, no checksums, metadata
     that do not match them) is removed -- a level is recomputable from the spec and the levels
     below -- and said in one line; a foreign one was refused before any work (``_check_store``)."""
-    st = LV.state(lv.out, ST.identity(lv.spec))
+    st = LV.state(lv.out, DS.identity(lv.spec))
     if st.kind == "foreign":                         # appeared since the check: another hand in the store
         raise ForeignLevel(f"{lv.out}: holds a refinement level of another atlas; remove it (rm -r {lv.out}) and "
                            f"run the same command again")
@@ -385,9 +385,9 @@ def _run_level(lv: LV.Level, cluster: _LazyCluster, runs_per_task, flush_s, retr
         chunks, done, repaired, said = _resume(spec, out, say)
         notices += said
         if retry_failed:
-            done &= ST.regime_codes(out) != -1
+            done &= DS.regime_codes(out) != -1
     else:
-        chunks = ST.chunk_shape(spec)
+        chunks = DS.chunk_shape(spec)
         done = np.zeros((len(spec.models), len(spec.deltas), len(spec.chis), spec.members), dtype=bool)
     check()
     skip = done if lv.wanted is None else (done | ~lv.wanted[..., None])
@@ -403,8 +403,8 @@ def _run_level(lv: LV.Level, cluster: _LazyCluster, runs_per_task, flush_s, retr
         return None
     cl = cluster.get(small=sum(work_s(spec, b) for b in batches) < SMALL_WORK_S)
     if not exists:
-        ST.create(spec, out, chunks)
-    writer = ST.Writer(out, expected, flush_s=flush_s)
+        DS.create(spec, out, chunks)
+    writer = DS.Writer(out, expected, flush_s=flush_s)
     label = os.path.basename(out) if lv.wanted is None else f"{os.path.basename(os.path.dirname(out))}/" \
                                                              f"{os.path.basename(out)}"
     bar = Progress(todo, f"atlas {printable(label, 80)}", enabled=progress)
@@ -424,7 +424,7 @@ def _run_level(lv: LV.Level, cluster: _LazyCluster, runs_per_task, flush_s, retr
         if stats is not None:
             stats.write_s, stats.checksum_s = writer.write_s, writer.checksum_s
             stats.chunk_writes = writer.chunk_writes
-    totals["failed"] += int(((ST.regime_codes(out) == -1) & ~skip).sum())
+    totals["failed"] += int(((DS.regime_codes(out) == -1) & ~skip).sum())
     return stats
 
 
@@ -438,24 +438,24 @@ def _resume(spec: AtlasSpec, out: str, say) -> tuple:
     leftover temporary files removed, each said in one line.
 
     Returns (chunks, done mask, runs to recompute, notices)."""
-    rep = ST.verify(out)
+    rep = DS.verify(out)
     if rep.skeleton is None:
         if not os.path.exists(os.path.join(out, ".zgroup")):
             raise UsageError(f"{out}: exists and is not an atlas store (no .zgroup); choose another store path")
-        ST.check_identity(spec, out)                 # another Zarr store, or another spec: said as such
+        DS.check_identity(spec, out)                 # another Zarr store, or another spec: said as such
         raise StoreDamaged(f"{out}: carries no checksums (made by an earlier spinviz, or its {IN.DIR} was deleted), "
                            f"so its runs cannot be trusted; move it away and compute the atlas again")
     if rep.skeleton:
         raise StoreDamaged(f"{out}: its metadata are damaged ({IN.summary(rep.skeleton, 4)}); they cannot be "
                            f"recomputed from the runs: move it away and compute the atlas again")
-    ST.check_identity(spec, out)
+    DS.check_identity(spec, out)
     notices = []
     shape, chunks = IN.layout(out)
     bad = rep.bad_keys
     repaired = 0
     if bad:
         with deferred():
-            IN.discard(out, ST.run_variables(out), bad, rep.leftovers)
+            IN.discard(out, DS.run_variables(out), bad, rep.leftovers)
         n = sum(int(np.prod([r.stop - r.start for r in IN.chunk_region(k, shape, chunks)])) for k in bad)
         repaired = n
         what = "damaged" if rep.damaged else "unverified"
@@ -465,10 +465,10 @@ def _resume(spec: AtlasSpec, out: str, say) -> tuple:
                        f"{'their' if len(bad) != 1 else 'its'} {n} runs are recomputed")
     elif rep.leftovers:
         with deferred():
-            IN.discard(out, ST.run_variables(out), [], rep.leftovers)
+            IN.discard(out, DS.run_variables(out), [], rep.leftovers)
     if rep.leftovers and not bad:
         notices.append(f"{out}: removed {len(rep.leftovers)} temporary file{'s' if len(rep.leftovers) != 1 else ''} "
                        f"of an interrupted write ({IN.summary([IN.Damage(x, 'leftover') for x in rep.leftovers], 3)})")
     for line in notices:
         say(line)
-    return tuple(chunks), ST.done_mask(out), repaired, notices
+    return tuple(chunks), DS.done_mask(out), repaired, notices

@@ -131,7 +131,7 @@ def store_cost(spec, repeats: int = 3) -> dict:
     checksums), the store's size and the time to verify it."""
     from .api import RUNS_PER_TASK, plan
     from .engine import classify as C
-    from .store import dataset as ST
+    from .store import dataset as DS
     from .store import integrity as IN
 
     if isinstance(repeats, bool) or not isinstance(repeats, int) or not 1 <= repeats <= 100:
@@ -146,14 +146,14 @@ def store_cost(spec, repeats: int = 3) -> dict:
         for _ in range(repeats):
             for sums in (False, True):
                 out = os.path.join(tmp, f"s{int(sums)}.zarr")
-                chunks = ST.chunk_shape(spec)
-                ST.create(spec, out, chunks)
+                chunks = DS.chunk_shape(spec)
+                DS.create(spec, out, chunks)
                 done = np.zeros((len(spec.models), len(spec.deltas), len(spec.chis), spec.members), dtype=bool)
                 batches, keys, expected = plan(spec, chunks, done, RUNS_PER_TASK)
                 results = [_synthetic(b, len(C.EVIDENCE)) for b in batches]
                 IN.record = real if sums else (lambda *a, **k: None)
                 try:
-                    w = ST.Writer(out, expected, flush_s=float("inf"))
+                    w = DS.Writer(out, expected, flush_s=float("inf"))
                     for k, res in zip(keys, results):
                         w.add(k, res)
                     w.close()
@@ -161,7 +161,7 @@ def store_cost(spec, repeats: int = 3) -> dict:
                     IN.record = real
                 t0 = time.perf_counter()
                 if sums:
-                    assert ST.verify(out).clean
+                    assert DS.verify(out).clean
                 size = sum(os.path.getsize(os.path.join(r, f)) for r, _, fs in os.walk(out) for f in fs)
                 rows[sums].append((1e3 * w.write_s / w.chunk_writes, 1e3 * w.checksum_s / w.chunk_writes,
                                    time.perf_counter() - t0, size, w.chunk_writes))

@@ -13,8 +13,8 @@ import time
 from dataclasses import dataclass, field
 
 from ..atomic import atomic_path
+from ..inputs.render import MODEL_FORMATS
 from . import gltf, keyframes, webpage
-from .spec import MODEL_FORMATS
 
 __all__ = ["export", "ExportResult", "MODEL_FORMATS"]
 

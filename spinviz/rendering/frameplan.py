@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..inputs.render import RenderSpec
 from ..rotations import matrix_from_quat
-from .spec import RenderSpec
 
 
 @dataclass(frozen=True)

@@ -29,10 +29,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import rotations as R
+from ..inputs.render import RenderSpec
 from ..physics.free_top import pose_about_L
 from ..trajectory import radiated_power
 from .frameplan import FramePlan, Panel, ShapeInfo
-from .spec import RenderSpec
 
 if TYPE_CHECKING:
     from ..trajectory import Trajectory

@@ -22,11 +22,11 @@ from dataclasses import dataclass, field
 from .. import interrupt
 from ..atomic import Outputs
 from ..errors import RenderError, printable
+from ..inputs.render import poster_for
 from ..progress import Progress
 from .encode import save_png
 from .fonts import Fonts
 from .picture import Picture, plan_picture
-from .spec import poster_for
 from .workers import WorkerPool, render_here, render_segments
 
 __all__ = ["render_video", "render_frames", "picture_of", "RenderResult", "RenderError", "WorkerPool", "open_pool",

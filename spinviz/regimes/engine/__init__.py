@@ -7,4 +7,4 @@ next) and ``cost`` (what an atlas costs, and the refusal of one that cannot fini
 The hand-over engine is imported here so that it is registered with ``runs`` (its
 ``ENGINES``) wherever a batch is run."""
 
-from . import handover  # noqa: F401  (registers the hand-over engine with runs)
+from . import handover_engine  # noqa: F401  (registers the hand-over engine with runs)

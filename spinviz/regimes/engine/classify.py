@@ -50,7 +50,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...physics import asymptotics as F
+from ...physics import asymptotics as FM
 from ...physics import models as M
 
 VERSION = 3                # bump when a rule changes: stores made by another version are not resumed
@@ -485,25 +485,25 @@ def deviations(label: str, ev: dict, delta: float, chi: float, model: str = "red
     formulas fix, keyed by "<quantity> <equation>"."""
     if model == "reduced":
         if label == "1":
-            f = F.type1_eq4_9(delta, chi)
+            f = FM.type1_eq4_9(delta, chi)
             return {"C^2 (4.9)": _rel(ev["Y2"], f["C2"]), "B (4.9)": _rel(ev["w2_tau"], f["B"])}
         if label == "2":
-            f = F.type2_eq4_14(delta, chi)
+            f = FM.type2_eq4_14(delta, chi)
             return {"alpha (4.14)": _rel(ev["slope_perp"], f["alpha"]), "B^2 (4.14)": _rel(ev["Y2"], f["B2"])}
         if label == "3":
-            f = F.type3_eq4_16(delta, chi)
+            f = FM.type3_eq4_16(delta, chi)
             return {"A^2 (4.16)": _rel(ev["X2"], f["A2"]), "B^2 (4.16)": _rel(ev["Y2"], f["B2"])}
         if label == "4":
-            f = F.type4_eq4_18(delta, chi)
+            f = FM.type4_eq4_18(delta, chi)
             return {"beta (4.18)": _rel(ev["slope_3"], f["beta"]), "A^2 (4.18) corrected": _rel(ev["X2"], f["A2"])}
         if label == "5":
-            f = F.type5_eq4_42(delta, chi)
+            f = FM.type5_eq4_42(delta, chi)
             if not f["real"]:
                 return {}                  # (4.42) has no real solution here (A^2 outside (0, 1])
             return {"A^2 (4.42)": _rel(ev["libration_A2"], f["A2"]), "B (4.42)": _rel(ev["libration_B"], f["B"]),
                     "M^2 (4.42)": _rel(ev["libration_M2"], f["M2"])}
     else:
-        f = F.truncated_averaged(delta, chi)
+        f = FM.truncated_averaged(delta, chi)
         if label == "T4":
             return {"A^2 (averaged)": _rel(ev["X2"], f["T4_A2"]), "beta (averaged)": _rel(ev["slope_3"], f["T4_beta"])}
         if label == "T2":

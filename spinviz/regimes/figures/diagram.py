@@ -16,7 +16,7 @@ import textwrap
 import numpy as np
 
 from ...physics import asymptotics as FM
-from ...physics import presets as PR
+from ...physics import presets as P
 from ...plotting import pyplot
 from .cells import compose_levels, limit_diagram, spec_of
 from .style import COLORS, DELTA_AXIS, LINE_STYLE, ORDER, WORDS
@@ -109,7 +109,7 @@ def _lines(ax, model: str) -> None:
         elif ok.any():
             k = int(np.argmin(np.where(ok, np.abs(d - at), np.inf)))
             ax.annotate(line["label"], (d[k], c[k]), fontsize=7.5, color=color, ha="center", va="bottom", **_BOX)
-    for fam in PR.dast_families():
+    for fam in P.dast_families():
         ax.plot(fam["delta"], np.degrees(fam["chi"]), color="0.25", ls=fam["style"], lw=1.2, alpha=0.9)
         ax.text(-0.98, np.degrees(fam["chi"][0]) + 0.8, fam["short"], fontsize=7, color="0.2", **_BOX)
 

@@ -66,7 +66,7 @@ def series_of(ds, model: str, i: int, j: int, k: int):
     st = settings_from_canonical(spec_of(ds))
     d, c, w0 = float(ds["delta"].values[i]), float(ds["chi"].values[j]), ds["omega0"].values[k]
     if st.engine == "handover":
-        from ..engine.handover import cell_records
+        from ..engine.handover_engine import cell_records
 
         return st.times(), cell_records(model, d, c, [w0], st, series=True)[0].series
     r = integrate(model, d, c, w0, st)

@@ -32,7 +32,7 @@ import warnings
 import numpy as np
 
 from ...physics import asymptotics as FM
-from ...physics import presets as PR
+from ...physics import presets as P
 from .cells import compose_levels
 from .style import COLORS, LINE_STYLE, WORDS
 
@@ -108,7 +108,7 @@ def _lines(model: str) -> list[str]:
             k = int(np.argmin(np.where(inside, np.abs(d - at), np.inf)))
             out.append(f'<text x="{_x(d[k]):.1f}" y="{_y(c[k]) - 3:.1f}" class="lbl" fill="{color}">'
                        f'{html.escape(line["label"])}</text>')
-    for fam in PR.dast_families():
+    for fam in P.dast_families():
         y = _y(math.degrees(fam["chi"][0]))
         out.append(f'<line x1="{_x(-1)}" x2="{_x(1)}" y1="{y:.1f}" y2="{y:.1f}" stroke="#404040" stroke-width="1" '
                    f'stroke-dasharray="{"" if fam["style"] == "-" else "7,3,2,3"}" pointer-events="none"/>'

@@ -21,7 +21,7 @@ import numpy as np
 
 from ...errors import SceneError
 from ..engine import refine as RF
-from . import dataset as ST
+from . import dataset as DS
 from . import integrity as IN
 
 LEVEL_DIR = re.compile(r"level([1-9][0-9]*)")
@@ -39,7 +39,7 @@ def level_spec(spec, k: int):
 
 def level_identity(spec, k: int) -> str:
     """The ``spec_sha256`` level ``k`` of an atlas of ``spec`` must carry."""
-    return ST.identity(level_spec(spec, k))
+    return DS.identity(level_spec(spec, k))
 
 
 def level_types(path: str, model_index: int):
@@ -137,14 +137,14 @@ def recorded_spec(path: str):
     except (OSError, ValueError):
         raise SceneError(where, "(file)", "unreadable: not the attributes of an atlas store") from None
     spec = replace(spec_from_record(attrs, where), path=path)
-    if ST.identity(spec) != attrs.get("spec_sha256"):
+    if DS.identity(spec) != attrs.get("spec_sha256"):
         raise SceneError(where, "spec_sha256", "does not match the recorded spec (the attributes were changed)")
     return spec
 
 
 def done_within(path: str, cells: np.ndarray | None) -> tuple[int, int]:
     """(runs done, runs wanted) of a level store: all its runs, or the members of ``cells``."""
-    done = ST.done_mask(path)
+    done = DS.done_mask(path)
     if cells is None:
         return int(done.sum()), int(done.size)
     return int((done & cells[..., None]).sum()), int(cells.sum()) * done.shape[-1]

@@ -22,7 +22,7 @@ from __future__ import annotations
 import os
 
 from ...errors import SceneError, UsageError, printable
-from . import dataset as ST
+from . import dataset as DS
 from . import levels as LV
 from .integrity import summary
 from .lock import StoreLock
@@ -49,7 +49,7 @@ def _judge(path: str) -> dict:
     reports = [first]
     paths, judged, sound = [path], {0}, first["ok"]
     for k in range(1, (spec.refine_levels if spec is not None else 0) + 1):
-        lpath = ST.level_path(path, k)
+        lpath = DS.level_path(path, k)
         if not sound:                                  # the labels that decide level k cannot be trusted
             if os.path.isdir(lpath):
                 lines, lrep = level_lines(lpath)
@@ -70,7 +70,7 @@ def _judge(path: str) -> dict:
     for k in LV.found(path):
         if k in judged:
             continue
-        lpath = ST.level_path(path, k)
+        lpath = DS.level_path(path, k)
         if spec is None:                               # nothing says which levels belong: their files only
             lines, lrep = level_lines(lpath) if os.path.isdir(lpath) else (["not a directory"], None)
             lines.append("not judged against the spec: the store's own spec cannot be read")
@@ -94,7 +94,7 @@ def _judge_top(path: str, problems: list):
             lines.insert(1, f"spec: DAMAGED ({e.key}: {e.reason})")
             problems.append(("metadata", "the recorded spec does not hold; compute the atlas again into a new store"))
         else:
-            lines.insert(1, f"spec: ok (sha256 {ST.identity(spec)[:12]}, [refine] levels = {spec.refine_levels})")
+            lines.insert(1, f"spec: ok (sha256 {DS.identity(spec)[:12]}, [refine] levels = {spec.refine_levels})")
     entry = _entry(path, 0, lines, rep, ok=rep.clean and spec is not None)
     _chunk_problems(entry, rep, problems)
     if spec is not None and rep.clean:
@@ -180,7 +180,7 @@ def _verdict(path: str, reports: list, problems: list) -> dict:
 
 def level_lines(path: str):
     """The lines ``--verify`` says about one store (one level)'s files, and the integrity report."""
-    rep = ST.verify(path)
+    rep = DS.verify(path)
     lines = []
     if rep.skeleton is None:
         lines.append("metadata: NO CHECKSUMS (made by an earlier spinviz, or its .checksums was deleted)")

@@ -60,7 +60,7 @@ def run_point(model: str, delta: float, chi: float, starts: np.ndarray, horizon:
     (``handover.cell_records``), whose cost does not grow with the horizon where the averaged
     flow holds, and which keeps the free spiral a brute-force run at rtol 1e-10 loses past
     ~1e12 near alpha = -1 (docs/atlas.md, "The hand-over engine against brute force")."""
-    from ...regimes.engine.handover import cell_records
+    from ...regimes.engine.handover_engine import cell_records
 
     return cell_records(model, delta, chi, starts, Settings(tau_end=horizon, rtol=rtol))
 

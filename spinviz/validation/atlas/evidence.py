@@ -82,24 +82,24 @@ def _compute(req) -> tuple:
                                                 f"({r['seconds']:.1f} s)"))
         return rows, X.format_rows(rows), 0
     if kind == "physical":
-        from . import physical as P
+        from . import physical as PC
 
-        rows = P.compare(members=n, tau_end=req.tau_end or 1e10, progress=_say)
-        return rows, P.format_table(rows), 0 if all(r["label_atlas"] == r["label_physical"] for r in rows) else 1
+        rows = PC.compare(members=n, tau_end=req.tau_end or 1e10, progress=_say)
+        return rows, PC.format_table(rows), 0 if all(r["label_atlas"] == r["label_physical"] for r in rows) else 1
     if kind == "basins":
-        from . import handover as HV
+        from . import against_brute_force as HV
 
         rows = HV.basins(members=n, tau_end=req.tau_end or 1e16, progress=_say)
         return rows, HV.format_basins(rows), 0
     if kind == "flows":
-        from . import handover as HV
+        from . import against_brute_force as HV
 
         rows = HV.flows(progress=_say)
         return rows, HV.format_flows(rows), 0 if all(r["within_bound"] for r in rows) else 1
     from . import convergence as CV
 
     if kind == "handover":
-        from . import handover as HV
+        from . import against_brute_force as HV
 
         rows = HV.run(n, req.horizons or HV.HORIZONS, progress=_say)
         _keep(req, rows, "handover_validation")

@@ -26,7 +26,7 @@ import numpy as np
 
 from ...inputs.atlas_spec import Settings, directions
 from ...physics import averaged as AV
-from ...regimes.engine import handover as HO
+from ...regimes.engine import handover_engine as HO
 from ...regimes.engine import runs as RN
 
 HORIZONS = (1e12, 1e14)

@@ -1,4 +1,4 @@
-"""The hand-over engine (spinviz.regimes.engine.handover): its hand-over rule, a case with a
+"""The hand-over engine (spinviz.regimes.engine.handover_engine): its hand-over rule, a case with a
 known answer (chi = 0, where the averaged flow is exact: (5.2), (5.4)), a run's numbers
 independent of its batch, labels from the attractor, the cells that stay in full, the noise
 floor's flag, the store's records, small work in this process; and (slow) labels and end
@@ -14,7 +14,7 @@ from spinviz.inputs.atlas_spec import Settings, directions
 from spinviz.physics import averaged as AV
 from spinviz.physics import closed_forms as CF
 from spinviz.regimes.engine import classify as C
-from spinviz.regimes.engine import handover as HO
+from spinviz.regimes.engine import handover_engine as HO
 from spinviz.regimes.engine import runs as RN
 
 NAMES = {v: k for k, v in C.CODE.items()}
@@ -154,11 +154,11 @@ def test_every_limit_record_is_a_described_store_variable():
     """What a run records about its limit is what the store declares, each with a description;
     the label codes carry the flags."""
     from spinviz.regimes.engine import limit as LM
-    from spinviz.regimes.store import dataset as ST
+    from spinviz.regimes.store import dataset as DS
 
     for name, (dtype, _) in LM.RECORDS.items():
-        assert ST.PER_RUN[name][0] == dtype and len(ST.PER_RUN[name][1]) > 20
-    assert set(LM.RECORDS) <= set(ST.RUN_VARIABLES)
+        assert DS.PER_RUN[name][0] == dtype and len(DS.PER_RUN[name][1]) > 20
+    assert set(LM.RECORDS) <= set(DS.RUN_VARIABLES)
     blank = RN.outputs(batch("reduced", 0.3, 0.7, np.zeros((2, 3)), Settings()))
     assert set(LM.RECORDS) <= set(blank) and np.all(np.isnan(blank["bound"]))
 
@@ -171,18 +171,18 @@ def test_the_store_keeps_each_runs_limit(tmp_path):
     from spinviz.inputs.atlas_spec import parse_spec
     from spinviz.regimes import api
     from spinviz.regimes.engine import limit as LM
-    from spinviz.regimes.store import dataset as ST
+    from spinviz.regimes.store import dataset as DS
 
     doc = json.loads(json.dumps(DOC))
     res = api.atlas(parse_spec(doc, "h.toml"), str(tmp_path / "h.zarr"), progress=False)
     assert "this process" in res.cluster
-    ds = ST.open_atlas(res.path)
+    ds = DS.open_atlas(res.path)
     for name in LM.RECORDS:
-        assert ds[name].attrs["description"] and name in ST.PER_RUN
+        assert ds[name].attrs["description"] and name in DS.PER_RUN
     assert set(ds["limit_label"].values[0, 0].ravel()) == {"1"} and set(ds["limit_label"].values[0, 1].ravel()) == {"3"}
     assert np.all(np.isfinite(ds["tau_handover"].values))
     doc["run"]["engine"] = "taylor"
-    tb = ST.open_atlas(api.atlas(parse_spec(doc, "t.toml"), str(tmp_path / "t.zarr"), progress=False).path)
+    tb = DS.open_atlas(api.atlas(parse_spec(doc, "t.toml"), str(tmp_path / "t.zarr"), progress=False).path)
     assert np.all(np.isnan(tb["tau_handover"].values)) and np.all(tb["method"].values == 0)
     np.testing.assert_array_equal(tb["label_inf"].values, tb["regime"].values)
 
@@ -192,12 +192,12 @@ def test_in_process_and_on_a_cluster_the_same_numbers(tmp_path):
     """The small atlas computed in this process and on a LocalCluster: the same numbers."""
     from spinviz.inputs.atlas_spec import parse_spec
     from spinviz.regimes import api
-    from spinviz.regimes.store import dataset as ST
+    from spinviz.regimes.store import dataset as DS
 
     here = api.atlas(parse_spec(DOC, "h.toml"), str(tmp_path / "h.zarr"), progress=False)
     there = api.atlas(parse_spec(DOC, "h.toml"), str(tmp_path / "c.zarr"), workers=1, processes=False, progress=False)
     assert "this process" in here.cluster and "LocalCluster" in there.cluster
-    a, b = ST.open_atlas(here.path), ST.open_atlas(there.path)
+    a, b = DS.open_atlas(here.path), DS.open_atlas(there.path)
     for name in ("regime", "omega_final", "abar_end", "label_inf", "bound", "evidence"):
         np.testing.assert_array_equal(a[name].values, b[name].values)
 

@@ -417,7 +417,7 @@ def test_dimensionless_atlas_runs_match_physical_unit_simulate(name, model, delt
     heyoka's batch mode, against spinviz.simulate on a CGS body with the same delta, chi and
     tau0 = 1e-20 s (Omega0 ~ 1e19 rad/s), the general (2.2)+(2.3) or (2.5), mapped through
     (4.1): every sample within 1e-7 relative to tau = 1e6 (both at rtol 1e-10; measured <= 3e-9
-    to tau = 1e8, spinviz atlas --evidence physical)."""
+    to tau = 1e8, spinviz atlas evidence physical)."""
     from spinviz.validation.atlas import physical as PC
 
     rows = PC.compare([(name, model, delta, chi_deg)], members=2, tau_end=1e6)

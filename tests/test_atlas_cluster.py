@@ -17,8 +17,9 @@ import pytest
 from atlasdata import SPEC, VARIABLES
 
 from spinviz.errors import UsageError
+from spinviz.executors import cluster
 from spinviz.inputs.atlas_spec import load_spec
-from spinviz.regimes import api, cluster
+from spinviz.regimes import api
 from spinviz.regimes.store import dataset as DS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -179,7 +180,7 @@ def test_unreachable_scheduler_exit_2_nothing_written(spec_path, tmp_path, monke
 @pytest.mark.slow
 def test_sigterm_stops_cleanly_and_resume_completes(spec_path, reference, tmp_path):
     """The command in a subprocess, stopped by SIGTERM once the first chunk is on disk:
-    exit 143, a one-line note, the cluster gone; the same command then completes the DS."""
+    exit 143, a one-line note, the cluster gone; the same command then completes the store."""
     out = tmp_path / "t.zarr"
     spec = load_spec(spec_path)
     slow = tmp_path / "slow.toml"

@@ -1,4 +1,4 @@
-"""``spinviz atlas --evidence KIND``: the options each kind takes, the tolerance study's
+"""``spinviz atlas evidence KIND``: the options each kind takes, the tolerance study's
 invariants, and the convergence rows kept in an atlas store that stays verifiable."""
 
 import json
@@ -27,19 +27,19 @@ tau_end = 1e6
 
 
 @pytest.mark.parametrize("kind, options, error, message", [
-    ("crosscheck", {"tau_end": 1e8}, SpecError, "tau_end: not used by --evidence crosscheck (it takes members)"),
-    ("tolerance", {"out": "x.zarr"}, SpecError, "out: not used by --evidence tolerance"),
-    ("validate", {"horizons": (1e10, 1e12)}, SpecError, "horizons: not used by --evidence validate"),
+    ("crosscheck", {"tau_end": 1e8}, SpecError, "tau_end: not used by evidence crosscheck (it takes members)"),
+    ("tolerance", {"out": "x.zarr"}, SpecError, "out: not used by evidence tolerance"),
+    ("validate", {"horizons": (1e10, 1e12)}, SpecError, "horizons: not used by evidence validate"),
     ("convergence", {"horizons": (1e12, 1e10)}, SpecError, "horizons: must increase"),
     ("convergence", {"horizons": "1e10,x"}, SpecTypeError, "horizons: must be a list of horizons tau"),
     ("convergence", {"horizons": (1e10, 1e300)}, SpecError, "horizons: each must lie in [100000, 1e+20]"),
-    ("handover", {"horizons": (1e12, 1e18)}, SpecError, "horizons: each must be at most 1e+16 for handover"),
-    ("handover", {"workers": 2}, SpecError, "workers: not used by --evidence handover"),
+    ("handover", {"horizons": (1e12, 1e18)}, SpecError, "horizons: each must lie in [100000, 1e+16]"),
+    ("handover", {"workers": 2}, SpecError, "workers: not used by evidence handover"),
     ("basins", {"tau_end": float("inf")}, SpecError, "tau_end: must be finite"),
     ("physical", {"tau_end": 0.0}, SpecError, "tau_end: must lie in [100000, 1e+16]"),
     ("physical", {"tau_end": float("nan")}, SpecError, "tau_end: must be finite"),
     ("convergence", {"out": "/nonexistent/a.zarr"}, UsageError, "--out /nonexistent/a.zarr: not an atlas store"),
-    ("nonsense", {}, UsageError, "--evidence: nonsense is not one of validate, crosscheck, physical, convergence, "
+    ("nonsense", {}, UsageError, "evidence: nonsense is not one of validate, crosscheck, physical, convergence, "
                                  "tolerance, handover, basins, flows"),
 ])
 def test_options_a_kind_does_not_take_are_refused_before_work(kind, options, error, message, monkeypatch):
@@ -48,6 +48,26 @@ def test_options_a_kind_does_not_take_are_refused_before_work(kind, options, err
     with pytest.raises(error) as e:
         evidence.run(kind, 1, **options)
     assert message in str(e.value)
+
+
+@pytest.mark.parametrize("kind", sorted(evidence.KINDS))
+def test_each_kind_is_a_sub_command_with_exactly_its_options(kind, capsys):
+    """``spinviz atlas evidence KIND --help`` lists --members, the options the registry says the
+    kind takes and --json, nothing else; an option it does not take is refused by the parser."""
+    from spinviz.commands import main
+
+    with pytest.raises(SystemExit) as e:
+        main(["atlas", "evidence", kind, "--help"])
+    assert e.value.code == 0
+    text = capsys.readouterr().out
+    flags = {w.rstrip(",") for w in text.split() if w.startswith("--")}
+    taken = {"--" + o.replace("_", "-") for o in evidence.KINDS[kind].options}
+    assert flags == {"--help", "--members", "--json"} | taken
+    missing = sorted({"--tau-end", "--horizons", "--workers", "--out"} - taken)
+    if missing:
+        with pytest.raises(SystemExit) as e:
+            main(["atlas", "evidence", kind, missing[0], "1"])
+        assert e.value.code == 2 and f"unrecognized arguments: {missing[0]}" in capsys.readouterr().err
 
 
 def test_tolerance_rows_against_the_tightest_rtol():

@@ -82,7 +82,7 @@ def copy_store(reference, tmp_path) -> Path:
 
 
 def verify(path, capsys):
-    rc = cli_main(["atlas", "--verify", str(path)])
+    rc = cli_main(["atlas", "verify", str(path)])
     return rc, capsys.readouterr().out.splitlines()
 
 
@@ -171,7 +171,7 @@ def test_verify_a_clean_store(reference, capsys):
 
 
 def test_verify_refuses_what_is_not_a_store(tmp_path, capsys):
-    assert cli_main(["atlas", "--verify", str(tmp_path / "nothing.zarr")]) == 2
+    assert cli_main(["atlas", "verify", str(tmp_path / "nothing.zarr")]) == 2
     assert capsys.readouterr().err.strip() == (f"spinviz: error: --verify {tmp_path / 'nothing.zarr'}: not an atlas "
                                                f"store (no such directory, or no .zgroup in it)")
 
@@ -495,7 +495,7 @@ def test_task_error_that_never_reaches_the_client(spec_path, reference, tmp_path
     """A task whose error report distributed cannot read on the client (a RecursionError: its
     deep traceback fails distributed's check, and the future would stay pending forever):
     after ``STALL_S`` without a result (here 1 s) the scheduler's log is asked, the task
-    counted as failed, the others computed; exit status 1; the same call completes the DS."""
+    counted as failed, the others computed; exit status 1; the same call completes the store."""
     monkeypatch.setattr(atlas_cluster, "STALL_S", 1.0)
     deep = tmp_path / "deep.py"
     deep.write_text(DEEP)

@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 
 from spinviz import commands
 from spinviz.commands import shared
+from spinviz.validation.atlas.evidence import KINDS
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = str(ROOT / "scenes" / "dast_cube.toml")
@@ -24,7 +25,7 @@ BASE = {                         # a valid invocation of each command, before th
     "check": [], "info": ["dast_cube"], "simulate": [SCENE, "--out", "t.npz"], "render": [SCENE],
     "compare": [SCENE], "observe": [SCENE], "decide": [SCENE], "listen": [SCENE, "--out", "s.wav"], "bench": [],
     "stress": [],
-    "report": [], "methods": [], "atlas": ["SPEC"],
+    "report": [], "methods": [], "atlas run": ["SPEC"], "atlas verify": ["nothing.zarr"], "atlas bench": ["SPEC"],
 }
 STATUSES = {0, 1, 2, 75}         # success, a failed run, bad input, a busy store or lost cluster
 NUMBER_TYPES = {shared.whole, shared.real, shared.positive}
@@ -71,11 +72,20 @@ def world(monkeypatch, tmp_path, small_atlas_spec):
 
 
 def parser_actions() -> dict:
-    """command -> [argparse actions with an option string], from ``commands.parser()``."""
-    top = commands.parser()
-    sub = next(a for a in top._actions if isinstance(a, argparse._SubParsersAction))
-    return {name: [a for a in p._actions if a.option_strings and not isinstance(a, argparse._HelpAction)]
-            for name, p in sub.choices.items()}
+    """command path ("atlas evidence basins") -> [argparse actions with an option string], from
+    ``commands.parser()``, every nested sub-command walked to its leaves."""
+    out = {}
+
+    def walk(p, path):
+        sub = next((a for a in p._actions if isinstance(a, argparse._SubParsersAction)), None)
+        if sub is None:
+            out[" ".join(path)] = [a for a in p._actions if a.option_strings and not isinstance(a, argparse._HelpAction)]
+            return
+        for name, q in sub.choices.items():
+            walk(q, [*path, name])
+
+    walk(commands.parser(), [])
+    return out
 
 
 ACTIONS = parser_actions()
@@ -121,14 +131,11 @@ def one_line_or_none(code, err) -> None:
 def test_no_option_takes_a_non_finite_or_astronomical_number(world, capsys, command, option):
     """Every numeric option of every command, each value no option can take: exit 2, one line
     naming the option, and the work never reached.  (A context flag is added where the option
-    needs one: --sweep, --evidence, --process.)"""
-    context = {"--seeds": ["--sweep"], "--runs": ["--sweep"], "--members": ["--evidence", "validate"],
-               "--tau-end": ["--evidence", "physical"], "--frames": ["--bench"]}.get(option, [])
-    base = [world if x == "SPEC" else x for x in BASE[command]]
-    if command == "atlas" and context:
-        base = []
+    needs one: --sweep, --bench.)"""
+    context = {"--seeds": ["--sweep"], "--runs": ["--sweep"], "--frames": ["--bench"]}.get(option, [])
+    base = [world if x == "SPEC" else x for x in BASE.get(command, [])]
     for value in MUST_REFUSE:
-        code, err = run([command, *base, *context, option, value], capsys)
+        code, err = run([*command.split(), *base, *context, option, value], capsys)
         assert code == 2, (command, option, value, code, err)
         one_line_or_none(code, err)
         assert option in err, (option, value, err)
@@ -136,8 +143,9 @@ def test_no_option_takes_a_non_finite_or_astronomical_number(world, capsys, comm
 
 def test_every_command_and_numeric_option_is_covered():
     """The walk found the options (a parser change that hid them from it would show here)."""
-    assert {c for c, _ in NUMERIC} >= {"check", "render", "observe", "listen", "bench", "atlas", "compare"}
-    assert ("atlas", "--tau-end") in NUMERIC and ("bench", "--repeats") in NUMERIC
+    assert {c.split()[0] for c, _ in NUMERIC} >= {"check", "render", "observe", "listen", "bench", "atlas", "compare"}
+    assert ("atlas evidence physical", "--tau-end") in NUMERIC and ("bench", "--repeats") in NUMERIC
+    assert {c for c in ACTIONS if c.startswith("atlas evidence ")} == {f"atlas evidence {k}" for k in KINDS}
 
 
 @pytest.mark.parametrize("command", sorted(ACTIONS))
@@ -147,7 +155,7 @@ def test_every_command_and_numeric_option_is_covered():
 def test_any_options_get_acceptance_or_one_line(world, capsys, command, data):
     """Up to four options of a command at once, each with a hostile value its type suggests."""
     acts = ACTIONS[command]
-    argv = [command] + [world if x == "SPEC" else x for x in BASE[command]]
+    argv = command.split() + [world if x == "SPEC" else x for x in BASE.get(command, [])]
     if acts:
         chosen = data.draw(st.lists(st.sampled_from(acts), max_size=4, unique_by=lambda a: a.dest))
         for a in chosen:
@@ -162,11 +170,11 @@ def test_any_options_get_acceptance_or_one_line(world, capsys, command, data):
 
 
 FOUND = [   # combinations a long hunt (HYPOTHESIS_PROFILE=fuzz) turns up, checked in every run
-    (["atlas", "SPEC", "--workers", "1" + "0" * 40, "--bench"], "--workers: must be at most"),
+    (["atlas", "bench", "SPEC", "--workers", "1" + "0" * 40], "--workers: must be at most"),
     (["render", SCENE, "--duration", "nan", "--bench"], "--duration: must be finite, got nan"),
     (["render", SCENE, "--bench", "--frames", "1" + "0" * 40], "--frames: must lie in [2, "),
-    (["atlas", "SPEC", "--bench", "--write-path", "--workers", "1" + "0" * 40], "--workers: not used by --bench "
-                                                                                  "--write-path"),
+    (["atlas", "bench", "SPEC", "--write-path", "--workers", "1" + "0" * 40], "--workers: not used by bench "
+                                                                                 "--write-path"),
 ]
 
 

@@ -135,7 +135,7 @@ def test_verify_names_a_special_file_planted_in_the_store(store, tmp_path, capsy
     rc = {}
 
     def run():
-        rc["code"] = main(["atlas", "--verify", str(s)])
+        rc["code"] = main(["atlas", "verify", str(s)])
         raise RuntimeError("done")
 
     at_once(run, target)

@@ -55,7 +55,7 @@ def counts(atlas) -> tuple[int, int, int]:
 
 
 def verify(path, capsys):
-    code = main(["atlas", "--verify", str(path)])
+    code = main(["atlas", "verify", str(path)])
     return code, capsys.readouterr().out.strip().splitlines()
 
 
@@ -223,7 +223,7 @@ def test_a_second_command_on_a_store_being_written_is_refused_at_once(refined_at
         err = capsys.readouterr().err.strip()
         assert err == (f"spinviz: error: {copy}: another spinviz (pid {os.getpid()}) is using this store; this atlas "
                        f"command refused (never two at once): run it again when that command has finished")
-        assert main(["atlas", "--verify", str(copy)]) == 75
+        assert main(["atlas", "verify", str(copy)]) == 75
         assert "is writing this store; --verify refused" in capsys.readouterr().err
         with pytest.raises(StoreBusy):
             resume(refined_atlas, copy)
@@ -292,7 +292,7 @@ def test_a_kill_during_creation_leaves_what_the_next_command_removes(refined_atl
     left = [p.name for p in where.iterdir() if p.name.endswith(".partial")]
     assert len(left) == 1 and left[0].startswith(".s.zarr." if creation == 1 else ".level1."), left
     if creation == 1:
-        assert main(["atlas", "--verify", str(out)]) == 2
+        assert main(["atlas", "verify", str(out)]) == 2
         assert f"{tmp_path / left[0]} is what an interrupted creation left" in capsys.readouterr().err
     else:
         code, lines = verify(out, capsys)

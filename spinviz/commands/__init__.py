@@ -3,8 +3,9 @@ module per subcommand and maps errors to exit statuses (0 success, 1 a check or 
 2 bad input, 128 + the signal when stopped).  No physics and no file formats here.
 
 Each subcommand is a module of this package with ``add_parser(subparsers)`` (its options,
-declared once) and ``run(args) -> int``; ``COMMANDS`` lists them in the order ``--help``
-shows.  Options are parsed here and checked by the schema (``spinviz.inputs``), so the
+declared once), ``run(args) -> int`` and, where it has one, ``shorthand(argv) -> argv`` (how
+its own arguments are spelt shorter: ``atlas SPEC`` for ``atlas run SPEC``); ``COMMANDS``
+lists them in the order ``--help`` shows.  Options are parsed here and checked by the schema (``spinviz.inputs``), so the
 command line and Python never disagree; a schema error naming an argument is shown with the
 option that set it, its name read from the parser (``--workers: ...``), or with the scene's
 key when the value came from the file (``shared.named``: the one translation).  Standard
@@ -57,8 +58,14 @@ def main(argv: list[str] | None = None) -> int:
     into the command); ``entry`` is the console script around it.
     """
     top = parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv and argv[0] in COMMANDS and hasattr(command(argv[0]), "shorthand"):
+        try:
+            argv = [argv[0], *command(argv[0]).shorthand(argv[1:])]
+        except UsageError as e:
+            top.error(str(e))
     args = top.parse_args(argv)
-    args.options = options_of(_subparser(top, args.command))
+    args.options = options_of(_subparser(top, args))
     out, err = sys.stdout, sys.stderr
     sys.stdout, sys.stderr = Stream(out, pipe_ends=True), Stream(err, pipe_ends=False)
     try:
@@ -92,9 +99,14 @@ def ended(code: int) -> int:
     return 128 + late
 
 
-def _subparser(top: argparse.ArgumentParser, name: str) -> argparse.ArgumentParser:
-    sub = next(a for a in top._actions if isinstance(a, argparse._SubParsersAction))
-    return sub.choices[name]
+def _subparser(top: argparse.ArgumentParser, args) -> argparse.ArgumentParser:
+    """The parser that read the innermost sub-command of ``args`` (``atlas evidence KIND``'s)."""
+    p = top
+    while True:
+        sub = next((a for a in p._actions if isinstance(a, argparse._SubParsersAction)), None)
+        if sub is None:
+            return p
+        p = sub.choices[getattr(args, sub.dest)]
 
 
 def _run(args) -> int:

@@ -1,11 +1,12 @@
-"""``spinviz atlas SPEC.toml [--out PATH] [--scheduler ADDRESS] [--workers N] [--plot PATH]``,
-``spinviz atlas --verify STORE``, ``spinviz atlas SPEC --bench [--write-path]`` and
-``spinviz atlas --evidence KIND``.
+"""``spinviz atlas run SPEC``, ``spinviz atlas verify STORE``, ``spinviz atlas bench SPEC`` and
+``spinviz atlas evidence KIND``: the regime atlas's four jobs, one sub-command each with
+exactly its own options.  ``spinviz atlas SPEC`` (a spec where the job's name would be) is
+``spinviz atlas run SPEC``.
 
 Exit statuses of its own: 75 when the cluster failed and runs were not computed (sysexits'
 EX_TEMPFAIL: the same command resumes) or when another command holds the store's lock (the
 same command works once that one has finished), 1 when tasks failed as a whole, 128 + the
-signal after a stop; for ``--verify``, 0 (the whole atlas its spec implies, every chunk
+signal after a stop; for ``verify``, 0 (the whole atlas its spec implies, every chunk
 matching its checksums) or 1 (damaged, incomplete, a level missing or foreign), 2 (not an
 atlas store).
 """
@@ -18,90 +19,111 @@ import sys
 
 from ..errors import UsageError, printable
 from ..interrupt import check
-from .shared import positive, real, reals
+from .shared import Parser, positive, real, reals
 
-EVIDENCE = ("validate", "crosscheck", "physical", "convergence", "tolerance", "handover", "basins", "flows")
+JOBS = ("run", "verify", "bench", "evidence")
+# what each evidence option is, for the sub-command of a kind that takes it
+_EVIDENCE_OPTIONS = {
+    "workers": ("--workers", positive, None, "worker processes (default: one per core)"),
+    "tau_end": ("--tau-end", real, None, "the horizon tau"),
+    "horizons": ("--horizons", reals, "LIST", "the horizons tau, increasing, comma-separated"),
+    "out": ("--out", str, "STORE", "keep the rows in this atlas store"),
+}
+
+
+def shorthand(argv: list[str]) -> list[str]:
+    """``atlas SPEC ...`` is ``atlas run SPEC ...``; the job names and --help pass as they are."""
+    if argv and argv[0] not in JOBS and not argv[0].startswith("-"):
+        return ["run", *argv]
+    if argv and argv[0] in ("--verify", "--evidence", "--bench"):
+        raise UsageError(f"{argv[0]}: a job of its own: spinviz atlas {argv[0][2:]} ... (see 'spinviz atlas --help')")
+    return argv
 
 
 def add_parser(sub) -> None:
-    """Add ``spinviz atlas`` (the regime atlas, its --verify, --bench and --evidence) and its options to ``sub``."""
+    """Add ``spinviz atlas`` and its four jobs (run, verify, bench, evidence KIND) to ``sub``."""
     a = sub.add_parser(
         "atlas", help="regime atlas: which asymptotic type each (delta, chi) ends in, from ensembles of runs on Dask",
-        description="Integrate the Euler equation (no orientation) for every cell and member of an atlas spec, "
-                    "classify each run into the paper's asymptotic types, and write an xarray Dataset to a Zarr "
-                    "store, resumably.")
-    a.add_argument("spec", nargs="?", help="the atlas spec (TOML)")
-    a.add_argument("--out", help="the Zarr store (a directory; default <spec stem>.zarr); an existing store of the "
+        description="The regime atlas: run (integrate and classify every cell of a spec into a resumable Zarr "
+                    "store), verify (check a store against its spec and checksums), bench (measure it), evidence "
+                    "KIND (the checks it rests on).  'spinviz atlas SPEC' is 'spinviz atlas run SPEC'.")
+    jobs = a.add_subparsers(dest="job", metavar="JOB", parser_class=Parser)
+    jobs.required = True
+    r = jobs.add_parser("run", help="integrate and classify every cell and member of a spec into a Zarr store, "
+                                    "resumably (the embedded cluster or --scheduler)")
+    r.add_argument("spec", help="the atlas spec (TOML)")
+    r.add_argument("--out", help="the Zarr store (a directory; default <spec stem>.zarr); an existing store of the "
                                  "same spec is completed, one of another spec refused")
-    a.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing Dask cluster (tcp://HOST:8786) instead "
+    r.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing Dask cluster (tcp://HOST:8786) instead "
                                                           "of the embedded LocalCluster")
-    a.add_argument("--workers", type=positive, help="worker processes of the embedded LocalCluster (default: one per core)")
-    a.add_argument("--plot", metavar="PATH", help="also draw the delta-chi diagram (PNG, every refinement level), "
+    r.add_argument("--workers", type=positive, help="worker processes of the embedded LocalCluster (default: one per core)")
+    r.add_argument("--plot", metavar="PATH", help="also draw the delta-chi diagram (PNG, every refinement level), "
                    "PATH_hodographs.png and the interactive page PATH.html")
-    a.add_argument("--runs-per-task", type=positive, default=None, help="runs per Dask task (default 32)")
-    a.add_argument("--retry-failed", action="store_true", help="also recompute the runs the store records as failed")
-    a.add_argument("--json", action="store_true", help="print the summary as JSON")
-    a.add_argument("--quiet", action="store_true", help="no progress bar")
-    a.add_argument("--verify", metavar="STORE", help="instead: check every chunk of an atlas store against its "
-                                                     "checksums and say, per variable, whether it is intact "
-                                                     "(exit status 0) or damaged (1)")
-    a.add_argument("--bench", action="store_true",
-                   help="instead: measure runs per second on 1 and 2 workers, the scheduling overhead and the memory "
-                        "per worker on this spec (temporary stores), and project a 64 x 64 x 32 atlas")
-    a.add_argument("--peer", metavar="SCRIPT",
-                   help="with --bench, on a one-cell spec: the whole command against the standalone heyoka script "
-                        "SCRIPT (benchmarks/peer_heyoka_atlas.py) as a whole process, 256 starts to tau 1e10, 1e12, "
-                        "1e14 and the spec's starts to 1e10, with the end states compared")
-    a.add_argument("--write-path", action="store_true",
-                   help="with --bench: only the store's write path at the spec's size (chunk writes, checksums, "
-                        "verification; no runs)")
-    ev = a.add_argument_group("evidence (instead of an atlas; no spec: the points are built in)")
-    ev.add_argument("--evidence", metavar="KIND", choices=EVIDENCE,
-                    help="validate (every domain against the paper's formulas), crosscheck (the disputed points with "
-                         "SciPy), physical (against physical-unit simulate runs), convergence (horizon x 100, x 1e4 "
-                         "and 4x members; --out STORE keeps the rows in that atlas), tolerance (labels against rtol), handover "
-                         "(the hand-over engine against brute force at 1e12 and 1e14; --out STORE keeps the rows), basins (the "
-                         "4|5 band: shares ending in 4 and 5 against beta), flows (the averaged flows against full "
-                         "integration: error, bound, order in mu)")
-    ev.add_argument("--members", type=positive, help="starts per point (default: validate 32, crosscheck 3, physical 4, "
-                                                     "convergence 32, tolerance 8, handover 16, basins 32)")
-    ev.add_argument("--tau-end", type=real, help="physical: the horizon (default 1e10); basins: (default 1e16)")
-    ev.add_argument("--horizons", metavar="LIST", type=reals, help="convergence: the horizons (default "
-                                                                   "1e10,1e12,1e14,1e16,1e20); handover: (default 1e12,1e14)")
+    r.add_argument("--runs-per-task", type=positive, default=None, help="runs per Dask task (default 32)")
+    r.add_argument("--retry-failed", action="store_true", help="also recompute the runs the store records as failed")
+    r.add_argument("--json", action="store_true", help="print the summary as JSON")
+    r.add_argument("--quiet", action="store_true", help="no progress bar")
+    v = jobs.add_parser("verify", help="check every level a store's spec implies: present, whole (every chunk "
+                                       "against its checksum) and of this spec")
+    v.add_argument("store", help="the atlas store (a directory)")
+    v.add_argument("--json", action="store_true", help="print the report as JSON")
+    b = jobs.add_parser("bench", help="measure runs per second on 1 and 2 workers, the scheduling overhead and the "
+                                      "memory per worker on a spec (temporary stores), and project a 64 x 64 x 32 atlas")
+    b.add_argument("spec", help="the atlas spec (TOML)")
+    how = b.add_mutually_exclusive_group()
+    how.add_argument("--peer", metavar="SCRIPT",
+                     help="on a one-cell spec: the whole command against the standalone heyoka script SCRIPT "
+                          "(benchmarks/peer_heyoka_atlas.py) as a whole process, 256 starts to tau 1e10, 1e12, 1e14 and "
+                          "the spec's starts to 1e10, with the end states compared")
+    how.add_argument("--write-path", action="store_true",
+                     help="only the store's write path at the spec's size (chunk writes, checksums, verification; no "
+                          "runs)")
+    b.add_argument("--workers", type=positive, help="the second measurement's workers (default 2)")
+    b.add_argument("--json", action="store_true", help="print the rows as JSON")
+    b.add_argument("--quiet", action="store_true", help="no progress bar")
+    _add_evidence(jobs)
+
+
+def _add_evidence(jobs) -> None:
+    """``atlas evidence KIND``: one sub-command per registered kind, with the options it takes."""
+    from ..validation.atlas.evidence import KINDS
+
+    e = jobs.add_parser("evidence", help="the checks the atlas rests on: " + ", ".join(KINDS))
+    kinds = e.add_subparsers(dest="kind", metavar="KIND", parser_class=Parser)
+    kinds.required = True
+    for k in KINDS.values():
+        p = kinds.add_parser(k.name, help=k.summary, description=k.summary)
+        p.add_argument("--members", type=positive, help=f"starts per point (default {k.members})")
+        for key in k.options:
+            flag, kind, metavar, text = _EVIDENCE_OPTIONS[key]
+            default = {"tau_end": k.tau_end, "horizons": k.horizons}.get(key)
+            text = f"{text} (default {', '.join(f'{x:g}' for x in default)})" if isinstance(default, tuple) else (
+                f"{text} (default {default:g})" if default is not None else text)
+            p.add_argument(flag, dest=key, type=kind, metavar=metavar, help=text)
+        p.add_argument("--json", action="store_true", help="print the rows as JSON")
 
 
 def run(args) -> int:
-    """Carry out ``spinviz atlas`` with the parsed ``args``; return its exit status."""
-    from ..regimes.api import RUNS_PER_TASK, atlas
-    from ..regimes.faults import AtlasIncomplete
-
-    if args.verify is not None:
-        if args.spec is not None or args.out or args.scheduler or args.plot or args.bench:
-            raise UsageError("--verify: checks a store on its own; give no spec and no other option")
-        return verify(args.verify, as_json=args.json)
-    evidence_only = (args.members, args.tau_end, args.horizons)
-    if args.evidence is not None:
+    """Carry out ``spinviz atlas JOB`` with the parsed ``args``; return its exit status."""
+    if args.job == "verify":
+        return verify(args.store, as_json=args.json)
+    if args.job == "evidence":
         from ..validation.atlas import evidence
 
-        if args.spec is not None or args.scheduler or args.plot or args.bench or args.retry_failed:
-            raise UsageError("--evidence: runs its own points; give no spec, --scheduler, --plot, --bench or "
-                             "--retry-failed")
-        return evidence.run(args.evidence, args.members, workers=args.workers, tau_end=args.tau_end,
-                            horizons=args.horizons, out=args.out, as_json=args.json)
-    if any(v is not None for v in evidence_only):
-        raise UsageError("--members, --tau-end and --horizons go with --evidence")
-    if args.write_path and not args.bench:
-        raise UsageError("--write-path goes with --bench")
-    if args.peer is not None and not args.bench:
-        raise UsageError("--peer goes with --bench")
-    if args.spec is None:
-        raise UsageError("atlas: the spec is missing (spinviz atlas SPEC.toml, spinviz atlas --verify STORE, or "
-                         "spinviz atlas --evidence KIND)")
+        given = {k: getattr(args, k, None) for k in _EVIDENCE_OPTIONS}
+        return evidence.run(args.kind, args.members, as_json=args.json, **given)
     from ..inputs.atlas_spec import load_spec
 
     spec = load_spec(args.spec)                       # SceneError: file, key, reason
-    if args.bench:
+    if args.job == "bench":
         return _bench(spec, args)
+    return _run(spec, args)
+
+
+def _run(spec, args) -> int:
+    from ..regimes.api import RUNS_PER_TASK, atlas
+    from ..regimes.faults import AtlasIncomplete
+
     try:
         res = atlas(spec, args.out, scheduler=args.scheduler, workers=args.workers, plot=args.plot,
                     progress=not args.quiet, runs_per_task=args.runs_per_task or RUNS_PER_TASK,
@@ -130,7 +152,7 @@ def stopped(args, signal_name) -> str:
     chunks are on disk and the same command completes the store -- that is the point."""
     from ..inputs.atlas_spec import default_out
 
-    if args.verify is not None or args.evidence is not None or args.bench or args.spec is None:
+    if args.job != "run":
         return f"interrupted by {signal_name}; nothing was written"
     out = args.out or default_out(args.spec)
     if not os.path.isdir(out):
@@ -142,16 +164,7 @@ def stopped(args, signal_name) -> str:
 def _bench(spec, args) -> int:
     from ..regimes import bench
 
-    if args.out or args.scheduler or args.plot:
-        raise UsageError("--bench: measures on temporary stores and the embedded cluster; drop --out, --scheduler "
-                         "and --plot")
-    unused = [o for o, v in (("--runs-per-task", args.runs_per_task), ("--retry-failed", args.retry_failed),
-                             ("--workers", args.workers if args.write_path else None)) if v]
-    if unused:                                        # never ignored in silence
-        raise UsageError(f"{unused[0]}: not used by --bench{' --write-path' if args.write_path else ''}")
     if args.peer is not None:
-        import os
-
         if not os.path.isfile(args.peer):
             raise UsageError(f"--peer: {printable(args.peer, 200)}: no such file")
         rows = bench.against_peer(spec, args.peer, progress=None if args.quiet else
@@ -159,6 +172,8 @@ def _bench(spec, args) -> int:
         print(bench.format_peer(rows) if not args.json else json.dumps(rows, indent=2, default=float))
         return 0
     if args.write_path:
+        if args.workers is not None:
+            raise UsageError("--workers: not used by bench --write-path")
         rows = bench.store_cost(spec)
         print(bench.format_store_cost(rows) if not args.json else json.dumps(rows, indent=2, default=float))
         return 0
@@ -168,7 +183,7 @@ def _bench(spec, args) -> int:
 
 
 def verify(path: str, as_json: bool = False) -> int:
-    """``--verify STORE``: one line per variable (chunks intact, or the damaged ones named),
+    """``verify STORE``: one line per variable (chunks intact, or the damaged ones named),
     the metadata and the spec, and a verdict, for the store and each refinement level its spec
     implies; 0 if every level the spec implies is present, whole (every file matches its
     checksum, every run computed) and of this spec, 1 if not (what is missing, damaged or
@@ -189,3 +204,4 @@ def verify(path: str, as_json: bool = False) -> int:
                 print(printable(prefix + line, 2000))
         print(printable(r["verdict"], 2000))
     return 0 if r["ok"] else 1
+

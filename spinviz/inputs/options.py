@@ -1,5 +1,5 @@
 """The counts and horizons of the commands that run studies -- ``check --sweep``, ``bench``,
-``bench --process``, ``atlas --evidence KIND`` -- as request classes of the one schema.
+``bench --process``, ``atlas evidence KIND`` -- as request classes of the one schema.
 
 Each field is named as the library function's argument, which is also the command-line
 option's ``dest`` (``--tau-end`` is ``tau_end``), so a value is refused with the same reason
@@ -23,7 +23,7 @@ from typing import Annotated, Any, Literal
 from pydantic import Field, PlainValidator, model_validator
 
 from ..errors import SpecError, brief
-from .base import Flag, Int, Path, Real, between, request, wrong_type
+from .base import Flag, Int, Path, Real, Text, between, request, wrong_type
 
 MAX_DAYS_ENV = "SPINVIZ_MAX_DAYS"
 MAX_DAYS = 30.0                  # default cap on the estimated work of one command, days
@@ -155,37 +155,10 @@ class BenchRequest:
         return self
 
 
-# --- atlas --evidence KIND ------------------------------------------------------------------
-TAU_END_RANGE = (1e5, 1e16)      # below: the classifier's two 2-decade windows and 100 braking times of |omega0|
-#                                  = 0.04 do not fit; above: float64 time steps (the limit of integration in full)
-HANDOVER_TAU_MAX = 1e20          # the hand-over engine's horizons (convergence, basins): where it was measured to hold
+# --- atlas evidence KIND ------------------------------------------------------------------
+TAU_MIN = 1e5                    # below: the classifier's two 2-decade windows and 100 braking times of |omega0| = 0.04
+TAU_MAX = 1e20                   # the hand-over engine's horizons: where it was measured to hold (a kind may ask less)
 MAX_HORIZONS = 8
-# Measured costs at tau = 1e10 (docs/atlas.md), growing as sqrt(tau / 1e10) -- the steps of a spiral:
-ATLAS_S_PER_RUN = 0.096          # a run of a single-cell atlas, cluster and classification included (one core)
-PHYSICAL_S_PER_RUN = 0.094       # an atlas run and its physical-unit simulate run (32 in 3 s)
-CROSSCHECK_S_PER_RUN = 25.0      # a SciPy DOP853 run of (4.2)-(4.4) at rtol 1e-10
-CONVERGENCE_S_PER_RUN = 0.0102   # a run of the study, per unit of sqrt(tau / 1e10) (8 min 46 s at its defaults)
-TOLERANCE_S_PER_RUN = 0.009      # a run of the 12 x 12 grid at one rtol (82 s for 9216)
-# The hand-over engine, one core, rtol 1e-8 (docs/atlas.md, "Horizons"; regimes.engine.cost's model
-# reads these): a handed-over run costs HANDED_S_PER_RUN at any tau, a run kept in full
-# a + b (tau/1e16)^(1/4) s; brute force in the handover kind 0.7 s per start and unit of
-# sqrt(tau/1e10) over its 19 points (1 222 s for 16 starts at 1e12 and 1e14, the machine shared)
-HANDED_S_PER_RUN = 0.002
-ENGINE_S_PER_RUN = (0.002, 0.021)
-HANDOVER_S_PER_START = 0.7
-EVIDENCE_MEMBERS = {"validate": 32, "crosscheck": 3, "physical": 4, "convergence": 32, "tolerance": 8, "handover": 16,
-                    "basins": 32, "flows": 1}
-ACCEPTS = {"validate": {"workers"}, "crosscheck": set(), "physical": {"tau_end"}, "convergence": {"horizons", "out"},
-           "tolerance": set(), "handover": {"horizons", "out"}, "basins": {"tau_end"},
-           "flows": set()}         # what each kind takes on the command line beyond --members
-
-
-def check_accepts(kind: str, given: dict) -> None:
-    """An option ``--evidence KIND`` does not use is refused (``SpecError`` naming it), not ignored."""
-    for key, value in given.items():
-        if value is not None and key not in ACCEPTS.get(kind, set()):
-            raise SpecError(key, f"not used by --evidence {kind} (it takes "
-                                 f"{', '.join(sorted(ACCEPTS[kind] | {'members'}))})")
 
 
 def _horizons(v):
@@ -198,10 +171,6 @@ def _horizons(v):
         x = float(x)
         if not math.isfinite(x):
             raise ValueError(f"must be finite, got {brief(v)}")
-        lo, hi = TAU_END_RANGE[0], HANDOVER_TAU_MAX
-        if not lo <= x <= hi:
-            raise ValueError(f"each must lie in [{lo:g}, {hi:g}] (the classifier's windows and 100 braking times below, "
-                             f"where the hand-over engine was measured to hold above), got {x:g}")
         out.append(x)
     if not 2 <= len(out) <= MAX_HORIZONS:
         raise ValueError(f"give 2 to {MAX_HORIZONS} horizons, got {len(out)}")
@@ -212,16 +181,18 @@ def _horizons(v):
 
 @request
 class EvidenceRequest:
-    """``spinviz atlas --evidence KIND``'s arguments (``validation.atlas.evidence.run``): the
-    kind, the starts per point, and what the kind takes beyond them."""
+    """The arguments of an evidence kind (``validation.atlas.evidence``): the starts per point,
+    the horizon (``tau_end``) or horizons, the worker processes and the store to keep rows in.
+    ``tau_max`` (and ``tau_why``): the kind's own largest horizon, given by its registry entry;
+    a horizon outside [``TAU_MIN``, ``tau_max``] is refused with the kind's reason."""
 
-    kind: Literal["validate", "crosscheck", "physical", "convergence", "tolerance", "handover", "basins", "flows"]
     members: _count(10**9, "starts per point") | None = None
     workers: Annotated[Int, Field(ge=1)] | None = None
-    tau_end: Annotated[Real, between(*TAU_END_RANGE, "the classifier's windows and 100 braking times below, float64 "
-                                                    "time steps of integration in full above")] | None = None
+    tau_end: Real | None = None
     horizons: Annotated[Any, PlainValidator(_horizons)] | None = None
     out: Path = None
+    tau_max: Real = TAU_MAX
+    tau_why: Text = "where the hand-over engine was measured to hold"
 
     @model_validator(mode="after")
     def _check(self):
@@ -231,46 +202,13 @@ class EvidenceRequest:
             cores = usable_cores()
             if self.workers > cores:
                 raise SpecError("workers", f"must be at most {cores}, the cores this process may use, got {self.workers}")
-        if self.kind == "handover" and self.horizons and max(self.horizons) > TAU_END_RANGE[1]:
-            raise SpecError("horizons", f"each must be at most {TAU_END_RANGE[1]:g} for handover (brute force integrates "
-                                        f"in full to each), got {max(self.horizons):g}")
-        n = self.n_members
-        key = "members" if self.members is not None else {"physical": "tau_end", "convergence": "horizons",
-                                                          "handover": "horizons", "basins": "tau_end"}.get(self.kind,
-                                                                                                           "members")
-        check_work(key, self.seconds(), f"--evidence {self.kind} with {n} member(s) per point")
+        why = f"the classifier's windows and 100 braking times below, {self.tau_why} above"
+        if self.tau_end is not None and not TAU_MIN <= self.tau_end <= self.tau_max:
+            raise SpecError("tau_end", f"must lie in [{TAU_MIN:g}, {self.tau_max:g}] ({why}), got {self.tau_end!r}")
+        for x in self.horizons or ():
+            if not TAU_MIN <= x <= self.tau_max:
+                raise SpecError("horizons", f"each must lie in [{TAU_MIN:g}, {self.tau_max:g}] ({why}), got {x!r}")
         return self
-
-    @property
-    def n_members(self) -> int:
-        """The starts per point: as given, or the kind's default."""
-        return self.members if self.members is not None else EVIDENCE_MEMBERS[self.kind]
-
-    def seconds(self) -> float:
-        """The estimated work, s (see the constants: measured at tau = 1e10, growing as sqrt(tau))."""
-        n = self.n_members
-        grows = math.sqrt((self.tau_end or 1e10) / 1e10)
-        if self.kind == "validate":
-            from ..executors.processes import usable_cores
-
-            return 11 * n * ATLAS_S_PER_RUN * grows / (self.workers or usable_cores())
-        if self.kind == "crosscheck":
-            return 6 * n * CROSSCHECK_S_PER_RUN * grows
-        if self.kind == "physical":
-            return 8 * n * PHYSICAL_S_PER_RUN * grows
-        if self.kind == "tolerance":
-            return 144 * n * 2 * 4 * TOLERANCE_S_PER_RUN * grows
-        a, b = ENGINE_S_PER_RUN
-        full = lambda tau: a + b * (tau / 1e16) ** 0.25          # noqa: E731 -- an upper bound: every run in full
-        if self.kind == "basins":
-            return 12 * n * full(self.tau_end or 1e16)
-        if self.kind == "flows":
-            return 60.0                                           # eight starts to 1e10 at tol 1e-15 (measured 25-50 s)
-        if self.kind == "handover":
-            horizons = self.horizons or (1e12, 1e14)
-            return n * HANDOVER_S_PER_START * sum(math.sqrt(h / 1e10) for h in horizons)
-        horizons = self.horizons or (1e10, 1e12, 1e14, 1e16, 1e20)
-        return 15 * n * (sum(full(h) for h in horizons) + 4 * full(horizons[0]))
 
 
 # --- listen ------------------------------------------------------------------------------------

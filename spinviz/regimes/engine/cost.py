@@ -14,7 +14,7 @@ from ...errors import SceneError
 from ...executors.processes import usable_cores
 from ...inputs import atlas as IA
 from ...inputs.atlas_spec import AtlasSpec, Settings
-from ...inputs.options import ENGINE_S_PER_RUN, HANDED_S_PER_RUN, MAX_DAYS_ENV, max_days
+from ...inputs.options import MAX_DAYS_ENV, max_days
 from ...physics.averaged import averaging_holds
 
 # What this process holds for an atlas, measured with tracemalloc around api.plan and the
@@ -25,10 +25,16 @@ BYTES_PER_CELL = 1200            # the paper's predictions at each (delta, chi),
 BYTES_PER_TASK = 1000            # a batch (its chi tuple, omega0 view, region), its key and counters
 BYTES_PER_RUN = 16               # done mask, label codes and their copies
 CPU_S_PER_RUN = 0.010            # engine "taylor": a run to tau_end = 1e10, growing as sqrt(tau_end) (a spiral's steps)
-CPU_S_HANDED = HANDED_S_PER_RUN  # engine "handover", a cell where the averaged flow holds: the same at any tau_end
-CPU_S_FULL = ENGINE_S_PER_RUN    # engine "handover", a cell integrated in full (5, 4|5, "?"): a + b (tau_end/1e16)^(1/4)
+CPU_S_HANDED = 0.002             # engine "handover", a cell where the averaged flow holds: the same at any tau_end
+CPU_S_FULL = (0.002, 0.021)      # engine "handover", a cell integrated in full (5, 4|5, "?"): a + b (tau_end/1e16)^(1/4)
 SAMPLED_AXIS = 64               # cells per axis of the subgrid a large grid's CPU time is estimated on
 MEMORY_SHARE = 0.5               # of physical memory, for this process (the workers need the rest)
+
+
+def full_run_s(tau_end: float) -> float:
+    """The CPU seconds of a hand-over engine run kept in full to ``tau_end`` (``CPU_S_FULL``)."""
+    a, b = CPU_S_FULL
+    return a + b * (tau_end / 1e16) ** 0.25
 
 
 def run_cost_s(settings: Settings, model: str, delta: float, chi: float) -> float:
@@ -41,7 +47,7 @@ def run_cost_s(settings: Settings, model: str, delta: float, chi: float) -> floa
     if settings.engine == "taylor":
         return CPU_S_PER_RUN * math.sqrt(te / 1e10)
     handed = CPU_S_HANDED * min(1.0, math.sqrt(te / 1e8))
-    full = CPU_S_FULL[0] + CPU_S_FULL[1] * (te / 1e16) ** 0.25
+    full = full_run_s(te)
     return handed if averaging_holds(model, float(delta), float(chi))[0] else full
 
 

@@ -3,7 +3,7 @@
 A second ``spinviz atlas`` on a store that another is writing would interleave chunk writes
 and checksum records, and ``--verify`` during a write would report chunks in the middle of
 their write as damaged.  So every command that writes a store (the atlas, its resume,
-``--evidence convergence --out``) takes an exclusive lock first, ``--verify`` a shared one,
+``evidence convergence --out``) takes an exclusive lock first, ``--verify`` a shared one,
 and a command that cannot have its lock at once is refused with one line (``StoreBusy``):
 it never waits, never interleaves.
 

@@ -1,4 +1,4 @@
-"""``spinviz atlas --verify STORE``: is the store the whole atlas its own spec implies?
+"""``spinviz atlas verify STORE``: is the store the whole atlas its own spec implies?
 
 A store is judged from its spec, not from what happens to be on disk.  The spec it records
 (attributes ``spec``, ``grid_axes``; checked against its ``spec_sha256``) says which levels

@@ -1,7 +1,7 @@
 """The hand-over engine against brute force: the same starts at the validation points, run by
 the engine and by brute-force Taylor integration to each horizon.
 
-    spinviz atlas --evidence handover [--members 16] [--horizons 1e12,1e14] [--out STORE] [--json]
+    spinviz atlas evidence handover [--members 16] [--horizons 1e12,1e14] [--out STORE] [--json]
 
 Per point and horizon: the labels of both (same class -- an "approaching X" counted as X --,
 compatible -- a mixture "1|2" or "4|5" against one of its types -- or different), and for

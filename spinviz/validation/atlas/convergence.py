@@ -1,7 +1,7 @@
 """Convergence evidence for the atlas's labels: horizon, member count and tolerance.
 
-    spinviz atlas --evidence convergence [--members 32] [--horizons 1e10,1e12,1e14,1e16,1e20] [--out STORE] [--json]
-    spinviz atlas --evidence tolerance [--members 8]
+    spinviz atlas evidence convergence [--members 32] [--horizons 1e10,1e12,1e14,1e16,1e20] [--out STORE] [--json]
+    spinviz atlas evidence tolerance [--members 8]
 
 For a validation subset -- the points of ``validate.POINTS`` (every domain of figure 2 and
 the truncated types) and the four points where the paper is disputed -- each point's starts
@@ -67,10 +67,11 @@ def run_point(model: str, delta: float, chi: float, starts: np.ndarray, horizon:
 
 def study(members: int = 32, horizons=HORIZONS, rtol: float = 1e-10, seed: int = 1, progress=None) -> list[dict]:
     """Per point: labels per horizon and with 4x members (see the module docstring).
-    ``members`` and ``horizons`` are checked first (``inputs.options.EvidenceRequest``)."""
+    ``members`` and ``horizons`` are checked first (``inputs.options.EvidenceRequest``; the work against the cap by
+    ``evidence.run``)."""
     from ...inputs.options import EvidenceRequest
 
-    horizons = EvidenceRequest(kind="convergence", members=members, horizons=horizons).horizons
+    horizons = EvidenceRequest(members=members, horizons=horizons).horizons
     say = progress or (lambda m: None)
     rows = []
     for name, model, d, cdeg, w in points():
@@ -167,10 +168,11 @@ def tolerance(members: int = 8, rtols=TOLERANCES, cells: int = 12, seed: int = 1
               tau_end: float = 1e10, progress=None) -> list[dict]:
     """Labels and end states against rtol on a ``cells`` x ``cells`` grid (both models),
     against the tightest rtol of ``rtols``; see the module docstring.  ``members`` and
-    ``tau_end`` are checked first (``inputs.options.EvidenceRequest``)."""
+    ``tau_end`` are checked first (``inputs.options.EvidenceRequest``; the work against the cap by
+    ``evidence.run``)."""
     from ...inputs.options import EvidenceRequest
 
-    EvidenceRequest(kind="tolerance", members=members, tau_end=tau_end)
+    EvidenceRequest(members=members, tau_end=tau_end)
     from ...regimes.engine.refine import centres
     from ...regimes.engine.runs import warm
 

@@ -1,6 +1,6 @@
 """The atlas's disagreements with the paper, re-checked with an independent integrator.
 
-    spinviz atlas --evidence crosscheck [--members 3] [--json]
+    spinviz atlas evidence crosscheck [--members 3] [--json]
 
 Independent of the atlas in two ways: the equations are (4.2)-(4.4) typed in from the paper
 (with omega_a, omega_b, omega_c of section 3), not spinviz's general reduced equation; and
@@ -96,10 +96,11 @@ def measures(delta, chi, tau, w) -> dict:
 
 def run(members: int = 3, settings: Settings | None = None, progress=None) -> list[dict]:
     """Integrate every point's starts with SciPy and classify them; one row per start.
-    ``members`` is checked first (``inputs.options.EvidenceRequest``)."""
+    ``members`` is checked first (``inputs.options.EvidenceRequest``; the work against the cap by
+    ``evidence.run``)."""
     from ...inputs.options import EvidenceRequest
 
-    EvidenceRequest(kind="crosscheck", members=members, tau_end=settings.tau_end if settings is not None else None)
+    EvidenceRequest(members=members, tau_end=settings.tau_end if settings is not None else None)
     st = settings or Settings()
     starts = directions(members, 1) * 0.1
     rows = []

@@ -1,7 +1,7 @@
 """The atlas at single points inside each domain: label shares, exponents and amplitudes
 against the paper's formulas (the README's validation table).
 
-    spinviz atlas --evidence validate [--members 32] [--workers 2] [--json]
+    spinviz atlas evidence validate [--members 32] [--workers 2] [--json]
 
 Each point is an atlas of one cell (built with ``parse_spec``, run with ``atlas`` into a
 temporary store, the default engine, tau_end = 1e16 as the shipped atlases), so the table is
@@ -42,10 +42,11 @@ POINTS = [
 
 def run(members: int = 32, workers: int | None = None, tau_end: float = 1e16, points=POINTS, progress: bool = False):
     """A single-cell atlas at each validation point; one row per point with its labels and formulas.
-    ``members``, ``workers`` and ``tau_end`` are checked first (``inputs.options.EvidenceRequest``)."""
+    ``members``, ``workers`` and ``tau_end`` are checked first (``inputs.options.EvidenceRequest``; the work against the cap by
+    ``evidence.run``)."""
     from ...inputs.options import EvidenceRequest
 
-    EvidenceRequest(kind="validate", members=members, workers=workers, tau_end=tau_end)
+    EvidenceRequest(members=members, workers=workers, tau_end=tau_end)
     rows = []
     tmp = tempfile.mkdtemp(prefix="spinviz-atlas-validate-")
     try:

@@ -213,8 +213,8 @@ def _compute(spec, out, scheduler, workers, processes, runs_per_task, flush_s, r
     notices: list = []
     _clear_creation_leftovers(out, say, notices)
     if os.path.exists(out):
-        _check_store(spec, out)
-    levels: list[Level] = []
+        LV.check_store(spec, out)
+    levels: list[LV.Level] = []
     totals = {"todo": 0, "reused": 0, "repaired": 0, "failed": 0, "runs": 0}
     stats = None
     where = "nothing to compute"
@@ -223,14 +223,10 @@ def _compute(spec, out, scheduler, workers, processes, runs_per_task, flush_s, r
     with deferred(), contextlib.ExitStack() as stack:
         cluster = _LazyCluster(stack, scheduler, workers, processes)
         for k in range(spec.refine_levels + 1):
-            if k == 0:
-                lv = Level(spec, out, None)
-            else:
-                cells = LV.wanted(spec, [x.out for x in levels], k)
-                if not cells.any():
-                    break
-                lv = Level(LV.level_spec(spec, k), DS.level_path(out, k), cells)
-                _prepare_level(lv, k, say, notices)
+            lv = LV.level(spec, out, levels, k)
+            if lv is None:
+                break
+            _prepare_level(lv, say, notices)
             levels.append(lv)
             s = _run_level(lv, cluster, runs_per_task, flush_s, retry_failed, on_result, progress, say, notices, totals)
             stats = s if stats is None else stats.merged(s)
@@ -254,43 +250,14 @@ def _compute(spec, out, scheduler, workers, processes, runs_per_task, flush_s, r
                        totals["repaired"], notices, levels=len(levels) - 1)
 
 
-def _check_store(spec: AtlasSpec, out: str) -> None:
-    """Before any work: an existing store must be an atlas of this very spec (its metadata
-    whole: ``StoreDamaged`` otherwise), and every ``levelK`` inside it a level of this spec --
-    one of another atlas, or beyond the spec's ``[refine] levels``, is refused with the one
-    command that removes it (``ForeignLevel``), never mixed in and never deleted.  (A level
-    that is damaged or missing is recomputed when its turn comes, ``_prepare_level``.)"""
-    if not os.path.isdir(out):
-        return                                       # store_path has said what it is
-    skeleton = IN.verify_skeleton(out)
-    if skeleton is None:
-        if not os.path.exists(os.path.join(out, ".zgroup")):
-            raise UsageError(f"{out}: exists and is not an atlas store (no .zgroup); choose another store path")
-        DS.check_identity(spec, out)                 # another Zarr store, or another spec: said as such
-        raise StoreDamaged(f"{out}: carries no checksums (made by an earlier spinviz, or its {IN.DIR} was deleted), "
-                           f"so its runs cannot be trusted; move it away and compute the atlas again")
-    if skeleton:
-        raise StoreDamaged(f"{out}: its metadata are damaged ({IN.summary(skeleton, 4)}); they cannot be "
-                           f"recomputed from the runs: move it away and compute the atlas again")
-    DS.check_identity(spec, out)
-    for k in LV.found(out):
-        path = DS.level_path(out, k)
-        if k > spec.refine_levels:
-            raise ForeignLevel(f"{path}: not a refinement level of this spec ([refine] levels = {spec.refine_levels}); "
-                               f"refusing to mix it in: remove it (rm -r {path}) and run the same command again")
-        want = LV.level_identity(spec, k)
-        st = LV.state(path, want)
-        if st.kind == "foreign":
-            raise ForeignLevel(f"{path}: holds a refinement level of another atlas (sha256 {st.sha256[:12]}; this "
-                               f"spec's level {k}: {want[:12]}); refusing to mix them: remove it (rm -r {path}) and "
-                               f"the same command computes this spec's")
-
-
-def _prepare_level(lv: Level, k: int, say, notices: list) -> None:
-    """Level ``k``'s store before its runs: a damaged one (no .zgroup, no checksums, metadata
-    that do not match them) is removed -- a level is recomputable from the spec and the levels
-    below -- and said in one line; a foreign one was refused before any work (``_check_store``)."""
-    st = LV.state(lv.out, DS.identity(lv.spec))
+def _prepare_level(lv: LV.Level, say, notices: list) -> None:
+    """A refinement level's store before its runs (``lv.state``, judged by ``levels.level``): a
+    damaged one (no .zgroup, no checksums, metadata that do not match them) is removed -- a
+    level is recomputable from the spec and the levels below -- and said in one line; a foreign
+    one was refused before any work (``levels.check_store``)."""
+    st = lv.state
+    if st is None:
+        return
     if st.kind == "foreign":                         # appeared since the check: another hand in the store
         raise ForeignLevel(f"{lv.out}: holds a refinement level of another atlas; remove it (rm -r {lv.out}) and "
                            f"run the same command again")
@@ -316,25 +283,6 @@ def _clear_creation_leftovers(out: str, say, notices: list) -> None:
             f"left beside it ({names})")
     notices.append(line)
     say(line)
-
-
-@dataclass
-class Level:
-    """One level of the quadtree (``refine``): its spec (level 0: the spec itself; level k: the
-    grid cut 2^k times finer), its store (level 0: ``out``; level k: ``out/levelK``, an atlas
-    store of its own), and the cells to compute (model, delta, chi) -- None: all."""
-
-    spec: AtlasSpec
-    out: str
-    wanted: np.ndarray | None
-
-    @property
-    def runs(self) -> int:
-        """Runs this level holds: all of its spec's, or its wanted cells' members."""
-        return self.spec.runs if self.wanted is None else int(self.wanted.sum()) * self.spec.members
-
-
-level_spec, level_types = LV.level_spec, LV.level_types      # the levels' rules live with the store
 
 
 class _LazyCluster:

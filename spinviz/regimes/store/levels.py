@@ -19,8 +19,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...errors import SceneError
+from ...errors import SceneError, UsageError
 from ..engine import refine as RF
+from ..faults import ForeignLevel, StoreDamaged
 from . import dataset as DS
 from . import integrity as IN
 
@@ -69,6 +70,70 @@ def wanted(spec, paths: list, k: int) -> np.ndarray:
         eff = RF.effective(maj, comp)
         out[mi] = RF.children(RF.flags(maj[-1], share, comp[-1], eff, spec.refine_agree))
     return out
+
+
+@dataclass
+class Level:
+    """One level of the quadtree (``refine``): its spec (level 0: the spec itself; level k: the
+    grid cut 2^k times finer), its store (level 0: ``out``; level k: ``out/levelK``, an atlas
+    store of its own), the cells to compute (model, delta, chi) -- None: all -- and what its
+    directory holds (``State``; None for level 0, which ``check_store`` judged)."""
+
+    spec: object
+    out: str
+    wanted: np.ndarray | None
+    state: State | None = None
+
+    @property
+    def runs(self) -> int:
+        """Runs this level holds: all of its spec's, or its wanted cells' members."""
+        return self.spec.runs if self.wanted is None else int(self.wanted.sum()) * self.spec.members
+
+
+def level(spec, out: str, below: list, k: int) -> Level | None:
+    """Level ``k`` of the atlas of ``spec`` in the store ``out``, given the levels ``below`` it
+    (computed): level 0 the store itself; level k its wanted cells (``wanted``) and the state of
+    its directory against the identity it must carry -- None when the levels below flag no cell."""
+    if k == 0:
+        return Level(spec, out, None)
+    cells = wanted(spec, [x.out for x in below], k)
+    if not cells.any():
+        return None
+    sub = level_spec(spec, k)
+    path = DS.level_path(out, k)
+    return Level(sub, path, cells, state(path, DS.identity(sub)))
+
+
+def check_store(spec, out: str) -> None:
+    """Before any work: an existing store must be an atlas of this very spec (its metadata
+    whole: ``StoreDamaged`` otherwise), and every ``levelK`` inside it a level of this spec --
+    one of another atlas, or beyond the spec's ``[refine] levels``, is refused with the one
+    command that removes it (``ForeignLevel``), never mixed in and never deleted.  (A level
+    that is damaged or missing is recomputed when its turn comes.)"""
+    if not os.path.isdir(out):
+        return                                       # store_path has said what it is
+    skeleton = IN.verify_skeleton(out)
+    if skeleton is None:
+        if not os.path.exists(os.path.join(out, ".zgroup")):
+            raise UsageError(f"{out}: exists and is not an atlas store (no .zgroup); choose another store path")
+        DS.check_identity(spec, out)                 # another Zarr store, or another spec: said as such
+        raise StoreDamaged(f"{out}: carries no checksums (made by an earlier spinviz, or its {IN.DIR} was deleted), "
+                           f"so its runs cannot be trusted; move it away and compute the atlas again")
+    if skeleton:
+        raise StoreDamaged(f"{out}: its metadata are damaged ({IN.summary(skeleton, 4)}); they cannot be "
+                           f"recomputed from the runs: move it away and compute the atlas again")
+    DS.check_identity(spec, out)
+    for k in found(out):
+        path = DS.level_path(out, k)
+        if k > spec.refine_levels:
+            raise ForeignLevel(f"{path}: not a refinement level of this spec ([refine] levels = {spec.refine_levels}); "
+                               f"refusing to mix it in: remove it (rm -r {path}) and run the same command again")
+        want = level_identity(spec, k)
+        st = state(path, want)
+        if st.kind == "foreign":
+            raise ForeignLevel(f"{path}: holds a refinement level of another atlas (sha256 {st.sha256[:12]}; this "
+                               f"spec's level {k}: {want[:12]}); refusing to mix them: remove it (rm -r {path}) and "
+                               f"the same command computes this spec's")
 
 
 def found(out: str) -> list[int]:

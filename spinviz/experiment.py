@@ -45,37 +45,70 @@ def receiver_of(scene, **options):
     return _scene(scene).observe.receiver.with_options(**options)
 
 
-def compare(scene, *, samples: int = 800):
+def _plots(sc, paths):
+    """The outputs group of ``paths`` (checked now, before any work; written together at the end)."""
+    from .atomic import Outputs
+
+    return Outputs(paths, [sc.path] if sc.path else [])
+
+
+def compare(scene, *, samples: int = 800, plots: str | None = None):
     """Run both models of a two-model scene at the same instants and compare them
     (``analysis.compare.Comparison``: misorientation, dipole angle, first times above 1° and
-    10°, final states).  ``samples``: evenly spaced plus as many log-spaced instants."""
+    10°, final states; ``.table()`` for people, ``.record()`` for JSON).
+
+    samples : evenly spaced plus as many log-spaced instants.  plots : a path prefix: writes
+    ``PREFIX_compare.png`` (how far apart, |Omega|, angle(d, L)) and ``PREFIX_hodograph.png``
+    (like the paper's figures 3 and 4), together, atomically."""
     from .analysis import compare as CMP
     from .driver import simulate_request
     from .inputs.experiment import CompareRequest
 
     samples = CompareRequest(samples=samples).samples
     sc = _scene(scene).require("compare")
+    group = _plots(sc, [f"{plots}_compare.png", f"{plots}_hodograph.png"]) if plots is not None else None
     times = CMP.compare_times(sc.t_end, samples)
     try:
         trajs = [simulate_request(sc.request(m, t_eval=times)) for m in sc.models]
     except SpecError as e:                              # the output times are this argument's
         raise SpecError("samples", e.reason) if e.key == "t_eval" else e from None
-    return CMP.compare(trajs)
+    c = CMP.compare(trajs)
+    c.title = sc.title
+    if group is not None:
+        with group as (tmp_compare, tmp_hodograph):
+            CMP.plot(c, tmp_compare, sc.title)
+            CMP.plot_hodograph(c, tmp_hodograph, sc.title)
+    return c
 
 
-def observe(scene, *, samples: int = 800, line_of_sight=None, **receiver):
+def observe(scene, *, samples: int = 800, line_of_sight=None, plots: str | None = None, **receiver):
     """What the scene's receiver records from both models (``analysis.observe.Observation``:
-    SNR, resolutions, the field at the antenna, when the models part, the P-f test).
+    SNR, resolutions, the field at the antenna, when the models part, the P-f test;
+    ``.table()`` for people, ``.record()`` for JSON).
 
     line_of_sight : world-frame direction to the detector (default the scene's [observe], else
-    across L(0)); ``receiver``: receiver keys (``distance_cm=`` ...) in place of the scene's."""
+    across L(0)); ``receiver``: receiver keys (``distance_cm=`` ...) in place of the scene's.
+    plots : a path prefix: writes ``PREFIX_observe.png``, ``PREFIX_detector.png`` and, for a
+    physical body, ``PREFIX_receiver.png``, together, atomically."""
     from .analysis import observe as OB
     from .inputs.experiment import ObserveRequest
 
     req = ObserveRequest(samples=samples, line_of_sight=line_of_sight)
     sc = _scene(scene)
     rx = receiver_of(sc, **receiver)
-    obs, _ = OB.run_scene(sc.require("observe"), req.samples, req.line_of_sight, rx)
+    sc.require("observe")
+    names = ["observe", "detector"] + (["receiver"] if sc.units == "cgs" else [])
+    group = _plots(sc, [f"{plots}_{n}.png" for n in names]) if plots is not None else None
+    obs, _ = OB.run_scene(sc, req.samples, req.line_of_sight, rx)
+    if group is not None:
+        from .analysis import experiment_plots as EP
+        from .analysis import observe_plots as OP
+
+        with group as tmps:
+            OP.plot(obs, tmps[0])
+            OP.plot_detector(obs, tmps[1])
+            if len(tmps) > 2:
+                EP.plot_receiver(obs, tmps[2])
     return obs
 
 
@@ -100,14 +133,15 @@ def listen(scene, out: str, *, png: str | None = None, duration: float = 20.0, f
 
 
 def decide(scene, *, trials: int = 200, seed: int = 1, spin_range=(0.5, 2.0), tau0: str = "known",
-           workers: int | None = None, scheduler: str | None = None, say=None, **receiver):
+           workers: int | None = None, scheduler: str | None = None, plot: str | None = None, say=None, **receiver):
     """How long to watch: a Monte Carlo over noise and unknown starts of the time a
     likelihood-ratio test needs to tell the scene's two models apart at 5 sigma in 95 % of
-    trials (``analysis.decide.Outcome``).
+    trials (``analysis.decide.Outcome``; ``.table()`` for people, ``.record()`` for JSON).
 
     Runs on worker processes of this machine (``workers``, default one per core), or on Dask
     from ``DASK_TRIALS`` trials or with ``scheduler`` (an existing cluster's address);
-    ``say(text)``, if given, hears where it runs."""
+    ``say(text)``, if given, hears where it runs.  plot : a PNG path for the share of trials
+    decided against observation time, written atomically."""
     from .analysis import decide as DC
     from .inputs.decide import DecideArguments
 
@@ -116,9 +150,17 @@ def decide(scene, *, trials: int = 200, seed: int = 1, spin_range=(0.5, 2.0), ta
     sc = _scene(scene)
     rx = receiver_of(sc, **receiver)
     setup = DC.setup_from_scene(sc.require("decide"), rx, sc.observe.t_end or sc.t_end, spec.spin_range, spec.tau0)
+    group = _plots(sc, [plot]) if plot is not None else None
     with contextlib.ExitStack() as stack:
         mapper = _mapper(stack, spec, say)
-        return DC.run(setup, spec.trials, spec.seed, mapper)
+        outcome = DC.run(setup, spec.trials, spec.seed, mapper)
+    outcome.title, outcome.receiver = sc.title, rx
+    if group is not None:
+        from .analysis.experiment_plots import plot_decide
+
+        with group as (tmp,):
+            plot_decide(outcome, sc.title, tmp)
+    return outcome
 
 
 def _mapper(stack: contextlib.ExitStack, spec, say):

@@ -191,9 +191,9 @@ def test_dask_runs_the_same_trials(cube_setup, monkeypatch, capsys, tmp_path):
     LocalCluster here, one worker): the same decision times as in this process."""
     import json
 
-    import spinviz.commands.decide as CLI
+    from spinviz import experiment
 
-    monkeypatch.setattr(CLI, "DASK_TRIALS", 8)
+    monkeypatch.setattr(experiment, "DASK_TRIALS", 8)
     code = main(["decide", str(CUBE), "--trials", "8", "--workers", "1", "--json", "--out", str(tmp_path / "c")])
     captured = capsys.readouterr()
     assert code == 0, captured.err

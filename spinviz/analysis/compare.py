@@ -62,6 +62,11 @@ class Comparison:
     first_exceed: dict = field(default_factory=dict)      # metric -> {threshold: time or None}
     models: list = field(default_factory=list)
     omega_body: dict = field(default_factory=dict)
+    title: str = ""
+
+    def table(self) -> str:
+        """The comparison for people (``format_table``): when the models part, how each ends."""
+        return format_table(self, self.title)
 
     def record(self) -> dict:
         """The end states and first crossings as a JSON-ready dict (``spinviz compare --json``)."""

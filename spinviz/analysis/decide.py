@@ -341,6 +341,12 @@ class Outcome:
     rows: list
     t95: dict = field(default_factory=dict)
     interval: dict = field(default_factory=dict)
+    title: str = ""
+    receiver: object = None          # inputs.receiver.ReceiverSpec the trials were watched by
+
+    def table(self) -> str:
+        """The answer for people (``format_outcome``)."""
+        return format_outcome(self, self.title, self.receiver)
 
     def times(self, truth: str) -> np.ndarray:
         """The trials' decision times under ``truth`` (s; inf where Z < 5 at the horizon)."""

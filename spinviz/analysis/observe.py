@@ -55,6 +55,11 @@ class Observation:
     pf_reason: str = ""
     notes: list = field(default_factory=list)
 
+    def table(self) -> str:
+        """The observation for people (``format_table``): the receiver, the observables, when the
+        models part, the P-f test."""
+        return format_table(self)
+
     def record(self) -> dict:
         """The observation as a JSON-ready dict (``spinviz observe --json``): the receiver, per
         model its observables and budget at the first and last samples, the parting curves, the

@@ -23,25 +23,17 @@ def add_parser(sub) -> None:
 def run(args) -> int:
     """Carry out ``spinviz compare`` with the parsed ``args``; return its exit status."""
     from .. import experiment
-    from ..analysis import compare
-    from ..atomic import Outputs
-    from ..inputs.scene_spec import load_scene
 
-    sc = load_scene(args.scene)
     need_matplotlib("compare's plots")
     prefix = prefix_of(args)
-    paths = [f"{prefix}_compare.png", f"{prefix}_hodograph.png"]
-    group = Outputs(paths, [args.scene])                # checked before the runs, landed together after
-    c = experiment.compare(sc, samples=args.samples)    # the arguments and the scene checked before the runs
     try:
-        with group as tmps:
-            compare.plot(c, tmps[0], sc.title)
-            compare.plot_hodograph(c, tmps[1], sc.title)
+        c = experiment.compare(args.scene, samples=args.samples, plots=prefix)
     except OSError as e:
         raise cannot_write(prefix, e) from None
+    paths = [f"{prefix}_compare.png", f"{prefix}_hodograph.png"]
     if args.json:
-        print(json.dumps({**c.record(), "plots": list(paths)}, indent=2, default=float))
+        print(json.dumps({**c.record(), "plots": paths}, indent=2, default=float))
     else:
-        out(compare.format_table(c, sc.title))
+        out(c.table())
         out(f"\nplots: {p(paths[0])}, {p(paths[1])}")
     return EXIT_OK

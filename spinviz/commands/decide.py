@@ -45,39 +45,30 @@ def add_parser(sub) -> None:
 def run(args) -> int:
     """Carry out ``spinviz decide`` with the parsed ``args``; return its exit status."""
     from .. import experiment
-    from ..analysis import decide as DC
-    from ..atomic import Outputs
-    from ..inputs.scene_spec import load_scene
 
-    sc = load_scene(args.scene)
     if args.measurements is not None:
-        return _measurements(args, sc)
+        return _measurements(args, args.scene)
     given = {k: getattr(args, k) for k in ("trials", "seed", "spin_range", "tau0", "workers", "scheduler")
              if getattr(args, k) is not None}
-    prefix = prefix_of(args)
-    plot = f"{prefix}_decide.png"
-    group = Outputs([plot], [args.scene])
-    outcome = experiment.decide(sc, say=progress, **given, **receiver_options(args))
+    plot = f"{prefix_of(args)}_decide.png"
     try:
-        with group as tmps:
-            from ..analysis.experiment_plots import plot_decide
-
-            plot_decide(outcome, sc.title, tmps[0])
+        outcome = experiment.decide(args.scene, plot=plot, say=progress, **given, **receiver_options(args))
     except OSError as e:
-        raise cannot_write(prefix, e) from None
-    receiver = experiment.receiver_of(sc, **receiver_options(args))
+        raise cannot_write(plot, e) from None
     if args.json:
-        print(json.dumps({**outcome.record(), "receiver": receiver.record(), "plots": [plot]}, indent=2))
+        print(json.dumps({**outcome.record(), "receiver": outcome.receiver.record(), "plots": [plot]}, indent=2))
     else:
-        out(DC.format_outcome(outcome, sc.title, receiver))
+        out(outcome.table())
         out(f"\nplot: {p(plot)}")
     return EXIT_OK
 
 
-def _measurements(args, sc) -> int:
+def _measurements(args, scene) -> int:
     """``decide --measurements FILE``: the start-free P-f test of measured data."""
     from .. import experiment
+    from ..inputs.scene_spec import load_scene
 
+    sc = load_scene(scene)
     law, test = experiment.test_measurements(sc, args.measurements)
     if law is None:
         if args.json:

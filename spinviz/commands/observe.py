@@ -38,33 +38,20 @@ def add_parser(sub) -> None:
 def run(args) -> int:
     """Carry out ``spinviz observe`` with the parsed ``args``; return its exit status."""
     from .. import experiment
-    from ..analysis import observe as OB
-    from ..analysis import observe_plots as OP
-    from ..atomic import Outputs
-    from ..inputs.scene_spec import load_scene
 
-    sc = load_scene(args.scene)
     need_matplotlib("observe's plots")
     prefix = prefix_of(args)
-    paths = [f"{prefix}_observe.png", f"{prefix}_detector.png"] + ([f"{prefix}_receiver.png"] if sc.units == "cgs" else [])
-    group = Outputs(paths, [args.scene])
     try:
-        obs = experiment.observe(sc, samples=args.samples, line_of_sight=args.line_of_sight, **receiver_options(args))
+        obs = experiment.observe(args.scene, samples=args.samples, line_of_sight=args.line_of_sight, plots=prefix,
+                                 **receiver_options(args))
     except SimulationError as e:
         raise SimulationError(f"{args.scene}: {e}") from None
-    try:
-        with group as tmps:
-            OP.plot(obs, tmps[0])
-            OP.plot_detector(obs, tmps[1])
-            if len(tmps) > 2:
-                from ..analysis.experiment_plots import plot_receiver
-
-                plot_receiver(obs, tmps[2])
     except OSError as e:
         raise cannot_write(prefix, e) from None
+    paths = [f"{prefix}_{n}.png" for n in ("observe", "detector", "receiver")][:3 if obs.units == "cgs" else 2]
     if args.json:
-        print(json.dumps({**obs.record(), "plots": list(paths)}, indent=2, default=float))
+        print(json.dumps({**obs.record(), "plots": paths}, indent=2, default=float))
     else:
-        out(OB.format_table(obs))
+        out(obs.table())
         out(f"\nplots: {', '.join(p(x) for x in paths)}")
     return EXIT_OK

@@ -13,6 +13,7 @@ The public API (see the README's "Python" section)::
     tr.save("run.npz"); tr = spinviz.Trajectory.load("run.npz")
     img = spinviz.render_frame(sc, t=0.0)                                       # RGB array: the first frame
     spinviz.render("scenes/default.toml", out="renders/default.mp4")
+    spinviz.show(sc)                                                            # turnable, inline in Jupyter
 
 Importing the package is light: every name loads its module on first use (PEP 562), and
 nothing here imports numba, pyvista, vtk or imageio.  No public name is also a submodule
@@ -33,6 +34,7 @@ _API = {
     "Trajectory": ("trajectory", "Trajectory"),
     "render": ("pipeline", "render"),
     "render_frame": ("pipeline", "render_frame"),
+    "show": ("notebook", "show"),
     "Renderer": ("pipeline", "Renderer"),
     "Body": ("physics.bodies", "Body"),
     "symmetric_top": ("physics.bodies", "symmetric_top"),
@@ -49,7 +51,7 @@ _API = {
 }
 _SUBMODULES = {
     "units", "rotations", "errors", "atomic", "plotting", "physics", "integrators", "inputs", "driver", "trajectory",
-    "rendering", "pipeline", "analysis", "validation", "regimes", "commands",
+    "rendering", "pipeline", "notebook", "analysis", "validation", "regimes", "commands",
 }
 
 __all__ = sorted(_API) + ["__version__"]

@@ -9,9 +9,9 @@ the video's frame n, then the frame range 0..F-1, the file's camera as the scene
 the video's frame size, a world that gives the video's ambient light and shows its background
 colour, and the Standard view transform (the video's colours).
 
-Safe to run: the script is text from this module with numbers and the model's file name (a
-Python literal, ``repr``), nothing from a scene's title or captions; it reads the model beside
-it and writes nothing.  Pure Python (no drawing library).
+Safe to run: the script is text from this module with numbers and the model's file name (once,
+as a Python literal: ``repr``), nothing from a scene's title or captions; it reads the model
+beside it and writes nothing.  Pure Python (no drawing library).
 """
 
 from __future__ import annotations
@@ -24,11 +24,12 @@ from .style import COLORS
 
 __all__ = ["script", "script_path"]
 
-TEMPLATE = '''"""Opens {model} in Blender ready to play and render, as spinviz's video shows it.
+TEMPLATE = '''"""Opens the glTF model beside this script (MODEL below) in Blender, ready to play
+and render as spinviz's video shows it.
 
 Written by spinviz beside the model.  Run it with
 
-    blender --python {script}
+    blender --python THIS_SCRIPT.py
 
 or open it in Blender's Text Editor and press Run Script.  It adds a scene of its own (the
 scenes already open are left as they are), sets the video's frame rate ({fps} fps) before
@@ -125,7 +126,7 @@ def script(plan, model_path: str) -> str:
     """
     spec = plan.spec
     name = os.path.basename(os.fspath(model_path))
-    return TEMPLATE.format(model=name, script=os.path.basename(script_path(model_path)), fps=int(spec.fps), first=0,
+    return TEMPLATE.format(model=name, fps=int(spec.fps), first=0,
                            last=int(plan.frames - 1), camera=CAMERA_NAME, resolution=tuple(int(x) for x in spec.size),
                            background=tuple(round(x, 6) for x in linear_from_srgb(COLORS[spec.background]["bg_rgb"])),
                            ambient=float(AMBIENT_STRENGTH))

@@ -28,25 +28,24 @@ from spinviz.rendering import blender, framing, gltf, keyframes
 from spinviz.rendering.stage import arrow_length, content_points
 from spinviz.rendering.style import ARROWS
 
-from media import ROOT, accessor, channel, componentwise, load, validate, world_matrices, write_scene, wxyz
+from media import ROOT, accessor, channel, componentwise, load, validate, world_matrices, wxyz
 
 MODELS = ("reduced", "truncated")
 
 
 @pytest.fixture(scope="module")
-def scene(tmp_path_factory):
-    return write_scene(tmp_path_factory.mktemp("gltf") / "askew_true.toml")
+def scene(askew):
+    return askew.scene
 
 
 @pytest.fixture(scope="module")
-def plan(scene):
-    return pipeline.plan(str(scene))
+def plan(askew):
+    return askew.plan
 
 
 @pytest.fixture(scope="module")
-def glb(scene, tmp_path_factory):
-    out = tmp_path_factory.mktemp("glb") / "askew.glb"
-    res = spinviz.render(str(scene), out=str(out))
+def glb(askew):
+    out, res = askew.glb, askew.result
     assert res.path == str(out) and res.format == "glb" and res.bytes == out.stat().st_size
     assert res.script == str(out.with_name("askew_blender.py"))
     return out

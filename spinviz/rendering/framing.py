@@ -126,7 +126,7 @@ def frame_models(plan) -> Framing:
     el = math.radians(spec.elevation_deg)
     W, H = spec.size
     aspect = W / H
-    pts = content_points(plan)
+    pts = np.unique(np.round(content_points(plan), 4), axis=0)
     # the video's panel camera: its distance sets the perspective
     D = Camera(view, aspect / n, pts, (MARGIN, MARGIN), spec.zoom).distance
     g_view = gltf_from_spinviz(view)
@@ -142,7 +142,7 @@ def frame_models(plan) -> Framing:
         ndc = _ndc(allp, pitch, t, aspect)
         worst = np.max(np.abs(ndc), axis=0) / (1.0 - MARGIN)
         need = float(np.max(worst))
-        if abs(need - 1.0) < 1e-6:
+        if abs(need - 1.0) < 1e-5:
             break
         t *= need
     mid = np.mean(places, axis=0)
@@ -172,7 +172,7 @@ def _centred_pitch(p) -> float:
         y = _ndc(p, pitch, 1.0, 1.0)[:, 1]
         return float(y.max() + y.min())
 
-    for _ in range(80):
+    for _ in range(48):              # to ~1e-14 rad
         mid = 0.5 * (lo + hi)
         if off(mid) > 0.0:          # content above the centre: the camera looks too far down
             hi = mid

@@ -128,20 +128,23 @@ def _tracks(plan) -> list[dict]:
 
 
 def _slerp(qa, qb, tau):
-    """slerp from qa to qb (each (4,), sign-aligned) at fractions tau (n,) -> (n, 4)."""
+    """slerp from qa to qb (each (4,), or (n, 4) row by row; sign-aligned) at fractions tau (n,)
+    -> (n, 4)."""
+    qa, qb = np.broadcast_arrays(np.atleast_2d(qa), np.atleast_2d(qb))
+    tau = np.asarray(tau, dtype=float)
     rel = R.multiply(R.conjugate(qa), qb)
-    half = math.atan2(float(np.linalg.norm(rel[1:])), float(rel[0]))
-    v = rel[1:]
-    nv = float(np.linalg.norm(v))
-    axis = v / nv if nv > 0.0 else np.zeros(3)
-    return R.multiply(qa[None, :], R.exp_rotvec(2.0 * np.asarray(tau)[:, None] * half * axis[None, :]))
+    half = np.arctan2(np.linalg.norm(rel[:, 1:], axis=1), rel[:, 0])
+    nv = np.linalg.norm(rel[:, 1:], axis=1, keepdims=True)
+    axis = np.divide(rel[:, 1:], nv, out=np.zeros_like(rel[:, 1:]), where=nv > 0.0)
+    return R.multiply(qa, R.exp_rotvec(2.0 * (tau * half)[:, None] * axis))
 
 
 def _componentwise(qa, qb, tau):
-    """The four numbers interpolated one by one from qa to qb (sign-aligned) at fractions tau
-    (n,), then normalized (Blender's quaternion F-curves) -> (n, 4)."""
+    """The four numbers interpolated one by one from qa to qb (each (4,) or (n, 4);
+    sign-aligned) at fractions tau (n,), then normalized (Blender's quaternion F-curves) ->
+    (n, 4)."""
     tau = np.asarray(tau, dtype=float)[:, None]
-    return R.normalize((1.0 - tau) * qa[None, :] + tau * qb[None, :])
+    return R.normalize((1.0 - tau) * np.atleast_2d(qa) + tau * np.atleast_2d(qb))
 
 
 _BETWEEN = {"slerp": _slerp, "componentwise": _componentwise}
@@ -251,8 +254,8 @@ def _assemble(plan, tracks, frames, tol) -> Keyframes:
     fps = int(plan.spec.fps)
     kf = Keyframes(frame=frame, position=position, video_t=position / float(fps), fps=fps, sim_t=sim_t, panels=panels,
                    tolerance=tol)
-    kf.max_error, kf.max_length_error = measure(kf, plan, "slerp")
-    kf.max_error_componentwise, _ = measure(kf, plan, "componentwise")
+    kf.max_error, kf.max_length_error = measure(kf, plan, "slerp", tracks)
+    kf.max_error_componentwise, _ = measure(kf, plan, "componentwise", tracks)
     kf.max_step = max((float(np.max(R.misorientation(q[:-1], q[1:]))) for q in _all_quats(kf) if len(q) > 1),
                       default=0.0)
     return kf
@@ -292,7 +295,7 @@ def interpolate(kf: Keyframes, video_t, how: str = "slerp") -> list[dict]:
     between = _BETWEEN[how]
 
     def rows(q):
-        return np.array([between(q[a], q[b], [u])[0] for a, b, u in zip(i, j, tau)])
+        return between(q[i], q[j], tau)
 
     out = []
     for p in kf.panels:
@@ -305,12 +308,13 @@ def interpolate(kf: Keyframes, video_t, how: str = "slerp") -> list[dict]:
     return out
 
 
-def measure(kf: Keyframes, plan, how: str = "slerp") -> tuple[float, float]:
+def measure(kf: Keyframes, plan, how: str = "slerp", tracks=None) -> tuple[float, float]:
     """(largest angle (rad), largest arrow-length error) between what a viewer interpolates
     from ``kf`` (``how``: "slerp" or "componentwise") and what ``plan`` draws, over every
-    frame of the plan, each at its time on the MP4's clock."""
+    frame of the plan, each at its time on the MP4's clock (``tracks``: ``_tracks(plan)``,
+    if already made)."""
     shown = interpolate(kf, frame_clock(plan), how)
-    tracks = _tracks(plan)
+    tracks = _tracks(plan) if tracks is None else tracks
     ang, dlen = 0.0, 0.0
     x = np.array([1.0, 0.0, 0.0])
     for got, want in zip(shown, tracks):

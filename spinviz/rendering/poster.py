@@ -61,14 +61,14 @@ def _project(p, view, D) -> np.ndarray:
     return np.c_[(p @ right) / depth, (p @ up) / depth]
 
 
-def _shade(rgb, normal, lit: bool, view) -> np.ndarray:
-    """The video's flat shading of a face: colour x (ambient + Lambert of its three lights)."""
-    if not lit:
-        return np.asarray(rgb)
+def _shade(rgb, normal, lit, view) -> np.ndarray:
+    """The video's flat shading of faces (rgb, normal: (m, 3); lit: (m,) bool): colour x
+    (ambient + Lambert of its three lights); an unlit face keeps its colour."""
     v, r, u = _frame(view)
-    lights = [(-0.55 * r + 0.75 * u + 0.45 * v, 0.55), (0.85 * r - 0.15 * u + 0.35 * v, 0.22), (v, 0.25)]
-    k = AMBIENT + sum(w * max(0.0, float(normal @ (d / np.linalg.norm(d)))) for d, w in lights)
-    return np.clip(np.asarray(rgb) * k, 0.0, 1.0)
+    k = np.full(len(normal), AMBIENT)
+    for d, w in ((-0.55 * r + 0.75 * u + 0.45 * v, 0.55), (0.85 * r - 0.15 * u + 0.35 * v, 0.22), (v, 0.25)):
+        k += w * np.maximum(0.0, normal @ (d / np.linalg.norm(d)))
+    return np.where(np.asarray(lit)[:, None], np.clip(np.asarray(rgb) * k[:, None], 0.0, 1.0), rgb)
 
 
 def _hex(rgb) -> str:
@@ -135,17 +135,14 @@ def svg(plan, k: int, D: float, R: float, f: int = 0, label_id: str = "alt") -> 
             axes.append(f'<polyline points="{xy(np.array([np.zeros(3), e]))}" stroke="{_hex(colors["axes"])}"/>')
     faces = []
     for part, rot, shift in _solids(plan, k, f):
-        pts = part.points @ rot.T + shift
-        nrm = part.normals @ rot.T
-        for tri in part.triangles:
-            p3 = pts[tri]
-            n = nrm[tri].mean(axis=0)
-            n /= np.linalg.norm(n) or 1.0
-            centre = p3.mean(axis=0)
-            if n @ (cam - centre) <= 0.0:
-                continue
-            rgb = _shade(part.color[tri[0]], n, bool(part.lit[tri[0]]), view)
-            faces.append((float(np.linalg.norm(cam - centre)), _hex(rgb), xy(p3)))
+        p3 = (part.points @ rot.T + shift)[part.triangles]                     # (m, 3 corners, 3)
+        n = (part.normals @ rot.T)[part.triangles].mean(axis=1)
+        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+        centre = p3.mean(axis=1)
+        seen = np.einsum("ij,ij->i", n, cam - centre) > 0.0                    # facing the camera
+        rgb = _shade(part.color[part.triangles[:, 0]], n, part.lit[part.triangles[:, 0]], view)
+        dist = np.linalg.norm(cam - centre, axis=1)
+        faces += [(float(dist[i]), _hex(rgb[i]), xy(p3[i])) for i in np.flatnonzero(seen)]
     faces.sort(key=lambda x: -x[0])
     polys = [f'<polygon points="{p}" fill="{c}" stroke="{c}"/>' for _, c, p in faces]
     # stroke widths in viewBox units (2000 across a 300-600 px view): lines about a pixel, and the

@@ -14,7 +14,8 @@ by their dotted names, so that the configuration stays picklable).
   video plays on the page.  (matplotlib figures left open are caught by sphinx-gallery's own
   matplotlib scraper, listed first.)  A web page an example writes (``.html``: a turnable
   scene) is shown in a frame with a link to it on its own, and a glTF model (``.glb``) is
-  offered for download; both go to ``docs/gallery/pages/``, which the site serves from its
+  offered for download, with the Blender script written beside it (``X_blender.py``); all
+  go to ``docs/gallery/pages/``, which the site serves from its
   root (``html_extra_path``).  Any other file an example leaves in ``examples/`` stops the
   build, naming it: an example writes its other outputs (a store, a WAV) to a scratch folder,
   so that building the site leaves the checkout as it was.
@@ -33,6 +34,7 @@ PAGES_DIR = Path(__file__).resolve().parent / "gallery" / "pages"       # conf.p
 PICTURES = (".png", ".gif")
 PAGES = (".html",)
 MODELS = (".glb",)
+SCRIPTS = "_blender.py"          # what spinviz writes beside a model: X.glb -> X_blender.py
 
 ORDER = [
     "plot_compare_models.py",
@@ -79,7 +81,8 @@ def written_pictures(block, block_vars, gallery_conf) -> str:
     """The PNG and GIF files the block wrote into ``examples/``, moved into the gallery's images
     (sphinx-gallery's next image names, the extension kept), as reST."""
     new_files = [EXAMPLES / name for name, mtime in _listing().items() if _before.get(name) != mtime]
-    others = sorted(p.name for p in new_files if p.suffix.lower() not in PICTURES + PAGES + MODELS)
+    others = sorted(p.name for p in new_files if p.suffix.lower() not in PICTURES + PAGES + MODELS
+                    and not p.name.endswith(SCRIPTS))
     example = Path(block_vars["src_file"]).stem
     if others:
         raise ExtensionError(f"{example}.py left {', '.join(others)} in examples/: write outputs other than "
@@ -95,13 +98,18 @@ def written_pictures(block, block_vars, gallery_conf) -> str:
             shown.append(dest)
             names.append(name)
             continue
-        PAGES_DIR.mkdir(parents=True, exist_ok=True)
-        served = f"sphx_glr_{example}_{src.stem}{suffix}"        # at the site's root, beside no page of it
+        if suffix in PAGES:
+            served = f"sphx_glr_{example}_{src.stem}{suffix}"    # at the site's root, beside no page of it
+        else:
+            served = f"sphx_glr_{example}_files/{name}"         # a model and its script keep the names they know
+        (PAGES_DIR / served).parent.mkdir(parents=True, exist_ok=True)
         shutil.move(src, PAGES_DIR / served)
         if suffix in PAGES:
             rst += (f"\n.. raw:: html\n\n    <iframe class=\"written-page\" src=\"../{served}\" title=\"{name}\" "
-                    f"width=\"100%\" height=\"800\" loading=\"lazy\"></iframe>\n"
+                    f"width=\"100%\" height=\"960\" loading=\"lazy\" allow=\"fullscreen\"></iframe>\n"
                     f"    <p><a href=\"../{served}\">{name} on its own</a> (full window)</p>\n\n")
+        elif name.endswith(SCRIPTS):
+            rst += f"\nIts Blender script: `{name} <../{served}>`__ (``blender --python {name}``).\n\n"
         else:
             rst += f"\nThe model: `{name} <../{served}>`__ ({(PAGES_DIR / served).stat().st_size / 1e3:.0f} kB).\n\n"
     # the alt text: the file names the example wrote (dast_cube_compare.png)

@@ -3,20 +3,24 @@ Turn the crystal yourself
 =========================
 
 ``spinviz.render`` writes a scene as a glTF model (``.glb``) or as one self-contained web
-page (``.html``) instead of a video: both models side by side, turnable in the browser, with
-a Play button and a slider on the video's clock (marked in Θ, with the video's captions and
-its honesty line).  The poses are the video's: the model holds the video's own frames as
-keyframes, and between them its interpolation stays within 0.25° of every frame.  The page
-has its viewer (three.js) inside and loads nothing from the network.
+page (``.html``) instead of a video.  The page is for people: one sentence on what the two
+crystals are, each turnable under its heading (one above the other on a phone), Play and a
+slider in days, labels on the arrows, full screen, the captions in plain words -- and its
+viewer (three.js, MIT licence, printed at its foot) inside it, so it loads nothing from the
+network.  The model is for Blender and the web: the video's camera and lights, its clock,
+and beside it a Blender script that plays it whole at the video's rate.  Both show the
+video's own frames: between the kept ones a viewer's interpolation stays within 0.25° of
+every frame.
 
-Below, the README's scene: the DAST cube, reduced (left) and truncated (right), over 6 Θ.
-Drag to turn both crystals, scroll to zoom.
+Below, the README's scene: the DAST cube, reduced and truncated, over 6 Θ.  Drag to turn
+both crystals, scroll to zoom.
 """
 
 # %%
-# The page, shown in a frame; and the model, which imports into Blender, three.js or any
-# glTF viewer (both crystals with the dipole and L arrows, animated on the video's clock,
-# the physical time of every keyframe in its ``extras``).
+# The page, shown in a frame; and the model, which imports into Blender (``blender --python
+# dast_cube_blender.py`` opens it at 30 fps, frames 0-359, through its camera), three.js or
+# any glTF viewer -- both crystals with the dipole and L arrows, the physical time of every
+# keyframe in its ``extras``.
 import matplotlib.pyplot as plt
 
 import spinviz
@@ -27,8 +31,8 @@ model = spinviz.render("../scenes/default.toml", out="dast_cube.glb")
 print(model.describe())
 
 # %%
-# The video's first frame, the pose the page opens on (``spinviz.render_frame``; the page
-# draws it with three.js, the video with VTK).
+# The video's first frame, the pose the page opens on (``spinviz.render_frame``: the video's
+# frame at a time of the run; the page draws it with three.js, the video with VTK).
 img = spinviz.render_frame("../scenes/default.toml", t=0.0, size=(640, 360))
 fig = plt.figure(figsize=(6.4, 3.6), dpi=100)
 ax = fig.add_axes((0, 0, 1, 1))

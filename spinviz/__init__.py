@@ -15,6 +15,7 @@ The public API (see the README's "Python" section)::
     spinviz.render("scenes/default.toml", out="renders/default.mp4")
     c = spinviz.compare("scenes/default.toml")                                 # the two models side by side
     obs = spinviz.observe("scenes/dast_cube.toml", distance_cm=20)              # what a receiver records
+    spinviz.show(sc)                                                            # turnable, inline in Jupyter
 
 Importing the package is light: every name loads its module on first use (PEP 562), and
 nothing here imports numba, pyvista, vtk or imageio.  No public name is also a submodule
@@ -35,6 +36,7 @@ _API = {
     "Trajectory": ("trajectory", "Trajectory"),
     "render": ("pipeline", "render"),
     "render_frame": ("pipeline", "render_frame"),
+    "show": ("notebook", "show"),
     "Renderer": ("pipeline", "Renderer"),
     "Body": ("physics.bodies", "Body"),
     "symmetric_top": ("physics.bodies", "symmetric_top"),
@@ -55,7 +57,8 @@ _API = {
 }
 _SUBMODULES = {
     "units", "rotations", "errors", "atomic", "plotting", "presentation", "physics", "integrators", "inputs", "driver",
-    "trajectory", "rendering", "pipeline", "executors", "experiment", "analysis", "validation", "regimes", "commands",
+    "trajectory", "rendering", "pipeline", "notebook", "executors", "experiment", "analysis", "validation", "regimes",
+    "commands",
 }
 
 __all__ = sorted(_API) + ["__version__"]

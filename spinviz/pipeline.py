@@ -21,7 +21,7 @@ from .inputs.scene_spec import Scene, load_scene
 from .rendering.timeline import FramePlan, frame_times, plan_frames
 from .trajectory import Trajectory
 
-__all__ = ["render", "render_frame", "Renderer", "plan", "require_render_stack", "default_output"]
+__all__ = ["render", "render_frame", "frame_at", "Renderer", "plan", "require_render_stack", "default_output"]
 
 OPTIONAL_RENDER_MODULES = {"pyvista", "vtk", "vtkmodules", "imageio", "imageio_ffmpeg", "PIL"}
 MAX_STORED_TURN = np.pi / 2         # slerp between stored orientations needs neighbours closer than this
@@ -234,12 +234,23 @@ class Renderer:
         self.close()
 
 
-def render_frame(source: Source, t: float | None = None, *, size=(640, 360), **overrides) -> np.ndarray:
-    """The picture at physical time ``t`` as an RGB array, shape (H, W, 3), uint8.
+def frame_at(plan: FramePlan, t: float) -> int:
+    """The frame of ``plan`` that shows simulation time ``t`` (scene time unit): the one whose
+    place on the video's time map is nearest t (t = 0 the first frame, the plan's end the last)."""
+    s = plan.spec.video_fraction(float(t), plan.t_end)
+    return int(min(max(round(s * (plan.frames - 1)), 0), plan.frames - 1))
 
-    ``t = 0`` is the first frame of the video (the start, nothing before it); a later ``t``
-    is the last frame of the video of [0, t] (the trail and, for a slowed spin, the shown
-    phase depend on what came before).  Shows nicely in Jupyter with
+
+def render_frame(source: Source, t: float | None = None, *, size=(640, 360), **overrides) -> np.ndarray:
+    """The video's frame at physical time ``t`` as an RGB array, shape (H, W, 3), uint8.
+
+    The video is the source's own -- its plan over the whole run, with its duration, frame
+    rate, time map and spin slowdown: the video ``render`` writes, and the one the glTF model
+    and the page animate -- and the frame is the one that shows ``t``, the frame whose place
+    on the time map is nearest t (``frame_at``; ``t = 0`` the first frame, the end of the
+    run the last).  So a slowed spin shows the same phase here as in the video, the model and
+    the page.  (The last frame of a shorter video, one that ends at t, is ``r.frame(r.frames
+    - 1)`` of ``r = Renderer(source, t_end=t)``.)  Shows nicely in Jupyter with
     ``PIL.Image.fromarray(img)`` or ``matplotlib.pyplot.imshow(img)``.
 
     Parameters
@@ -247,19 +258,19 @@ def render_frame(source: Source, t: float | None = None, *, size=(640, 360), **o
     source : Scene, path, Trajectory or list of one or two Trajectories
     t : float, optional
         Simulation time (the trajectory's, scene time unit) in [0, end of the run]; default
-        the end of the run.  (A video's own end is ``Renderer(t_end=...)``.)
+        the end of the run.
     size : (int, int)
         (width, height) px.
     **overrides
-        ``RenderSpec`` fields.
+        ``RenderSpec`` fields (duration, fps and the time map change which frame shows t).
     """
     t = RenderArguments(t=t).t
     scene, trajs = _as_source(source)
     t = _within("t", t, _horizon(scene, trajs), start_open=False)
     if isinstance(size, list):
         size = tuple(size)
-    with Renderer(scene if scene is not None else trajs, t_end=None if t == 0.0 else t, size=size, **overrides) as r:
-        return r.frame(0 if t == 0.0 else r.frames - 1)
+    with Renderer(scene if scene is not None else trajs, size=size, **overrides) as r:
+        return r.frame(frame_at(r.plan, t))
 
 
 def render(source: Source, out: str | None = None, *, size=None, fps=None, duration=None, workers=None,
@@ -302,8 +313,10 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
     spec.check_output(out, len(scene.models) if scene is not None else len(trajs))
     inputs = [scene.path] if scene is not None and os.path.exists(scene.path) else []
     if os.path.splitext(os.fspath(out))[1].lower() in MODEL_FORMATS:
-        # an animated glTF model or the page that shows it: the same plan, no drawing stack
-        check_outputs([out], inputs)
+        # an animated glTF model (and its Blender script) or the page that shows it: the same plan, no drawing stack
+        from .rendering.blender import script_path
+
+        check_outputs([out] + ([] if os.fspath(out).lower().endswith(".html") else [script_path(out)]), inputs)
         import importlib.util
 
         if importlib.util.find_spec("pygltflib") is None:

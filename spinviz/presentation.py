@@ -21,12 +21,14 @@ class ModelStyle:
     line : (matplotlib line style, width) in the plots (both visible where two models coincide).
     heading : {"outreach": (name, equations), "physics": (name, equations)} over a panel.
     subtitle : {"outreach": ..., "physics": ...}: what the model predicts in general, one line.
+    phrase : the model in a sentence for people ("the reduced equation").
     """
 
     color: tuple[int, int, int]
     line: tuple[str, float]
     heading: dict
     subtitle: dict
+    phrase: str = ""
 
 
 STYLES = {
@@ -34,16 +36,19 @@ STYLES = {
         color=(0, 128, 128), line=("-", 2.4),
         heading={"outreach": ("Reduced equation", "(2.2)+(2.3)"), "physics": ("reduced", "(2.2)+(2.3)")},
         subtitle={"outreach": "radiation slows the tumbling; a spin about the dipole can last",
-                  "physics": "Ω̇, Ω̈ in the torque taken from the free motion"}),
+                  "physics": "Ω̇, Ω̈ in the torque taken from the free motion"},
+        phrase="the reduced equation"),
     "truncated": ModelStyle(
         color=(136, 60, 180), line=("--", 1.7),
         heading={"outreach": ("Truncated equation", "(2.5)"), "physics": ("truncated", "(2.5)")},
         subtitle={"outreach": "radiation slows every rotation, all the way to rest",
-                  "physics": "textbook torque without the Schott-like term"}),
+                  "physics": "textbook torque without the Schott-like term"},
+        phrase="the truncated equation"),
     "free": ModelStyle(
         color=(120, 120, 120), line=(":", 1.7),
         heading={"outreach": ("No radiation", "(2.3a)"), "physics": ("free", "d = 0")},
-        subtitle={"outreach": "no braking: the top turns freely", "physics": "torque-free Euler top"}),
+        subtitle={"outreach": "no braking: the top turns freely", "physics": "torque-free Euler top"},
+        phrase="no braking at all"),
 }
 
 # what a name without a row gets (a model registered in a session without its presentation)

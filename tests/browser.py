@@ -49,3 +49,29 @@ def page_text(page: Path, tmp_path: Path, fragment: str = "") -> tuple[str, str]
     text = re.sub(r"</?(?:p|div|dt|dd|li|h[1-6]|br|td|th|pre|section|nav|header|footer)\b[^>]*>", " ", text)
     text = html.unescape(re.sub(r"<[^>]+>", "", text))          # inline markup: no space added
     return dom, re.sub(r"\s+", " ", text)
+
+
+def page_requests(netlog: Path) -> list[str]:
+    """The URLs a page asked the network for, read from Chromium's ``--log-net-log`` file: the
+    requests with an initiator (a page: "null" for a file's opaque origin), not Chromium's own
+    background ones ("not an origin")."""
+    import json
+
+    d = json.loads(netlog.read_text())
+    start = d["constants"]["logEventTypes"]["URL_REQUEST_START_JOB"]
+    return [e["params"]["url"] for e in d["events"] if e["type"] == start and "url" in (e.get("params") or {})
+            and e["params"].get("initiator") != "not an origin"]
+
+
+def framed(page: Path, tmp_path: Path, width: int, height: int = 900) -> Path:
+    """A page that shows ``page`` in an iframe ``width`` x ``height`` CSS px and prints, in its
+    ``<pre id="out">``, the last message the framed page posted to it.  Headless Chromium's
+    window is at least 500 px wide, so a phone's 360 px viewport is an iframe's."""
+    harness = tmp_path / f"frame-{width}-{page.name}"
+    harness.write_text(
+        '<!DOCTYPE html><html><head><meta charset="utf-8"></head><body style="margin:0">'
+        f'<iframe src="{page.name}" width="{width}" height="{height}" style="border:0;display:block"></iframe>'
+        '<pre id="out"></pre><script>window.addEventListener("message", '
+        '(e) => { document.getElementById("out").textContent = String(e.data); });</script></body></html>')
+    assert harness.parent == page.parent
+    return harness

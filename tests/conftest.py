@@ -110,3 +110,25 @@ def observed_cube():
     obs, trajs = OB.run_scene(load_scene(ROOT / "scenes" / "dast_cube.toml"), samples=800)
     obs.trajectories = trajs
     return obs
+
+
+@pytest.fixture(scope="session")
+def askew(tmp_path_factory):
+    """The glTF and page tests' scene (``media.write_scene``: an askew top, both models, true
+    spin, 180 frames), made once: ``scene`` its file, ``plan`` its frame plan, ``glb`` the model
+    ``spinviz.render`` writes (with ``askew_blender.py`` beside it), ``page`` the page written
+    from the plan by ``rendering.export`` (its own keyframes and model)."""
+    import spinviz
+    from spinviz import pipeline
+    from spinviz.rendering.export import export
+
+    from media import write_scene
+
+    d = tmp_path_factory.mktemp("askew")
+    scene = write_scene(d / "askew.toml")
+    glb = d / "askew.glb"
+    res = spinviz.render(str(scene), out=str(glb))
+    plan = pipeline.plan(str(scene))
+    page = d / "askew.html"
+    export(plan, str(page))
+    return SimpleNamespace(scene=scene, plan=plan, glb=glb, page=page, result=res)

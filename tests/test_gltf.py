@@ -1,23 +1,20 @@
-"""The animated glTF model (.glb, .gltf) and the page that shows it (.html).
+"""The animated glTF model (.glb, .gltf) and the Blender script beside it.
 
 Faithful to the video: the keyframes are the video's own frames, at which the file holds the
-pose the video draws (render_frame's, to 1e-6 rad after float32); between them the viewers'
-slerp stays within the stated angle of every frame.  The .glb passes the Khronos validator
-(npm gltf-validator, installed by .ci/run); the page, opened by headless Chromium from a
-file with no network, draws both crystals and, with its slider set, shows the run's pose.
+pose the video draws (to 1e-6 rad after float32); between them both a viewer's slerp and
+Blender's component-wise interpolation stay within the stated angle at every frame, each
+frame at its time on the MP4's clock (f / fps), which is the clock the extras state.  The
+file's one camera sees each model from the video's direction, side by side; the video's
+lights ride on it; the axes and the cage are thin geometry; every name is unique and
+carries its model.  The Khronos validator (npm gltf-validator, installed by .ci/run) passes
+it with no error and no warning.  (The page: test_page.py; Blender itself: test_blender.py.)
 """
 
 from __future__ import annotations
 
-import base64
-import hashlib
+import ast
 import json
 import math
-import os
-import re
-import shutil
-import subprocess
-from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -27,85 +24,79 @@ import spinviz
 from spinviz import pipeline
 from spinviz import rotations as R
 from spinviz.commands import main
-from spinviz.rendering import gltf, keyframes
-from spinviz.rendering.stage import arrow_length
+from spinviz.rendering import blender, framing, gltf, keyframes
+from spinviz.rendering.stage import arrow_length, content_points
 from spinviz.rendering.style import ARROWS
 
-from tomlgen import value
+from media import ROOT, accessor, channel, componentwise, load, validate, world_matrices, wxyz
 
-ROOT = Path(__file__).resolve().parents[1]
-VALIDATOR_DIR = ROOT / ".ci" / "node"
-TITLE = 'Askew top <b>bold</b> & "quoted" </script>'
-
-
-def write_scene(path: Path, title: str = TITLE, **render) -> Path:
-    """A dimensionless askew top, both models, shown in true spin (about 14 deg a frame)."""
-    r = {"duration": 6.0, "fps": 30, "size": [640, 360], "spin": "true", "title": title,
-         "show": ["body", "dipole", "omega", "L", "axes", "sphere", "hud"], **render}
-    path.write_text(
-        "[body]\ndelta = 0.3\nchi = 0.7\n"
-        "[initial]\nomega = [0.0, 0.05, 0.3]\neuler_zxz = [0.0, 1.5707963267948966, 0.0]\n"
-        "[simulation]\nmodels = [\"reduced\", \"truncated\"]\nt_end = 300.0\nsamples = 400\n"
-        "[render]\n" + "".join(f"{k} = {value(v) if not isinstance(v, list) else json.dumps(v)}\n" for k, v in r.items()))
-    return path
+MODELS = ("reduced", "truncated")
 
 
 @pytest.fixture(scope="module")
-def scene(tmp_path_factory) -> Path:
-    return write_scene(tmp_path_factory.mktemp("gltf") / "askew_true.toml")
+def scene(askew):
+    return askew.scene
 
 
 @pytest.fixture(scope="module")
-def plan(scene):
-    return pipeline.plan(str(scene))
+def plan(askew):
+    return askew.plan
 
 
 @pytest.fixture(scope="module")
-def glb(scene, tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("glb") / "askew.glb"
-    res = spinviz.render(str(scene), out=str(out))
+def glb(askew):
+    out, res = askew.glb, askew.result
     assert res.path == str(out) and res.format == "glb" and res.bytes == out.stat().st_size
+    assert res.script == str(out.with_name("askew_blender.py"))
     return out
+
+
+@pytest.fixture(scope="module")
+def model(glb):
+    return load(glb)
 
 
 # --- keyframes ------------------------------------------------------------------------------
 @pytest.mark.slow
 def test_keyframes_are_video_frames_within_the_stated_angle(plan):
     """Every keyframe is one of the video's frames holding exactly its pose; slerp between them
-    (rotations.slerp_series, an implementation apart from the chooser's) stays within the
-    tolerance at every frame, for the body and the L and Omega arrows; consecutive keyframes
-    are sign-aligned and under a quarter turn apart; fewer keyframes than frames, more for a
-    tighter tolerance."""
+    (rotations.slerp_series, an implementation apart from the chooser's) and the component-wise
+    interpolation (Blender's) stay within the tolerance at every frame, for the body and the
+    L and Omega arrows; consecutive keyframes are sign-aligned and under a quarter turn apart;
+    fewer keyframes than frames, more for a tighter tolerance."""
     assert plan.spin_mode == "true" and plan.frames == 180
     kf = keyframes.choose(plan)
     f = kf.frame
+    clock = np.arange(plan.frames) / plan.spec.fps
     assert f[0] == 0 and f[-1] == plan.frames - 1 and np.all(np.diff(f) > 0)
     assert 10 < kf.count < plan.frames
+    np.testing.assert_array_equal(kf.video_t, clock[f])
     tol = math.radians(keyframes.TOLERANCE_DEG)
     x = np.array([1.0, 0.0, 0.0])
     for panel, keys in zip(plan.panels, kf.panels):
         assert np.max(R.misorientation(keys.q, panel.q[f])) < 1e-12
-        between = R.slerp_series(kf.video_t, keys.q, plan.video_t)
-        err = R.misorientation(between, panel.q)
-        assert np.max(err) <= tol + 1e-12 and np.max(err) > 0.3 * tol         # used, not wasted
+        for between in (R.slerp_series(kf.video_t, keys.q, clock), componentwise(kf.video_t, keys.q, clock)):
+            err = R.misorientation(between, panel.q)
+            assert np.max(err) <= tol + 1e-12 and np.max(err) > 0.3 * tol         # used, not wasted
         for q in (keys.q, *(a[0] for a in keys.arrows.values())):
             assert np.all(np.sum(q[1:] * q[:-1], axis=1) >= 0.0)
             assert np.max(R.misorientation(q[1:], q[:-1])) < keyframes.MAX_STEP < 0.5 * math.pi
         for key, vec in (("L", panel.L_world), ("omega", panel.omega_world)):
             qa, ln = keys.arrows[key]
             assert np.max(R.angle_between(R.world_from_body(qa, x), vec[f])) < 1e-12
-            direction = R.world_from_body(R.slerp_series(kf.video_t, qa, plan.video_t), x)
-            assert np.max(R.angle_between(direction, vec)) <= tol + 1e-12
+            for between in (R.slerp_series(kf.video_t, qa, clock), componentwise(kf.video_t, qa, clock)):
+                assert np.max(R.angle_between(R.world_from_body(between, x), vec)) <= tol + 1e-12
             lengths = np.array([arrow_length(key, float(v)) for v in np.linalg.norm(vec, axis=1)])
-            assert np.max(np.abs(np.interp(plan.video_t, kf.video_t, ln) - lengths)) <= keyframes.LENGTH_TOLERANCE + 1e-12
+            assert np.max(np.abs(np.interp(clock, kf.video_t, ln) - lengths)) <= keyframes.LENGTH_TOLERANCE + 1e-12
+    assert max(kf.max_error, kf.max_error_componentwise) <= tol
     assert keyframes.choose(plan, 0.05).count > kf.count
 
 
-def _spinning_plan(deg_per_frame: float, frames: int = 7):
+def _spinning_plan(deg_per_frame: float, frames: int = 7, fps: int = 6):
     """A bare plan: one body turning about z at a fixed angle per frame (no arrows)."""
     ang = np.radians(deg_per_frame) * np.arange(frames)
     q = np.c_[np.cos(ang / 2), np.zeros(frames), np.zeros(frames), np.sin(ang / 2)]
-    spec = SimpleNamespace(show=("body",), duration=1.0, time_map="linear")
+    spec = SimpleNamespace(show=("body",), duration=1.0, time_map="linear", fps=fps)
     panel = SimpleNamespace(model="free", q=q, L_world=None, omega_world=None)
     vt = np.linspace(0.0, 1.0, frames)
     return SimpleNamespace(panels=[panel], video_t=vt, sim_t=10.0 * vt, spec=spec, t_end=10.0, frames=frames)
@@ -113,8 +104,8 @@ def _spinning_plan(deg_per_frame: float, frames: int = 7):
 
 def test_frames_a_half_turn_apart_get_slerp_midpoints():
     """An aliased spin of 120 deg a frame: midpoints (frame -1, on the slerp path between the
-    two frames, their time on the time map) keep every step under MAX_STEP (40 deg steps); the
-    frames themselves stay exact."""
+    two frames, their time on the MP4's clock and their physical time on the time map) keep
+    every step under MAX_STEP (40 deg steps); the frames themselves stay exact."""
     p = _spinning_plan(120.0)
     kf = keyframes.choose(p)
     q = kf.panels[0].q
@@ -123,75 +114,221 @@ def test_frames_a_half_turn_apart_get_slerp_midpoints():
     real = kf.frame >= 0
     assert list(kf.frame[real]) == list(range(p.frames)) and (~real).sum() == 2 * (p.frames - 1)      # 40 deg steps
     assert np.max(R.misorientation(q[real], p.panels[0].q)) < 1e-12
-    np.testing.assert_allclose(kf.sim_t, 10.0 * kf.video_t, rtol=1e-12)
+    np.testing.assert_allclose(kf.position[~real] % 1.0, np.tile([1 / 3, 2 / 3], p.frames - 1), rtol=1e-12)
+    np.testing.assert_allclose(kf.video_t, kf.position / 6.0, rtol=1e-15)
+    np.testing.assert_allclose(kf.sim_t, 10.0 * kf.position / (p.frames - 1), rtol=1e-12)
     # a steady 12 deg a frame is one slerp: only MAX_STEP asks for keyframes between the ends (every 48 deg)
     assert list(keyframes.choose(_spinning_plan(12.0, 13)).frame) == [0, 4, 8, 12]
 
 
+def test_componentwise_interpolation_is_held_to_the_tolerance_too():
+    """A steady 8 deg a frame over 48 deg: slerp from the first frame to the last redraws every
+    frame exactly, but the four numbers interpolated one by one and normalized run off slerp's
+    timing mid-way (by ~0.14 deg) -- within 0.25 deg one span holds, within 0.004 deg it does
+    not, although slerp alone would still take it."""
+    p = _spinning_plan(8.0, 7)
+    both = keyframes.choose(p, 0.25)
+    assert list(both.frame) == [0, 6] and both.max_error < 1e-9 and 0.0 < both.max_error_componentwise < math.radians(0.25)
+    tight = keyframes.choose(p, 0.004)             # slerp alone would still take one span
+    assert tight.count > 2 and tight.max_error_componentwise <= math.radians(0.004)
+
+
 # --- the glTF file --------------------------------------------------------------------------
-def _accessor(g, blob: bytes, i: int) -> np.ndarray:
-    a = g.accessors[i]
-    v = g.bufferViews[a.bufferView]
-    width = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[a.type]
-    assert a.componentType == gltf.FLOAT
-    data = np.frombuffer(blob, dtype="<f4", count=a.count * width, offset=v.byteOffset + (a.byteOffset or 0))
-    return data.reshape(a.count, width) if width > 1 else data
-
-
-def test_glb_reread_holds_the_videos_poses(glb, plan):
+def test_glb_reread_holds_the_videos_poses(model, plan):
     """Reread with pygltflib: the body's rotation keyframes (x, y, z, w) are the video's poses
-    at the keyframe frames to 1e-6 rad; their times are those frames' video seconds, the
-    extras give each one's physical time; slerp between them stays within the stated bound at
-    every frame; the L arrow's rotation, shaft scale and head offset give the video's arrow;
-    each model's 'world' node turns spinviz's +z into glTF's +y; the two models stand side by side."""
-    import pygltflib
-
-    g = pygltflib.GLTF2().load(str(glb))
-    blob = g.binary_blob()
+    at the keyframe frames to 1e-6 rad; slerp and component-wise interpolation between them
+    stay within the stated bound at every frame's time f / fps; the L arrow's rotation, shaft
+    scale and head offset give the video's arrow; each model's 'world' node turns spinviz's +z
+    into glTF's +y."""
+    g, blob = model
     nodes = {n.name: n for n in g.nodes}
     anim = g.animations[0]
     frames = np.array(anim.extras["video_frame"])
+    assert np.all(frames >= 0)                          # true spin at 14 deg a frame: no midpoints
     tol = math.radians(g.scenes[0].extras["spinviz"]["keyframes"]["tolerance_deg"])
     assert tol == pytest.approx(math.radians(keyframes.TOLERANCE_DEG))
-    np.testing.assert_allclose(anim.extras["physical_time"], plan.sim_t[frames], rtol=1e-15)
-
-    def channel(node_name, path):
-        idx = g.nodes.index(nodes[node_name])
-        ch = next(c for c in anim.channels if c.target.node == idx and c.target.path == path)
-        s = anim.samplers[ch.sampler]
-        assert s.interpolation == "LINEAR"
-        return _accessor(g, blob, s.input), _accessor(g, blob, s.output)
-
+    clock = np.arange(plan.frames) / plan.spec.fps
     x = np.array([1.0, 0.0, 0.0])
-    for k, panel in enumerate(plan.panels):
-        t, q_xyzw = channel(f"{panel.model} body", "rotation")
-        q = np.c_[q_xyzw[:, 3], q_xyzw[:, :3]].astype(float)
-        np.testing.assert_allclose(t, plan.video_t[frames], rtol=1e-7, atol=1e-7)
-        assert np.max(R.misorientation(R.normalize(q), panel.q[frames])) < 1e-6
-        assert np.max(R.misorientation(R.slerp_series(t, R.normalize(q), plan.video_t), panel.q)) < tol + 1e-6
-        _, qa = channel(f"{panel.model} L", "rotation")
-        qa = R.normalize(np.c_[qa[:, 3], qa[:, :3]].astype(float))
+    for panel in plan.panels:
+        t, q_xyzw = channel(g, blob, f"{panel.model} body", "rotation")
+        q = R.normalize(wxyz(q_xyzw))
+        assert np.max(R.misorientation(q, panel.q[frames])) < 1e-6
+        assert np.max(R.misorientation(R.slerp_series(t, q, clock), panel.q)) < tol + 1e-6
+        assert np.max(R.misorientation(componentwise(t.astype(float), q, clock), panel.q)) < tol + 1e-6
+        _, qa = channel(g, blob, f"{panel.model} L arrow", "rotation")
+        qa = R.normalize(wxyz(qa))
         assert np.max(R.angle_between(R.world_from_body(qa, x), panel.L_world[frames])) < 1e-6
-        _, scale = channel(f"{panel.model} L shaft", "scale")
-        _, shift = channel(f"{panel.model} L head", "translation")
+        _, scale = channel(g, blob, f"{panel.model} L shaft", "scale")
+        _, shift = channel(g, blob, f"{panel.model} L head", "translation")
         want = np.array([arrow_length("L", float(v)) for v in np.linalg.norm(panel.L_world[frames], axis=1)])
         np.testing.assert_allclose(scale[:, 0] + ARROWS["L"][1], want, atol=1e-6)
         np.testing.assert_allclose(shift[:, 0] + ARROWS["L"][1], want, atol=1e-6)
         world = nodes[f"{panel.model} world (spinviz z up)"]
-        wq = np.array([world.rotation[3], *world.rotation[:3]])
-        np.testing.assert_allclose(R.world_from_body(wq, [0.0, 0.0, 1.0]), [0.0, 1.0, 0.0], atol=1e-12)
-        assert nodes[panel.model].translation == [gltf.model_offsets(2)[k], 0.0, 0.0]
-    assert nodes["reduced"].translation[0] - nodes["truncated"].translation[0] == -gltf.SPACING
+        np.testing.assert_allclose(R.world_from_body(wxyz(world.rotation), [0.0, 0.0, 1.0]), [0.0, 1.0, 0.0], atol=1e-12)
+
+
+def test_extras_clock_is_the_keyframes_own(model, plan):
+    """The extras' clock is the one the keyframes keep: every keyframe's time is float32(f /
+    fps) exactly, f its video frame; the stated map gives its physical time, and the last
+    frame's time is the stated end of the clock."""
+    g, blob = model
+    ex = g.scenes[0].extras["spinviz"]["clock"]
+    anim = g.animations[0]
+    times = accessor(g, blob, anim.samplers[0].input)
+    frames = np.array(anim.extras["video_frame"])
+    fps, F = ex["fps"], ex["video_frames"]
+    assert (fps, F) == (plan.spec.fps, plan.frames) and ex["last_frame_s"] == (F - 1) / fps
+    np.testing.assert_array_equal(times, (frames / fps).astype(np.float32))
+    np.testing.assert_array_equal(np.array(anim.extras["frame_position"]), frames)
+    assert ex["map"] == f"t = t_end * f / {F - 1}" and ex["time_map"] == "linear"
+    np.testing.assert_allclose(anim.extras["physical_time"], ex["physical_time_end"] * frames / (F - 1), rtol=1e-12)
+    assert all(s.input == anim.samplers[0].input for s in anim.samplers)           # one clock for every channel
+    blender_ex = g.scenes[0].extras["spinviz"]["blender"]
+    assert (blender_ex["fps"], blender_ex["frame_start"], blender_ex["frame_end"]) == (fps, 0, F - 1)
+
+
+def test_names_are_unique_and_carry_their_model(model):
+    """Nodes, meshes and materials: every name unique, each model's named after it; the camera
+    and its lights are the only other nodes; the two bodies' meshes share their geometry."""
+    g, _ = model
+    for items in (g.nodes, g.meshes, g.materials):
+        names = [x.name for x in items]
+        assert len(set(names)) == len(names) and all(names)
+    others = {gltf.CAMERA_NAME, "key light", "fill light", "head light"}
+    for items in (g.nodes, g.meshes, g.materials):
+        for x in items:
+            assert x.name in others or x.name.split(" ")[0] in MODELS, x.name
+    assert {m.name for m in g.materials} >= {"reduced body", "reduced body edges", "truncated body", "truncated body edges"}
+    bodies = [next(m for m in g.meshes if m.name == f"{k} body") for k in MODELS]
+    assert [p.attributes.POSITION for p in bodies[0].primitives] == [p.attributes.POSITION for p in bodies[1].primitives]
+    assert [p.material for p in bodies[0].primitives] != [p.material for p in bodies[1].primitives]
+
+
+def test_cage_and_axes_are_thin_geometry_that_renders(model):
+    """No line primitive: every primitive is triangles; the cage's and the axes' are unlit
+    (KHR_materials_unlit, double-sided) tubes within ``LINE_RADIUS`` of the unit sphere's
+    circles and of the axes."""
+    g, blob = model
+    assert all(p.mode == 4 for m in g.meshes for p in m.primitives)
+    assert "KHR_materials_unlit" in g.extensionsUsed
+    for name in ("reduced unit sphere", "reduced axes"):
+        (prim,) = next(m for m in g.meshes if m.name == name).primitives
+        mat = g.materials[prim.material]
+        assert "KHR_materials_unlit" in mat.extensions and mat.doubleSided
+        pts = accessor(g, blob, prim.attributes.POSITION).astype(float)
+        tris = accessor(g, blob, prim.indices).reshape(-1, 3)
+        assert tris.shape[0] >= pts.shape[0] and tris.max() < pts.shape[0]
+        if name.endswith("sphere"):
+            # the circles lie on the unit sphere: latitudes at 0, +-30, +-60 deg, meridians through the poles
+            r = np.linalg.norm(pts, axis=1)
+            assert np.all(np.abs(r - 1.0) < 1.01 * gltf.LINE_RADIUS) and 2000 < pts.shape[0] < 4000
+        else:
+            off = np.sort(np.abs(pts), axis=1)[:, :2]            # distance from the nearest axis, per component
+            assert np.all(np.linalg.norm(off, axis=1) <= 1.01 * gltf.LINE_RADIUS)
+
+
+def test_camera_sees_each_model_from_the_videos_direction_side_by_side(model, plan):
+    """The scene's one camera, composed from the file's own transforms: each model's origin
+    seen from the video's view direction (azimuth_deg, elevation_deg) in that model's spinviz
+    world, to 1e-9; every point any frame draws inside the picture, each model in its own half;
+    both the same size, at the same height (mirror images in the picture)."""
+    g, _ = model
+    cams = [i for i, n in enumerate(g.nodes) if n.camera is not None]
+    assert len(cams) == 1 and cams[0] in g.scenes[0].nodes
+    cam = g.cameras[g.nodes[cams[0]].camera]
+    W, H = plan.spec.size
+    assert cam.type == "perspective" and cam.perspective.aspectRatio == pytest.approx(W / H)
+    world = world_matrices(g)
+    C = world[cams[0]]
+    az, el = math.radians(plan.spec.azimuth_deg), math.radians(plan.spec.elevation_deg)
+    view = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+    pts = content_points(plan)
+    t = math.tan(0.5 * cam.perspective.yfov)
+    boxes = []
+    for k, name in enumerate(MODELS):
+        M = world[next(i for i, n in enumerate(g.nodes) if n.name == f"{name} world (spinviz z up)")]
+        to_cam = np.linalg.inv(M[:3, :3]) @ (C[:3, 3] - M[:3, 3])          # in the model's spinviz world
+        np.testing.assert_allclose(to_cam / np.linalg.norm(to_cam), view, atol=1e-9)
+        p = (np.linalg.inv(C) @ (M @ np.c_[pts, np.ones(len(pts))].T))[:3].T        # camera frame: looks along -z
+        ndc = np.c_[p[:, 0] / (-p[:, 2] * t * cam.perspective.aspectRatio), p[:, 1] / (-p[:, 2] * t)]
+        assert np.all(np.abs(ndc) < 1.0)
+        assert np.all(ndc[:, 0] < 0) if k == 0 else np.all(ndc[:, 0] > 0)
+        boxes.append((ndc.min(axis=0), ndc.max(axis=0)))
+    (lo0, hi0), (lo1, hi1) = boxes
+    np.testing.assert_allclose(hi0 - lo0, hi1 - lo1, rtol=0.05)            # the same size
+    np.testing.assert_allclose([lo0[1], hi0[1]], [lo1[1], hi1[1]], atol=0.02)  # at the same height
+    assert 0.8 < max(np.max(np.abs(np.r_[lo0, hi0, lo1, hi1])), 0.0) < 1.0   # and filling the picture
+
+
+def test_lights_are_the_videos_riding_on_the_camera(model):
+    """KHR_lights_punctual: the video's key, fill and head lights, directional, children of the
+    camera; each shines from the video's direction in the camera's frame (key from the upper
+    left, head light along the view), at weight x pi x 683 lux (a Blender sun of weight x pi
+    W/m^2 lights a matte face to its colour x weight)."""
+    g, _ = model
+    assert "KHR_lights_punctual" in g.extensionsUsed
+    lights = g.extensions["KHR_lights_punctual"]["lights"]
+    cam = next(n for n in g.nodes if n.camera is not None)
+    kids = [g.nodes[i] for i in cam.children]
+    assert [n.name for n in kids] == ["key light", "fill light", "head light"]
+    for node, (name, direction, weight) in zip(kids, framing.SUN_STRENGTH):
+        light = lights[node.extensions["KHR_lights_punctual"]["light"]]
+        assert light["type"] == "directional" and light["name"] == name
+        assert light["intensity"] == pytest.approx(weight * math.pi * 683.0)
+        towards = R.world_from_body(wxyz(node.rotation), [0.0, 0.0, 1.0])      # a light shines along its -z
+        np.testing.assert_allclose(towards, np.asarray(direction) / np.linalg.norm(direction), atol=1e-7)
+    key = R.world_from_body(wxyz(kids[0].rotation), [0.0, 0.0, 1.0])
+    assert key[0] < 0 < key[1]                                                # upper left
 
 
 def test_cli_writes_what_the_api_writes(scene, glb, tmp_path, capsys):
     """`spinviz render SCENE --out X.glb` and spinviz.render(..., out=X.glb) write the same
-    bytes; the command says what it wrote and within what bound."""
-    out = tmp_path / "cli.glb"
+    bytes, and the same Blender script beside them; the command says what it wrote."""
+    out = tmp_path / "askew.glb"
     assert main(["render", str(scene), "--out", str(out)]) == 0
     assert out.read_bytes() == glb.read_bytes()
+    assert (tmp_path / "askew_blender.py").read_text() == glb.with_name("askew_blender.py").read_text()
     said = capsys.readouterr().out
     assert f"{out}: glTF model (binary)" in said and f"within {keyframes.TOLERANCE_DEG:g} deg of every frame" in said
+    assert "askew_blender.py opens it in Blender at 30 fps, frames 0-179, through its camera" in said
+
+
+def test_blender_script_holds_numbers_and_the_models_name_only(plan):
+    """The script is Python whose settings are literals: the model's file name (any name, even
+    one with quotes and a newline, stays one string literal), the rate, the range, the
+    camera, the frame size; nothing else varies with the scene."""
+    for name in ("askew.glb", 'a"b\'\n"""; import os; os.system("x") #.glb'):
+        text = blender.script(plan, f"/somewhere/{name}")
+        consts = {}
+        for n in ast.parse(text).body:
+            if isinstance(n, ast.Assign):
+                (target,) = n.targets
+                names = [target] if isinstance(target, ast.Name) else target.elts
+                values = [ast.literal_eval(n.value)] if isinstance(target, ast.Name) else ast.literal_eval(n.value)
+                consts.update((t.id, v) for t, v in zip(names, values))
+        assert consts["MODEL"] == name
+        assert consts["FPS"] == 30 and consts["FRAME_START"] == 0 and consts["FRAME_END"] == 179
+        assert consts["CAMERA"] == gltf.CAMERA_NAME and consts["RESOLUTION"] == (640, 360)
+        assert "os.system" not in text.replace(repr(name), "")
+    other = write_scene_plan_title_free(plan)
+    assert blender.script(plan, "x.glb") == blender.script(other, "x.glb")
+
+
+def write_scene_plan_title_free(plan):
+    """``plan`` with another title and subtitles (outside text the script must not carry)."""
+    from dataclasses import replace
+
+    return replace(plan, spec=plan.spec.with_(title="print('hi')", subtitles=("x\"y", "z")))
+
+
+def test_an_output_that_cannot_be_written_leaves_neither_file(scene, tmp_path, capsys):
+    """The model and its script land together: where the script's path is a directory, the
+    command refuses with one line naming it, before any work, and writes no model."""
+    (tmp_path / "m_blender.py").mkdir()
+    assert main(["render", str(scene), "--out", str(tmp_path / "m.glb")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "m_blender.py" in err and "directory" in err
+    assert not (tmp_path / "m.glb").exists()
 
 
 def test_outputs_refused_with_one_line(scene, tmp_path, capsys):
@@ -206,28 +343,19 @@ def test_outputs_refused_with_one_line(scene, tmp_path, capsys):
     assert not list(tmp_path.iterdir())
 
 
-def _validate(path: Path) -> dict:
-    node = shutil.which("node")
-    if node is None or not (VALIDATOR_DIR / "node_modules" / "gltf-validator").is_dir():
-        pytest.fail("the Khronos glTF validator is missing: npm install --prefix .ci/node gltf-validator@2.0.0-dev.3.10 "
-                    "(.ci/run does this)", pytrace=False)
-    r = subprocess.run([node, str(ROOT / "tests" / "gltf_validate.js"), str(VALIDATOR_DIR), str(path)],
-                       capture_output=True, text=True, timeout=60)
-    assert r.returncode == 0, r.stderr
-    return json.loads(r.stdout)
-
-
 @pytest.mark.slow                      # needs node and the validator, which .ci/run installs before its slow pass
 def test_khronos_validator_passes_glb_and_gltf(glb, scene, tmp_path):
     """No error, no warning from gltf-validator on the .glb and on the self-contained .gltf
-    (the same document, its buffer as a data URI)."""
+    (the same document, its buffer as a data URI) -- camera, lights and unlit materials
+    included."""
     embedded = tmp_path / "askew.gltf"
     spinviz.render(str(scene), out=str(embedded))
     for path in (glb, embedded):
-        issues = _validate(path)
+        issues = validate(path)
         assert issues["numErrors"] == 0 and issues["numWarnings"] == 0, issues["messages"][:5]
     doc = json.loads(embedded.read_text())
     assert doc["buffers"][0]["uri"].startswith("data:application/octet-stream;base64,")
+    assert set(doc["extensionsUsed"]) == {"KHR_lights_punctual", "KHR_materials_unlit"} and "cameras" in doc
 
 
 @pytest.mark.slow
@@ -244,97 +372,18 @@ def test_validator_catches_a_broken_file(glb, tmp_path):
     g.set_binary_blob(bytes(blob))
     bad = tmp_path / "bad.glb"
     g.save_binary(str(bad))
-    issues = _validate(bad)
+    issues = validate(bad)
     assert issues["numErrors"] >= 1 and any("NON_NORMALIZED_QUATERNION" in m["code"] for m in issues["messages"])
 
 
-# --- the page -------------------------------------------------------------------------------
-@pytest.fixture(scope="module")
-def page(scene, tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("page") / "askew.html"
-    res = spinviz.render(str(scene), out=str(out))
-    assert res.format == "html"
-    return out
-
-
-def check_csp(page: Path) -> str:
-    """The page's text, after checking: under 2 MB, every executable script inline and allowed
-    by its sha256 in the Content-Security-Policy, which allows nothing else (no remote load,
-    no inline handler), the style by its hash."""
-    text = page.read_text()
-    assert page.stat().st_size < 2_000_000
-    csp = re.search(r'<meta http-equiv="Content-Security-Policy" content="([^"]+)">', text).group(1)
-    assert "default-src 'none'" in csp and "unsafe" not in csp and "http" not in csp
-    scripts = re.findall(r"<script>(.*?)</script>", text, flags=re.S)
-    assert len(scripts) == 2
-    allowed = re.search(r"script-src ([^;]+)", csp).group(1).split()
-    assert sorted(allowed) == sorted("'sha256-" + base64.b64encode(hashlib.sha256(s.encode()).digest()).decode() + "'"
-                                     for s in scripts)
-    style = re.search(r"<style>(.*?)</style>", text, flags=re.S).group(1)
-    assert "'sha256-" + base64.b64encode(hashlib.sha256(style.encode()).digest()).decode() + "'" in csp
-    markup = re.sub(r"<script\b[^>]*>.*?</script>", "", text, flags=re.S)
-    assert not re.search(r"\son[a-z]+\s*=", markup)
-    return text
-
-
-def test_page_is_self_contained_under_its_csp(page, glb):
-    """One file under 2 MB under a hash-only CSP (``check_csp``); the title is text (escaped),
-    the data block cannot close its element; the model inside is the .glb, byte for byte."""
-    text = check_csp(page)
-    assert "<b>" not in re.sub(r"<script\b[^>]*>.*?</script>", "", text, flags=re.S)
-    assert "<title>Askew top &lt;b&gt;bold&lt;/b&gt; &amp; &quot;quoted&quot; &lt;/script&gt;</title>" in text
-    data = re.search(r'<script type="application/json" id="spinviz-data">(.*?)</script>', text, flags=re.S).group(1)
-    assert json.loads(data)["title"] == TITLE
-    b64 = re.search(r'<script type="application/octet-stream" id="spinviz-glb">(.*?)</script>', text, flags=re.S).group(1)
-    assert base64.b64decode("".join(b64.split())) == glb.read_bytes()
-
-
 @pytest.mark.slow                      # the validator: installed by .ci/run before its slow pass
-def test_committed_model_and_page(tmp_path):
-    """renders/dast_cube.glb passes the validator, and the committed page beside it (under
-    2 MB, its CSP right) carries that very model: both written by this code from
-    scenes/default.toml.  (The documentation site's page is written by its gallery.)"""
+def test_committed_model_and_script():
+    """renders/dast_cube.glb passes the validator with no error and no warning, carries its
+    camera and lights, and its Blender script beside it is the one this code writes for it."""
     glb = ROOT / "renders" / "dast_cube.glb"
-    issues = _validate(glb)
+    issues = validate(glb)
     assert issues["numErrors"] == 0 and issues["numWarnings"] == 0
-    text = check_csp(ROOT / "renders" / "dast_cube_turnable.html")
-    b64 = re.search(r'<script type="application/octet-stream" id="spinviz-glb">(.*?)</script>', text, flags=re.S).group(1)
-    assert base64.b64decode("".join(b64.split())) == glb.read_bytes()
-
-
-@pytest.mark.slow
-def test_page_in_chromium_turns_to_the_runs_pose(page, scene, plan, tmp_path):
-    """Headless Chromium, the page from a file, no network: both crystals are drawn (coloured
-    pixels in each half of the view); opened at #frame=N (the slider set to frame N) it shows,
-    for both models, render_frame's pose at that frame's time to 1e-6 rad (a keyframe) or
-    within the stated bound (a frame between keyframes); nothing is refused by the CSP.
-    Without WebGL it says so."""
-    from browser import CHROMIUM, WEBGL_FLAGS, chromium, page_text, screenshot
-
-    if CHROMIUM is None:
-        pytest.fail("the page test needs chromium (apt-get install chromium; .ci/run does this)", pytrace=False)
-    kf = keyframes.choose(plan)
-    key = int(kf.frame[len(kf.frame) // 2])
-    between = int(next(f for f in range(1, plan.frames) if f not in set(kf.frame.tolist())))
-    for f, bound in ((key, 1e-6), (between, math.radians(keyframes.TOLERANCE_DEG) + 1e-6)):
-        r = chromium(page, tmp_path, *WEBGL_FLAGS, "--enable-logging=stderr", "--v=0", "--dump-dom", fragment=f"frame={f}")
-        assert "Content Security Policy" not in r.stderr and "Uncaught" not in r.stderr, r.stderr[-2000:]
-        assert f'data-frame="{f}"' in r.stdout and 'class="ready"' in r.stdout
-        t = float(plan.sim_t[f])
-        drawn = pipeline.plan(str(scene), t_end=t)          # what render_frame(scene, t) draws
-        for k, panel in enumerate(drawn.panels):
-            shown = json.loads(re.search(rf'id="panel-{k}" data-pose="([^"]+)"', r.stdout).group(1))
-            assert R.misorientation(R.normalize(np.array(shown)), panel.q[-1]) < bound
-            if bound > 1e-6:
-                assert R.misorientation(R.normalize(np.array(shown)), panel.q[-1]) > 1e-6     # interpolated, not exact
-    img = screenshot(page, tmp_path, fragment=f"frame={key}", flags=WEBGL_FLAGS)
-    assert img.shape == (900, 1280, 3)
-    view = img[175:560].astype(int)                                    # below the headings, above the slider
-    body = (view.mean(axis=2) < 200) & (view[..., 0] - view[..., 2] > 15)  # the tan box, lit or shaded
-    assert body[:, :640].sum() > 5000 and body[:, 640:].sum() > 5000
-    assert (view.mean(axis=2) < 200)[:, 600:680].sum() < 400             # nothing but the divider between them
-    _, text = page_text(page, tmp_path, fragment="frame=3")
-    assert "no WebGL" not in text
-    dom = chromium(page, tmp_path, "--disable-webgl", "--disable-3d-apis", "--dump-dom", fragment="frame=3").stdout
-    assert "This browser has no WebGL" in dom and 'data-frame="3"' in dom
-    assert os.path.getsize(page) < 2_000_000
+    g, _ = load(glb)
+    assert any(n.camera is not None for n in g.nodes) and len(g.extensions["KHR_lights_punctual"]["lights"]) == 3
+    p = pipeline.plan(str(ROOT / "scenes" / "default.toml"))
+    assert (ROOT / "renders" / "dast_cube_blender.py").read_text() == blender.script(p, str(glb))

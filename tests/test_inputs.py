@@ -387,19 +387,23 @@ def test_a_damaged_trajectory_file_is_one_typed_error(tmp_path, damage, reason):
     assert isinstance(e.value, ValueError) and str(e.value) == f"{p}: {reason}"
 
 
-def test_render_frame_at_t_0_is_the_first_frame_and_t_is_the_runs_time():
-    """``render_frame(scene, t=0.0)`` is the first frame of every video; t is the trajectory's
-    time, and a video's own end is ``Renderer(t_end=...)``."""
+def test_render_frame_is_the_videos_frame_that_shows_t():
+    """``render_frame(scene, t)`` is the frame of the scene's own video that shows t: the first
+    at t = 0, the last at the run's end, frame f at its time, and between two frames the one
+    nearer on the time map (t is the trajectory's time); the frames differ, so each check
+    could fail.  A shorter video's last frame is ``Renderer(t_end=...)``'s."""
     sc = spinviz.load_scene(SCENES / "askew_example.toml")
     look = {"size": (64, 48), "duration": 1.0, "fps": 8}
-    first = spinviz.render_frame(sc, t=0.0, **look)
     with spinviz.Renderer(sc, **look) as r:
-        assert np.array_equal(first, r.frame(0))
-        last = r.frame(r.frames - 1)
-    assert np.array_equal(spinviz.render_frame(sc, t=sc.t_end, **look), last)
+        frames = [r.frame(f) for f in range(r.frames)]
+        sim_t = r.plan.sim_t
+    assert not np.array_equal(frames[3], frames[4]) and not np.array_equal(frames[0], frames[-1])
+    assert np.array_equal(spinviz.render_frame(sc, t=0.0, **look), frames[0])
+    assert np.array_equal(spinviz.render_frame(sc, t=sc.t_end, **look), frames[-1])
+    assert np.array_equal(spinviz.render_frame(sc, t=0.6 * sim_t[3] + 0.4 * sim_t[4], **look), frames[3])
+    assert np.array_equal(spinviz.render_frame(sc, t=0.4 * sim_t[3] + 0.6 * sim_t[4], **look), frames[4])
     with spinviz.Renderer(sc, t_end=600.0, **look) as r:            # the video of [0, 600]: its last frame shows t = 600
         assert r.plan.sim_t[-1] == 600.0
-        assert np.array_equal(spinviz.render_frame(sc, t=600.0, **look), r.frame(r.frames - 1))
 
 
 def test_adding_an_atlas_key_is_one_field_and_keeps_old_identities():

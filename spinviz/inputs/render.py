@@ -219,7 +219,8 @@ class RenderArguments:
 
     t : the physical time a picture shows, in [0, the run's end] (checked against it later);
     t_end : where a video (a frame plan) ends; frames : F of a plan; frame : an index of one;
-    out : the video's path; workers : render processes; progress : a bar on stderr.
+    out : the video's path; workers : render processes; progress : a bar on stderr;
+    height : px of a notebook's inline turnable view (``spinviz.show``).
     """
 
     t: Annotated[Real, Field(ge=0.0)] | None = None
@@ -229,6 +230,7 @@ class RenderArguments:
     out: Path = None
     workers: Annotated[Int, Field(ge=1), AfterValidator(_workers)] | None = None
     progress: Flag = False
+    height: Annotated[Int, Field(ge=200, le=4000)] | None = None
 
 
 def poster_for(out: str) -> str:

@@ -20,6 +20,11 @@ Drawing -- a ``Picture`` into pixels; decides nothing:
   ``hud`` (Pillow; ``fonts`` measures text for the layout and draws it); ``encode`` --
   MP4/GIF/PNG writers.
 
+Media -- the same plan as a glTF model or a page, without the drawing stack: ``export``
+writes the model (``keyframes``, ``framing``: its camera and lights, ``gltf``) with the
+Blender script beside it (``blender``), or the page (``webpage``: its words ``pagetext``, its
+poster ``poster``, its viewer ``web/``).
+
 Importing this package loads nothing heavy: pyvista, vtk, imageio and Pillow are imported
 by the drawing modules only.
 """

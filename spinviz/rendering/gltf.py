@@ -4,19 +4,26 @@ Blender, three.js, ``<model-viewer>`` and the operating systems' 3-D viewers.
 What the file holds (every length in units of the dipole arrow, which glTF reads as metres,
 so a body is about a metre across):
 
-* one node per model, side by side along glTF's +x (``SPACING`` apart), each with a child
-  ``world`` node that turns spinviz's +z-up world frame into glTF's +y-up frame (a quarter
-  turn about x); below it everything is in spinviz's world frame, as the video draws it;
+* one node per model, placed and turned about the vertical by ``framing`` so that the file's
+  camera sees each from the video's view direction, side by side as the video's panels; each
+  with a child ``world`` node that turns spinviz's +z-up world frame into glTF's +y-up frame
+  (a quarter turn about x); below it everything is in spinviz's world frame, as the video
+  draws it;
 * ``body``: the body's mesh (``meshes.body_part``, the video's colours) and, riding on it, the
   dipole arrow; its rotation channel holds the poses the video draws (``keyframes``);
 * ``L`` and ``omega`` arrows: rotation channels turn +x along the vector, the shaft's scale
   and the head's translation channels give the arrow the video's length;
-* the axes (thin rods) and the unit-sphere cage (lines) when the scene shows them; a
-  camera at the video's view direction;
-* ``extras``: the time map (the animation's clock is the video's: seconds of video), the
-  physical time and video frame of every keyframe, the stated and measured interpolation
-  errors, the spin mode and slowdown, the captions, and the bodies' physical scale.
+* the axes and the unit-sphere cage, when the scene shows them, as thin tubes (geometry a
+  renderer draws, unlit in the video's line colours: ``KHR_materials_unlit``);
+* the camera (the video's view, ``framing``) and, riding on it, the video's three lights
+  (``KHR_lights_punctual``, directional);
+* ``extras``: the clock (the MP4's: frame f at f / fps s, the animation's time of every
+  keyframe exactly), the physical time and video frame of every keyframe, the stated and
+  measured interpolation errors (slerp and component-wise), the spin mode and slowdown, the
+  captions, the bodies' physical scale, and what Blender needs to play it whole.
 
+Every node, mesh and material is named after its model ("reduced body", "truncated L arrow"),
+so names stay unique; the two models' meshes share their geometry (one set of accessors).
 Quaternions are (w, x, y, z) in spinviz and written in glTF's (x, y, z, w) order.  Colours are
 the video's (sRGB) converted to glTF's linear base colours.  NumPy and pygltflib only (no
 drawing library): a model is written without the render stack's VTK.
@@ -29,18 +36,24 @@ import math
 
 import numpy as np
 
+from .. import rotations as R
 from .. import units as U
 from . import keyframes
 from .captions import texts_of
-from .meshes import Part, arrow_head, arrow_shaft, body_part, cylinder_z
+from .framing import AMBIENT_STRENGTH, LUX_PER_W_M2, frame_models
+from .meshes import Part, arrow_head, arrow_shaft, body_part
 from .stage import _circle_points, rotation_x_to
-from .style import ARROW_COLORS, ARROWS, AXIS_LENGTH, BODY_RADIUS, COLORS, VIEW_ANGLE, body_color
+from .style import ARROW_COLORS, ARROWS, AXIS_LENGTH, BODY_RADIUS, COLORS, body_color
 
-__all__ = ["build", "to_bytes", "SPACING", "Z_UP_TO_Y_UP"]
+__all__ = ["build", "to_bytes", "Z_UP_TO_Y_UP", "CAMERA_NAME", "model_prefixes", "BLENDER_SCRIPT_SUFFIX"]
 
-SPACING = 3.2              # between the models' centres, glTF metres (dipole-arrow units)
-AXIS_RADIUS = 0.008
+LINE_RADIUS = 0.005        # the axes' and the cage's tubes: about a pixel of the video's 720-line frame
+TUBE_SIDES = 4
+CAGE_SEGMENTS = 72         # per circle of the cage (the video's lines have 144)
 Z_UP_TO_Y_UP = (-math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5))     # (x, y, z, w): -90 deg about x, spinviz z -> glTF y
+CAMERA_NAME = "camera (the video's view)"
+BLENDER_SCRIPT_SUFFIX = "_blender.py"     # X.glb -> X_blender.py beside it (``blender.script``)
+ARROW_WORDS = {"dipole": "dipole", "L": "L", "omega": "omega"}
 FLOAT, UINT16, UINT32 = 5126, 5123, 5125
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
 
@@ -65,6 +78,7 @@ class _Writer:
         self.doc = {"asset": {"version": "2.0", "generator": "spinviz"}, "scene": 0, "scenes": [], "nodes": [],
                     "meshes": [], "materials": [], "accessors": [], "bufferViews": [], "buffers": []}
         self._materials = {}
+        self.extensions = set()
 
     def accessor(self, data, kind: str, target: int | None = None, minmax: bool = False) -> int:
         """An accessor for ``data`` (float32 unless integer), in a buffer view of its own."""
@@ -87,46 +101,42 @@ class _Writer:
         self.doc["accessors"].append(acc)
         return len(self.doc["accessors"]) - 1
 
-    def material(self, rgb, name: str) -> int:
-        """A matte material of the sRGB colour ``rgb`` (one per colour)."""
-        key = tuple(round(float(c), 6) for c in rgb)
-        if key not in self._materials:
-            self.doc["materials"].append({"name": name, "pbrMetallicRoughness": {
-                "baseColorFactor": linear_from_srgb(key) + [1.0], "metallicFactor": 0.0, "roughnessFactor": 0.7}})
-            self._materials[key] = len(self.doc["materials"]) - 1
-        return self._materials[key]
+    def material(self, name: str, rgb, unlit: bool = False) -> int:
+        """The material ``name`` (one per name): matte, of the sRGB colour ``rgb``; ``unlit``
+        draws the colour whatever the light (``KHR_materials_unlit``: the video's lines)."""
+        if name not in self._materials:
+            mat = {"name": name, "pbrMetallicRoughness": {
+                "baseColorFactor": linear_from_srgb(rgb) + [1.0], "metallicFactor": 0.0,
+                "roughnessFactor": 1.0 if unlit else 0.7}}
+            if unlit:                       # the tubes are seen from inside where they cross
+                mat["extensions"] = {"KHR_materials_unlit": {}}
+                mat["doubleSided"] = True
+                self.extensions.add("KHR_materials_unlit")
+            self.doc["materials"].append(mat)
+            self._materials[name] = len(self.doc["materials"]) - 1
+        return self._materials[name]
 
-    def mesh(self, part: Part, name: str) -> int:
-        """A mesh of ``part``: one primitive per colour (triangles)."""
-        prims = []
+    def geometry(self, part: Part, lit: bool = True) -> list:
+        """The accessors of ``part``, one primitive per colour (triangles): [(attributes,
+        indices, rgb)].  Meshes of both models reuse them; ``lit`` False leaves the normals out."""
+        out = []
         tri_color = part.color[part.triangles[:, 0]]
         for rgb in np.unique(np.round(tri_color, 6), axis=0):
             tris = part.triangles[np.all(np.abs(tri_color - rgb) < 1e-6, axis=1)]
             used, inv = np.unique(tris.ravel(), return_inverse=True)
-            pts = part.points[used]
-            nrm = part.normals[used] / np.linalg.norm(part.normals[used], axis=1, keepdims=True)
-            prims.append({"attributes": {"POSITION": self.accessor(pts, "VEC3", ARRAY_BUFFER, minmax=True),
-                                         "NORMAL": self.accessor(nrm, "VEC3", ARRAY_BUFFER)},
-                          "indices": self.accessor(inv.astype(np.uint16 if used.size < 65536 else np.uint32), "SCALAR",
-                                                   ELEMENT_ARRAY_BUFFER),
-                          "material": self.material(rgb, f"{name} colour"), "mode": 4})
-        self.doc["meshes"].append({"name": name, "primitives": prims})
-        return len(self.doc["meshes"]) - 1
+            attrs = {"POSITION": self.accessor(part.points[used], "VEC3", ARRAY_BUFFER, minmax=True)}
+            if lit:
+                nrm = part.normals[used] / np.linalg.norm(part.normals[used], axis=1, keepdims=True)
+                attrs["NORMAL"] = self.accessor(nrm, "VEC3", ARRAY_BUFFER)
+            idx = self.accessor(inv.astype(np.uint16 if used.size < 65536 else np.uint32), "SCALAR", ELEMENT_ARRAY_BUFFER)
+            out.append((attrs, idx, tuple(float(c) for c in rgb)))
+        return out
 
-    def lines(self, curves, rgb, name: str) -> int:
-        """A mesh of polylines [(n, 3)] as one LINES primitive of one colour."""
-        pts, idx, start = [], [], 0
-        for c in curves:
-            pts.append(c)
-            k = np.arange(start, start + len(c) - 1)
-            idx.append(np.c_[k, k + 1].ravel())
-            start += len(c)
-        pts = np.vstack(pts)
-        prim = {"attributes": {"POSITION": self.accessor(pts, "VEC3", ARRAY_BUFFER, minmax=True)},
-                "indices": self.accessor(np.concatenate(idx).astype(np.uint16 if len(pts) < 65536 else np.uint32),
-                                         "SCALAR", ELEMENT_ARRAY_BUFFER),
-                "material": self.material(rgb, f"{name} colour"), "mode": 1}
-        self.doc["meshes"].append({"name": name, "primitives": [prim]})
+    def mesh(self, name: str, geometry: list, materials: list) -> int:
+        """A mesh named ``name`` of ``geometry``'s primitives, each with its material index."""
+        prims = [{"attributes": dict(attrs), "indices": idx, "material": m, "mode": 4}
+                 for (attrs, idx, _), m in zip(geometry, materials)]
+        self.doc["meshes"].append({"name": name, "primitives": prims})
         return len(self.doc["meshes"]) - 1
 
     def node(self, **fields) -> int:
@@ -135,49 +145,61 @@ class _Writer:
         return len(self.doc["nodes"]) - 1
 
 
-def _rotate(part: Part, m) -> Part:
-    return Part(part.points @ m.T, part.normals @ m.T, part.triangles, part.color, part.lit)
-
-
 def _axes_part(color) -> Part:
     """The three axes as thin rods from the origin to ``AXIS_LENGTH`` along x, y, z."""
-    rod = cylinder_z(AXIS_RADIUS, 0.5 * AXIS_LENGTH, 8, np.asarray(color))
-    rod = Part(rod.points + [0.0, 0.0, 0.5 * AXIS_LENGTH], rod.normals, rod.triangles, rod.color, rod.lit)
-    to_x = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])    # z -> x
-    to_y = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])    # z -> y
-    return Part.join([_rotate(rod, to_x), _rotate(rod, to_y), rod])
+    parts = []
+    for i in range(3):
+        e = np.zeros(3)
+        e[i] = AXIS_LENGTH
+        parts.append(_tube(np.array([np.zeros(3), e]), color, closed=False))
+    return Part.join(parts)
 
 
-def _quat_from_matrix(m) -> np.ndarray:
-    """(w, x, y, z) of a rotation matrix (3, 3) (Shepperd's method, one matrix)."""
-    m = np.asarray(m, dtype=float)
-    tr = np.trace(m)
-    cands = [1.0 + tr, 1.0 + 2 * m[0, 0] - tr, 1.0 + 2 * m[1, 1] - tr, 1.0 + 2 * m[2, 2] - tr]
-    k = int(np.argmax(cands))
-    s = 2.0 * math.sqrt(cands[k])
-    if k == 0:
-        q = [0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s]
-    elif k == 1:
-        q = [(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s]
-    elif k == 2:
-        q = [(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s]
+def _tube(curve, color, closed: bool) -> Part:
+    """A thin tube of radius ``LINE_RADIUS`` and ``TUBE_SIDES`` sides along the polyline
+    ``curve`` (n, 3) (closed: its last point joins its first), for an unlit material (its
+    normals are the outward radial directions)."""
+    c = np.asarray(curve, dtype=float)
+    n = c.shape[0]
+    if closed:
+        tangent = np.roll(c, -1, axis=0) - np.roll(c, 1, axis=0)
+        radial = c - c.mean(axis=0)
     else:
-        q = [(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s]
-    q = np.array(q)
-    return q / np.linalg.norm(q) * (1.0 if q[0] >= 0 else -1.0)
+        tangent = np.repeat((c[-1] - c[0])[None, :], n, axis=0)
+        ref = np.eye(3)[int(np.argmin(np.abs(tangent[0])))]
+        radial = np.repeat(np.cross(tangent[0], ref)[None, :], n, axis=0)
+    tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+    radial -= np.sum(radial * tangent, axis=1, keepdims=True) * tangent
+    radial /= np.linalg.norm(radial, axis=1, keepdims=True)
+    binormal = np.cross(tangent, radial)
+    ang = 2.0 * math.pi * np.arange(TUBE_SIDES) / TUBE_SIDES
+    ring = np.cos(ang)[None, :, None] * radial[:, None, :] + np.sin(ang)[None, :, None] * binormal[:, None, :]
+    pts = (c[:, None, :] + LINE_RADIUS * ring).reshape(-1, 3)
+    segs = n if closed else n - 1
+    i = np.arange(segs)[:, None]
+    j = np.arange(TUBE_SIDES)[None, :]
+    a, b = i * TUBE_SIDES + j, i * TUBE_SIDES + (j + 1) % TUBE_SIDES
+    a2, b2 = ((i + 1) % n) * TUBE_SIDES + j, ((i + 1) % n) * TUBE_SIDES + (j + 1) % TUBE_SIDES
+    tris = np.concatenate([np.stack([a, b, b2], -1).reshape(-1, 3), np.stack([a, b2, a2], -1).reshape(-1, 3)])
+    return Part(pts, ring.reshape(-1, 3), tris, np.tile(np.asarray(color, dtype=float), (pts.shape[0], 1)),
+                np.zeros(pts.shape[0], bool))
 
 
-def view_gltf(spec) -> np.ndarray:
-    """The video's view direction (towards the camera, ``azimuth_deg``, ``elevation_deg``) in
-    glTF's frame: spinviz (x, y, z) -> glTF (x, z, -y)."""
-    az, el = math.radians(spec.azimuth_deg), math.radians(spec.elevation_deg)
-    v = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
-    return np.array([v[0], v[2], -v[1]])
+def _cage_part(color) -> Part:
+    """The unit-sphere cage (latitudes every 30 deg and meridians, ``CAGE_SEGMENTS`` segments
+    each) as thin closed tubes."""
+    step = 144 // CAGE_SEGMENTS
+    return Part.join([_tube(c[:-1:step], color, closed=True) for c in _circle_points()])
 
 
-def model_offsets(n: int) -> list[float]:
-    """glTF x of each of ``n`` models' centres, side by side about 0."""
-    return [(k - 0.5 * (n - 1)) * SPACING for k in range(n)]
+def model_prefixes(plan) -> list[str]:
+    """The name of each model in the file: its model ("reduced"), or with "left" / "right"
+    when both panels show the same model -- so that every node, mesh and material name is
+    unique."""
+    models = [p.model for p in plan.panels]
+    if len(set(models)) == len(models):
+        return models
+    return [f"{m} {side}" for m, side in zip(models, ("left", "right"))]
 
 
 def physical_scale(plan) -> dict:
@@ -220,10 +242,10 @@ def build(plan, kf) -> tuple[dict, bytes]:
     (dict, bytes)
         The JSON document (its one buffer without a URI yet) and the buffer's bytes.
     """
-    spec, show = plan.spec, set(plan.spec.show)
     w = _Writer()
-    meshes = _meshes(w, plan)
+    geometry = _geometry(w, plan)
     texts = texts_of(plan)
+    framing = frame_models(plan)
     times = w.accessor(kf.video_t.astype(np.float32), "SCALAR", minmax=True)
     samplers, channels = [], []
 
@@ -232,120 +254,183 @@ def build(plan, kf) -> tuple[dict, bytes]:
         samplers.append({"input": times, "output": out, "interpolation": "LINEAR"})
         channels.append({"sampler": len(samplers) - 1, "target": {"node": node, "path": path}})
 
-    models = []
-    for k, (panel, keys, x) in enumerate(zip(plan.panels, kf.panels, model_offsets(len(plan.panels)))):
-        children = []
-        if keys.q is not None:
-            body_children = []
-            if "dipole" in show:
-                body_children.append(_arrow(w, meshes, "dipole", rotation_x_to(plan.d_body), ARROWS["dipole"][3]))
-            body = w.node(name=f"{panel.model} body", mesh=meshes.get("body"), rotation=xyzw(keys.q[0]).tolist(),
-                          children=body_children or None,
-                          extras={"role": "body", "index": k, "physical_scale": physical_scale(plan)})
-            animate(body, "rotation", xyzw(keys.q), "VEC4")
-            children.append(body)
-        for key, (q, length) in keys.arrows.items():
-            node = _arrow(w, meshes, key, None, float(length[0]), q0=q[0], name=f"{panel.model} {key}")
-            head_len = ARROWS[key][1]
-            animate(node, "rotation", xyzw(q), "VEC4")
-            shaft, head = w.doc["nodes"][node]["children"]
-            animate(shaft, "scale", np.c_[length - head_len, np.ones_like(length), np.ones_like(length)], "VEC3")
-            animate(head, "translation", np.c_[length - head_len, np.zeros_like(length), np.zeros_like(length)], "VEC3")
-            children.append(node)
-        for key in ("axes", "cage"):
-            if key in meshes:
-                children.append(w.node(name=f"{panel.model} {key}", mesh=meshes[key]))
-        world = w.node(name=f"{panel.model} world (spinviz z up)", rotation=list(Z_UP_TO_Y_UP), children=children)
-        heading, equations = texts.headings[k]
-        models.append(w.node(name=panel.model, translation=[x, 0.0, 0.0], children=[world],
-                             extras={"role": "model", "index": k, "model": panel.model, "heading": heading,
-                                     "equations": equations, "subtitle": texts.subtitles[k]}))
-    camera = _camera(w, spec, len(plan.panels))
-    w.doc["scenes"].append({"name": texts.footer, "nodes": models + [camera], "extras": {"spinviz": _extras(plan, kf, texts)}})
+    models = [_model(w, plan, k, keys, prefix, geometry, framing, texts, animate)
+              for k, (keys, prefix) in enumerate(zip(kf.panels, model_prefixes(plan)))]
+    camera = _camera(w, framing)
+    w.doc["scenes"].append({"name": texts.footer, "nodes": models + [camera],
+                            "extras": {"spinviz": _extras(plan, kf, texts, framing)}})
     w.doc["animations"] = [{"name": "spin", "samplers": samplers, "channels": channels,
-                            "extras": {"video_frame": kf.frame.tolist(), "physical_time": kf.sim_t.tolist(),
+                            "extras": {"video_frame": kf.frame.tolist(), "frame_position": kf.position.tolist(),
+                                       "physical_time": kf.sim_t.tolist(),
                                        "physical_time_unit": "s" if plan.units == "cgs" else "tau0"}}]
     w.doc["buffers"].append({"byteLength": len(w.blob)})
+    w.extensions.add("KHR_lights_punctual")
+    w.doc["extensionsUsed"] = sorted(w.extensions)
     for key in ("materials", "meshes"):
         if not w.doc[key]:
             del w.doc[key]
     return w.doc, bytes(w.blob)
 
 
-def _meshes(w: _Writer, plan) -> dict:
-    """The meshes ``plan`` shows, each once (both models use them): name -> mesh index."""
+def _model(w: _Writer, plan, k: int, keys, prefix: str, geometry: dict, framing, texts, animate) -> int:
+    """Model k's node tree (placed and turned by ``framing``), its meshes and its animation
+    channels (``animate(node, path, values, kind)``); returns the model node."""
+    show = set(plan.spec.show)
+    panel = plan.panels[k]
+    meshes = _model_meshes(w, geometry, prefix, plan)
+    children = []
+    if keys.q is not None:
+        body_children = []
+        if "dipole" in show:
+            body_children.append(_arrow(w, meshes, prefix, k, "dipole", R.quat_from_matrix(rotation_x_to(plan.d_body)),
+                                        ARROWS["dipole"][3]))
+        body = w.node(name=f"{prefix} body", mesh=meshes.get("body"), rotation=xyzw(keys.q[0]).tolist(),
+                      children=body_children or None,
+                      extras={"role": "body", "index": k, "physical_scale": physical_scale(plan)})
+        animate(body, "rotation", xyzw(keys.q), "VEC4")
+        children.append(body)
+    for key, (q, length) in keys.arrows.items():
+        node = _arrow(w, meshes, prefix, k, key, q[0], float(length[0]))
+        head_len = ARROWS[key][1]
+        animate(node, "rotation", xyzw(q), "VEC4")
+        shaft, head = w.doc["nodes"][node]["children"]
+        animate(shaft, "scale", np.c_[length - head_len, np.ones_like(length), np.ones_like(length)], "VEC3")
+        animate(head, "translation", np.c_[length - head_len, np.zeros_like(length), np.zeros_like(length)], "VEC3")
+        children.append(node)
+    for key, label in (("axes", "axes"), ("cage", "unit sphere")):
+        if key in meshes:
+            children.append(w.node(name=f"{prefix} {label}", mesh=meshes[key]))
+    world = w.node(name=f"{prefix} world (spinviz z up)", rotation=list(Z_UP_TO_Y_UP), children=children,
+                   extras={"role": "world", "index": k})
+    heading, equations = texts.headings[k]
+    yaw = framing.yaws[k]
+    return w.node(name=prefix, translation=[float(x) for x in framing.translations[k]],
+                  rotation=[0.0, math.sin(0.5 * yaw), 0.0, math.cos(0.5 * yaw)], children=[world],
+                  extras={"role": "model", "index": k, "model": panel.model, "heading": heading,
+                          "equations": equations, "subtitle": texts.subtitles[k], "yaw_deg": math.degrees(yaw)})
+
+
+def _geometry(w: _Writer, plan) -> dict:
+    """The geometry ``plan`` shows, written once (both models' meshes use it): part -> the
+    ``_Writer.geometry`` primitives and each one's role ("body", "body dark half", ...)."""
     show = set(plan.spec.show)
     colors = COLORS[plan.spec.background]
     body_from_shape = np.asarray(plan.shape.R_body_from_shape if plan.shape else np.eye(3), dtype=float)
-    meshes = {}
+    out = {}
     if "body" in show:
-        meshes["body"] = w.mesh(body_part(plan.shape, body_color(plan.body_name), body_from_shape), "body")
+        base = body_color(plan.body_name)
+        second = "body dark half" if plan.shape is not None and plan.shape.kind == "rod" else "body edges"
+        geo = w.geometry(body_part(plan.shape, base, body_from_shape))
+        out["body"] = (geo, ["body" if np.allclose(rgb, base, atol=1e-6) else second for *_, rgb in geo], False)
     for key in ("dipole", "L", "omega"):
         if key in show:
             shaft, head_len, head_r, _ = ARROWS[key]
             color = np.asarray(ARROW_COLORS[key])
-            meshes[key + "_shaft"] = w.mesh(arrow_shaft(shaft, color), f"{key} arrow shaft")
-            meshes[key + "_head"] = w.mesh(arrow_head(head_len, head_r, color), f"{key} arrow head")
+            role = f"{ARROW_WORDS[key]} arrow"
+            out[key + "_shaft"] = (w.geometry(arrow_shaft(shaft, color)), [role], False)
+            out[key + "_head"] = (w.geometry(arrow_head(head_len, head_r, color)), [role], False)
     if "axes" in show:
-        meshes["axes"] = w.mesh(_axes_part(colors["axes"]), "axes")
+        out["axes"] = (w.geometry(_axes_part(colors["axes"]), lit=False), ["axes"], True)
     if "sphere" in show:
-        meshes["cage"] = w.lines(list(_circle_points()), colors["sphere"], "unit sphere")
-    return meshes
+        out["cage"] = (w.geometry(_cage_part(colors["sphere"]), lit=False), ["unit sphere"], True)
+    return out
 
 
-def _arrow(w: _Writer, meshes, key: str, rot3, length: float, q0=None, name: str | None = None) -> int:
-    """An arrow node: its rotation (a matrix ``rot3`` or the quaternion ``q0``, (w, x, y, z)),
-    a shaft child scaled to ``length`` minus the head and a head child moved to its end."""
+_MESH_NAMES = {"body": "body", "axes": "axes", "cage": "unit sphere"}
+
+
+def _model_meshes(w: _Writer, geometry: dict, prefix: str, plan) -> dict:
+    """One model's meshes and materials, named "<prefix> <part>", on the shared geometry:
+    part -> mesh index."""
+    out = {}
+    for part, (geo, roles, unlit) in geometry.items():
+        mats = [w.material(f"{prefix} {role}", rgb, unlit) for (*_, rgb), role in zip(geo, roles)]
+        if part in _MESH_NAMES:
+            name = _MESH_NAMES[part]
+        else:
+            key, piece = part.rsplit("_", 1)
+            name = f"{ARROW_WORDS[key]} arrow {piece}"
+        out[part] = w.mesh(f"{prefix} {name}", geo, mats)
+    return out
+
+
+def _arrow(w: _Writer, meshes, prefix: str, k: int, key: str, q, length: float) -> int:
+    """An arrow node "<prefix> <key> arrow": its rotation ``q`` (w, x, y, z), a shaft child
+    scaled to ``length`` minus the head and a head child moved to its end."""
     head_len = ARROWS[key][1]
-    shaft = w.node(name=f"{name or key} shaft", mesh=meshes[key + "_shaft"], scale=[length - head_len, 1.0, 1.0])
-    head = w.node(name=f"{name or key} head", mesh=meshes[key + "_head"], translation=[length - head_len, 0.0, 0.0])
-    q = q0 if q0 is not None else _quat_from_matrix(rot3)
-    return w.node(name=name or f"{key} arrow", rotation=xyzw(q).tolist(), children=[shaft, head])
+    word = ARROW_WORDS[key]
+    shaft = w.node(name=f"{prefix} {word} shaft", mesh=meshes[key + "_shaft"], scale=[length - head_len, 1.0, 1.0])
+    head = w.node(name=f"{prefix} {word} head", mesh=meshes[key + "_head"], translation=[length - head_len, 0.0, 0.0])
+    return w.node(name=f"{prefix} {word} arrow", rotation=xyzw(q).tolist(), children=[shaft, head],
+                  extras={"role": "arrow", "key": key, "index": k, "head_length": head_len})
 
 
-def _camera(w: _Writer, spec, n: int) -> int:
-    """A perspective camera looking at the models from the video's view direction."""
-    aspect = spec.size[0] / spec.size[1]
-    yfov = math.radians(VIEW_ANGLE)
-    half_w = 0.5 * (n - 1) * SPACING + 1.7
-    dist = max(half_w / (math.tan(0.5 * yfov) * aspect), 1.7 / math.tan(0.5 * yfov)) * 1.05
-    back = view_gltf(spec)
-    yaw, pitch = math.atan2(back[0], back[2]), -math.asin(back[1])
-    q = _mul((math.cos(0.5 * yaw), 0.0, math.sin(0.5 * yaw), 0.0), (math.cos(0.5 * pitch), math.sin(0.5 * pitch), 0.0, 0.0))
-    w.doc.setdefault("cameras", []).append({"name": "the video's view", "type": "perspective",
-                                            "perspective": {"yfov": yfov, "aspectRatio": aspect, "znear": 0.05,
-                                                            "zfar": 100.0}})
-    return w.node(name="camera (the video's view)", camera=len(w.doc["cameras"]) - 1,
-                  translation=(back * dist).tolist(), rotation=xyzw(q).tolist())
+def _camera(w: _Writer, framing) -> int:
+    """The camera (``framing``: the video's view of every model) and, riding on it, the
+    video's lights (``KHR_lights_punctual``, directional, in lux)."""
+    w.doc.setdefault("cameras", []).append({"name": CAMERA_NAME, "type": "perspective",
+                                            "perspective": {"yfov": framing.yfov, "aspectRatio": framing.aspect,
+                                                            "znear": 0.05, "zfar": 20.0 * framing.distance}})
+    lights = w.doc.setdefault("extensions", {}).setdefault("KHR_lights_punctual", {"lights": []})["lights"]
+    children = []
+    for name, q, lux in framing.lights:
+        lights.append({"name": name, "type": "directional", "color": [1.0, 1.0, 1.0], "intensity": lux})
+        children.append(w.node(name=name, rotation=xyzw(q).tolist(),
+                               extensions={"KHR_lights_punctual": {"light": len(lights) - 1}}))
+    return w.node(name=CAMERA_NAME, camera=len(w.doc["cameras"]) - 1,
+                  translation=[float(x) for x in framing.camera_translation],
+                  rotation=xyzw(framing.camera_rotation).tolist(), children=children)
 
 
-def _mul(a, b):
-    a0, a1, a2, a3 = a
-    b0, b1, b2, b3 = b
-    return np.array([a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3, a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
-                     a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1, a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0])
+def physical_map(spec, frames: int) -> str:
+    """The physical time of video frame f, as the extras state it (t_end, knee: the clock's)."""
+    if spec.time_map == "linear":
+        return f"t = t_end * f / {frames - 1}"
+    return f"t = knee * ((1 + t_end / knee) ** (f / {frames - 1}) - 1)"
 
 
-def _extras(plan, kf, texts) -> dict:
-    """What the file says about itself: clock, time map, spin, errors, captions."""
+def _extras(plan, kf, texts, framing) -> dict:
+    """What the file says about itself: clock, time map, spin, errors, captions, camera, lights,
+    and how Blender plays it whole."""
     spec = plan.spec
     ts = plan.time_scale
+    F = plan.frames
     out = {
         "about": "spinviz: rotation of a dipolar nanocrystal under the radiation-reaction torque",
         "quaternions": "glTF (x, y, z, w); the body's rotation maps body-frame vectors to spinviz's world frame",
-        "frame": "each model's 'world' node turns spinviz's +z-up world frame into glTF's +y-up frame",
+        "frame": "each model's 'world' node turns spinviz's +z-up world frame into glTF's +y-up frame; the model node "
+                 "above it places the model and turns it about the vertical so that the camera sees it from the "
+                 "video's direction",
         "lengths": "units of the dipole arrow (its tip on the unit sphere), read as metres",
-        "clock": {"seconds": "video seconds, the same clock as the MP4", "duration_s": spec.duration, "fps": spec.fps,
-                  "video_frames": plan.frames, "time_map": spec.time_map,
-                  "physical_time_end": plan.t_end, "physical_time_unit": "s" if plan.units == "cgs" else "tau0",
-                  "map": ("t = t_end * v / duration" if spec.time_map == "linear"
-                          else "t = knee * ((1 + t_end / knee) ** (v / duration) - 1)")},
+        "clock": {"seconds": "the MP4's clock: video frame f is shown at f / fps seconds, and a keyframe of frame f "
+                             "is at exactly that time (float32)",
+                  "fps": spec.fps, "video_frames": F, "last_frame_s": (F - 1) / spec.fps,
+                  "time_map": spec.time_map, "physical_time_end": plan.t_end,
+                  "physical_time_unit": "s" if plan.units == "cgs" else "tau0", "map": physical_map(spec, F)},
         "keyframes": {"count": kf.count, "tolerance_deg": math.degrees(kf.tolerance),
-                      "max_error_deg": math.degrees(kf.max_error), "max_length_error_m": kf.max_length_error,
+                      "max_error_deg": math.degrees(kf.max_error),
+                      "max_error_componentwise_deg": math.degrees(kf.max_error_componentwise),
+                      "max_length_error_m": kf.max_length_error,
                       "max_step_deg": math.degrees(kf.max_step),
                       "max_step_limit_deg": math.degrees(keyframes.MAX_STEP),
-                      "what": "a subset of the video's frames: at each the exact pose the video draws; the viewer's "
-                              "LINEAR interpolation stays within tolerance_deg of every frame in between"},
+                      "what": "a subset of the video's frames: at each the exact pose the video draws; between them a "
+                              "viewer's slerp (LINEAR) and a component-wise interpolation (Blender's F-curves) both "
+                              "stay within tolerance_deg of every frame"},
+        "camera": {"name": CAMERA_NAME, "yfov_deg": math.degrees(framing.yfov), "aspect": framing.aspect,
+                   "distance_m": framing.distance, "pitch_deg": math.degrees(framing.pitch),
+                   "view": "each model seen from the video's azimuth_deg and elevation_deg at the video's panel "
+                           "distance, side by side as the video's panels",
+                   "azimuth_deg": spec.azimuth_deg, "elevation_deg": spec.elevation_deg},
+        "lights": {"what": "the video's key, fill and head lights, directional, riding on the camera; intensities in "
+                           "lux (Blender's default import reads lux / 683 as a sun's W/m^2); a viewer without exposure "
+                           "control (three.js) wants them divided by 683",
+                   "ambient": AMBIENT_STRENGTH, "lux_per_w_m2": LUX_PER_W_M2},
+        "blender": {"fps": spec.fps, "frame_start": 0, "frame_end": F - 1, "camera": CAMERA_NAME,
+                    "resolution": list(spec.size),
+                    "by_hand": f"set the scene's frame rate to {spec.fps} fps before File > Import > glTF 2.0 (the "
+                               f"importer places a key at its time x the scene's rate), the frame range to 0-{F - 1}, "
+                               f"and make '{CAMERA_NAME}' the scene's camera",
+                    "script": "spinviz writes NAME" + BLENDER_SCRIPT_SUFFIX + " beside NAME.glb: it does all this"},
         "spin_mode": plan.spin_mode, "notes": list(plan.notes), "title": texts.footer,
         "time_scale": {"symbol": ts[0], "value": ts[1]} if ts else None, "scale_text": texts.scale,
         "units": plan.units, "body": plan.body_name,

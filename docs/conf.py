@@ -109,9 +109,10 @@ nb_execution_raise_on_error = True                   # a cell's exception fails 
 nb_execution_show_tb = True                          # a failure's traceback in the build log
 nb_merge_streams = True                              # a cell's stdout as one block, not one per print
 # Generous limits, so that a build on a loaded machine is slow, never failed: no cell takes
-# more than a few seconds alone (the tutorial's longest, its atlas, 4 s on a quiet core), but
-# two cores shared with other jobs can stretch that many times, and the kernel's start-up
-# with it (nbclient's own default, 60 s, was once exceeded under a load of ~8).
+# more than a few seconds (the tutorial's longest, its atlas: 4.2 s on 2026-11-27, 2 cores,
+# load ~7), but two cores shared with other jobs can stretch that many times, and the
+# kernel's start-up with it (nbclient's own default, 60 s, has been exceeded on this
+# project's 2-core machine under a load of ~8).
 nb_execution_timeout = 600                           # seconds per cell
 NB_KERNEL_STARTUP_S = 600                            # seconds for the kernel to answer its first request
 

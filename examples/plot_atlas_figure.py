@@ -7,17 +7,17 @@ elongation δ = 1 − I3/I1 and dipole tilt χ, under each equation of motion?  
 atlas (``scenes/atlas_figure.toml``) answers as τ → ∞ at 32 × 32 cells × 32 random starts,
 both models: each run integrated in full until the flow averaged over the precession holds,
 then carried by it to τ = 1e16 and labelled by the attractor it is in; every cell along a
-change of type cut in four, twice (128 × 128 there): 206 464 runs, about a quarter of an
-hour on two cores -- too long for a documentation build::
+change of type cut in four, twice (128 × 128 there): 206 464 runs, 13 min 43 s on
+2026-11-26 on this project's two cores -- too long for a documentation build::
 
-    spinviz atlas scenes/atlas_figure.toml --out atlas_figure.zarr --plot atlas_figure.png
+    spinviz atlas run scenes/atlas_figure.toml --out atlas_figure.zarr --plot atlas_figure.png
 
 So this example reads a small extract of that store, committed beside it
 (``examples/data/atlas_figure_labels.npz``, made by ``examples/data/extract_atlas.py``, which
 checks that this very script draws from it the same diagram, pixel for pixel, as
 ``--plot`` draws from the store): each run's type and, for the hodographs, the confidence of
 each run and the series of the runs they show.  The pictures are drawn here, by the same
-functions ``spinviz atlas --plot`` calls.  What the diagram says, and where it disagrees
+functions ``spinviz atlas run --plot`` calls.  What the diagram says, and where it disagrees
 with the paper: the :doc:`regime atlas page <../atlas>`.
 """
 

@@ -10,16 +10,14 @@ be seen.
 """
 
 # %%
-# Both models from the scene, and how their ends differ.
+# Both models from the scene, and how their ends differ (``spinviz.compare``, as
+# ``spinviz compare scenes/cellulose_rod.toml`` prints it).
 import matplotlib.pyplot as plt
 
 import spinviz
-from spinviz.analysis import compare
 
 sc = spinviz.load_scene("../scenes/cellulose_rod.toml")
-times = compare.compare_times(sc.t_end, 200)
-runs = [spinviz.simulate_request(sc.request(model, t_eval=times)) for model in sc.models]
-print(compare.format_table(compare.compare(runs), sc.title))
+print(spinviz.compare(sc, samples=200).table())
 
 # %%
 # The scene's poster: the middle frame of its video, at 1.5 T.  The tumbling (the dipole's

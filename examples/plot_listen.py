@@ -13,17 +13,16 @@ sliding on and staying audible.
 """
 
 # %%
-# Simulate, detect and synthesize; the WAV goes to a scratch folder (removed after), its
-# spectrogram (the file as written, read back) is shown below.
+# Simulate, detect and synthesize (``spinviz.listen``, the command's own call); the WAV goes
+# to a scratch folder (removed after), its spectrogram (the file as written, read back) is
+# shown below.
 import tempfile
 from pathlib import Path
 
 import spinviz
-from spinviz.analysis import sonify
 
-sc = spinviz.load_scene("../scenes/dast_cube.toml")
 with tempfile.TemporaryDirectory() as scratch:
     wav = Path(scratch) / "dast_cube.wav"
-    mapping = sonify.listen_scene(sc, str(wav), "dast_cube_listen.png", duration=20.0)
+    mapping = spinviz.listen("../scenes/dast_cube.toml", str(wav), png="dast_cube_listen.png", duration=20.0)
     print(f"{wav.name}: {mapping.duration_s:g} s, {mapping.rate} Hz, 16-bit stereo, {wav.stat().st_size / 1e6:.1f} MB")
 print(mapping.statement())

@@ -8,33 +8,24 @@ records from each model -- here the scene's default one: an antenna of 5 dBi, bo
 polarizations, 10 cm from the crystal, 5 K of system noise, a 1 MHz band following the line,
 1 s per estimate -- how finely it measures the crystal's line (the Cramér–Rao bounds of
 frequency, power and polarization angle), and when the two predictions part against the
-resolution.  The receiver, its bounds and their checks: the "Designing an experiment" page.
+resolution.  The receiver, its bounds and their checks: :doc:`../experiment`.
 """
 
 # %%
 # Both models of the scene over its ``[observe]`` horizon, received by its ``[observe]``
-# receiver along its line of sight.
+# receiver along its line of sight (``spinviz.observe``; receiver keys such as
+# ``distance_cm=20`` would replace the scene's).  ``plots="dast_cube"`` writes the command's
+# three pictures, shown below in this order:
+#
+# * what each model sends toward the antenna -- power, the strongest spectral line, the
+#   polarization angle -- and below each the time the models part against the resolution,
+#   with this receiver's 5σ marked;
+# * the detector's record: the spectrogram over the run, the signal strength, and the
+#   waveform at four instants (its spin phase reconstructed, as the plot says);
+# * the receiver's view: the SNR of the line over the run, the resolutions of one
+#   integration, the field at the antenna with all its terms, and the start-free test of
+#   each model's own noisy line against the laws P ∝ f⁴ and P ∝ f²(f² − f∞²).
 import spinviz
-from spinviz.analysis import observe, observe_plots
-from spinviz.analysis.experiment_plots import plot_receiver
 
-sc = spinviz.load_scene("../scenes/dast_cube.toml")
-obs, runs = observe.run_scene(sc, samples=400)
-print(observe.format_table(obs))
-
-# %%
-# What each model sends toward the antenna -- power, the strongest spectral line, the
-# polarization angle -- and below each the time the models part against the resolution,
-# with this receiver's 5σ marked.
-observe_plots.plot(obs, "dast_cube_observe.png")
-
-# %%
-# The receiver's view: the SNR of the line over the run, the resolutions of one
-# integration, the field at the antenna with all its terms, and the start-free test of each
-# model's own noisy line against the laws P ∝ f⁴ and P ∝ f²(f² − f∞²).
-plot_receiver(obs, "dast_cube_receiver.png")
-
-# %%
-# The detector's record: the spectrogram over the run, the signal strength, and the
-# waveform at four instants (its spin phase reconstructed, as the plot says).
-observe_plots.plot_detector(obs, "dast_cube_detector.png")
+obs = spinviz.observe("../scenes/dast_cube.toml", samples=400, plots="dast_cube")
+print(obs.table())

@@ -4,9 +4,10 @@ Frames of the video, from Python
 
 ``spinviz.render_frame`` returns the picture of a scene at a physical time as an RGB array,
 and ``spinviz.Renderer`` draws any frames of one video plan, off-screen (pyvista/VTK, no
-display needed).  Here the README's main scene: the DAST cube under the reduced equation
-(left) and the truncated one (right), over 6 Θ (19 days), with the radio power of each
-under them.  Arrays are shown with matplotlib's ``imshow``, one screen pixel per pixel.
+display needed).  Here the default scene (``scenes/default.toml``): the DAST cube under
+the reduced equation (left) and the truncated one (right), over 6 Θ (19 days), with the
+radio power of each under them.  Arrays are shown with matplotlib's ``imshow``, one
+screen pixel per pixel.
 """
 
 # %%

@@ -12,8 +12,8 @@ and beside it a Blender script that plays it whole at the video's rate.  Both sh
 video's own frames: between the kept ones a viewer's interpolation stays within 0.25° of
 every frame.
 
-Below, the README's scene: the DAST cube, reduced and truncated, over 6 Θ.  Drag to turn
-both crystals, scroll to zoom.
+Below, the default scene (``scenes/default.toml``): the DAST cube, reduced (left) and
+truncated (right), over 6 Θ.  Drag to turn both crystals, scroll to zoom.
 """
 
 # %%
@@ -25,15 +25,20 @@ import matplotlib.pyplot as plt
 
 import spinviz
 
-page = spinviz.render("../scenes/default.toml", out="dast_cube_turnable.html")
+sc = spinviz.load_scene("../scenes/default.toml")
+page = spinviz.render(sc, out="dast_cube_turnable.html")
 print(page.describe())
-model = spinviz.render("../scenes/default.toml", out="dast_cube.glb")
+model = spinviz.render(sc, out="dast_cube.glb")
 print(model.describe())
 
 # %%
-# The video's first frame, the pose the page opens on (``spinviz.render_frame``: the video's
-# frame at a time of the run; the page draws it with three.js, the video with VTK).
-img = spinviz.render_frame("../scenes/default.toml", t=0.0, size=(640, 360))
+# What a drag on the page shows: the same crystals from above (elevation 60° instead of
+# the video's 22°), here drawn by ``spinviz.render_frame`` with the camera keys of the
+# scene's ``[render]`` table, halfway through the run (9.4 days, 3 Θ).  The reduced
+# crystal's dipole (red) has nearly joined L (green, the world's z axis); the truncated
+# one's still stands 45° from it.  (The page draws with three.js, the video and
+# this frame with VTK; the poses are the same.)
+img = spinviz.render_frame(sc, t=sc.t_end / 2, size=(640, 360), azimuth_deg=20.0, elevation_deg=60.0)
 fig = plt.figure(figsize=(6.4, 3.6), dpi=100)
 ax = fig.add_axes((0, 0, 1, 1))
 ax.imshow(img, interpolation="none")

@@ -4,7 +4,7 @@ The reduced (2.2)+(2.3) and truncated (2.5) Euler equations of A. Duviryak, "Asy
 dynamics of askew-polarized spinning top under the radiation reaction torque", with
 quaternion kinematics, checked against the paper's closed forms, rendered off-screen.
 
-The public API (see the README's "Python" section)::
+The public API (see docs/getting_started.md, "Python")::
 
     import spinviz
     sc = spinviz.load_scene("scenes/askew_example.toml")

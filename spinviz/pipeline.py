@@ -340,7 +340,7 @@ def render(source: Source, out: str | None = None, *, size=None, fps=None, durat
 def contact_sheet(sources: Sequence[Source], out: str, *, size=(640, 360), columns: int = 2, at: float = 0.5,
                   colors: int = 96) -> str:
     """One frame of each source (at fraction ``at`` of its video) in a grid, as a small PNG:
-    the README's gallery overview.  ``colors`` limits the palette (the sheet stays small)."""
+    the docs' overview of every scene (docs/scenes.md).  ``colors`` limits the palette (the sheet stays small)."""
     from PIL import Image
 
     from .atomic import atomic_path

@@ -56,7 +56,7 @@ def site(tmp_path_factory) -> Path:
 
 
 def readme_after(marker: str) -> str:
-    """The first words of the README after ``marker``, where a page includes it."""
+    """The first words of the README after ``marker``, where the front page includes it."""
     text = (ROOT / "README.md").read_text().split(marker, 1)[1]
     return " ".join(text.split()[:8])
 
@@ -101,8 +101,8 @@ def test_front_page(site, tmp_path):
     page = site / "index.html"
     assert_not_blank(screenshot(page, tmp_path))
     dom, text = page_text(page, tmp_path)
-    assert readme_after("# spinviz") in text                  # the README's intro, included
-    for title in ("Tutorial", "Getting started", "Gallery", "Physics notes", "API reference"):
+    assert readme_after("# spinviz") in text                  # the README's opening, included
+    for title in ("Tutorial", "Getting started", "Commands", "Gallery", "Physics notes", "API reference"):
         assert title in text
     assert "on the right replaced by the free-motion values (2.3a), (2.3b)" in text     # the models table
     # the README's video, as the gallery rendered it in this build (not the committed GIF)
@@ -136,10 +136,35 @@ def test_physics_equations_render_offline(site, tmp_path):
     assert written >= 25 and typeset >= written, (typeset, written)
     assert "<mjx-merror" not in dom and "data-mjx-error" not in dom
     assert "The paper prints c² in (3.3)–(3.5); c³ is right" in text
-    assert readme_after("how spinviz treats them:") in text   # the README's typo list, included
-    # what a detector sees and hears: the gallery's pictures of this build, not committed ones
-    assert [p.name for p in images(site / "physics.html", dom)] == ["sphx_glr_plot_observe_001.png",
-                                                                     "sphx_glr_plot_listen_001.png"]
+    assert "(4.43)’s 7δ − 6 is 7δ − 4" in text                  # the typo list (MyST's typographic quote)
+    assert "Does each model balance what it radiates?" in text
+
+
+def test_experiment_page_shows_this_builds_pictures(site, tmp_path):
+    """What a detector sees and hears: the gallery's pictures of this build, not committed ones."""
+    page = site / "experiment.html"
+    assert_not_blank(screenshot(page, tmp_path))
+    dom, text = page_text(page, tmp_path)
+    shown = images(page, dom)
+    assert [p.name for p in shown if p.name.startswith("sphx_glr_")] == ["sphx_glr_plot_observe_001.png",
+                                                                          "sphx_glr_plot_listen_001.png"]
+    for p in shown:
+        assert_drawn(picture(p))
+    assert "How long to watch (spinviz decide)" in text and "The receiver ([observe])" in text
+
+
+def test_commands_page(site, tmp_path):
+    """Every command of the parser has its row, and the promises are there."""
+    from spinviz.commands import COMMANDS
+
+    page = site / "commands.html"
+    assert_not_blank(screenshot(page, tmp_path))
+    dom, text = page_text(page, tmp_path)
+    for name in COMMANDS:
+        assert f"spinviz {name}" in text, name
+    for job in ("run", "verify", "bench", "evidence"):
+        assert f"spinviz atlas {job}" in text, job
+    assert "What every command promises" in text and "Ctrl-C, SIGTERM, SIGHUP" in text
 
 
 def test_gallery_has_a_drawn_thumbnail_for_every_example(site, tmp_path):
@@ -189,6 +214,13 @@ def test_gallery_pages_show_what_their_code_made(site, tmp_path):
         assert "Traceback" not in texts[name]
     # render_frame's arrays are shown pixel for pixel: 640 x 360, the size the code asked for
     assert [picture(p).shape for p in shown["plot_render_frames"]] == [(360, 640, 3)] * 3
+    # no two examples show the same picture
+    seen: dict = {}
+    for name, files in shown.items():
+        for p in files:
+            key = picture(p).tobytes()
+            assert key not in seen or seen[key] == name, f"{name} shows the same picture as {seen[key]}"
+            seen[key] = name
     # the video is a GIF that plays: 80 frames (8 s at 10 fps), and the picture moves
     gif = next(p for p in shown["plot_video"] if p.suffix == ".gif")
     with Image.open(gif) as im:

@@ -157,7 +157,7 @@ def test_taylor_error_follows_the_tolerance_on_an_askew_body():
     """An asymmetric body with a tilted dipole, reduced equation, 400 turns at tau0 |Omega0| =
     1e-2 (it brakes to ~1/5 of its spin), against the long-double reference: the orientation
     error falls with rtol (measured 1.7e-9, 9.8e-12, 7.5e-13 rad at 1e-10, 1e-12, 1e-13), each
-    within 30 x rtol, and reaches the 1e-11 rad the README claims at rtol 1e-13."""
+    within 30 x rtol, and reaches the 1e-11 rad docs/integrators.md claims at rtol 1e-13."""
     w0 = np.array([0.3, 0.5, 0.8]) / np.linalg.norm([0.3, 0.5, 0.8]) * 1e-2
     kw = dict(t_end=2.0 * math.pi * 400 / 1e-2, samples=41, euler_zxz0=(0.2, 0.9, -0.3))
     ref = simulate(ASYMMETRIC, "reduced", w0, method="taylor-long", rtol=1e-18, atol=1e-18, **kw)

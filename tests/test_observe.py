@@ -70,7 +70,7 @@ def test_cube_models_part_when_the_closed_forms_say(cube):
     assert obs.parting["frequency"].at(0.01) == pytest.approx(t_freq, rel=1e-4)
     assert obs.parting["frequency"].at(1e-6) == pytest.approx(t_1e6, rel=1e-4)
     assert obs.parting["polarization"].at(math.radians(0.1)) is None
-    # the README's numbers: 1.9 days, 8.6 hours, 4.5 minutes, against Theta = 3.15 days
+    # docs/experiment.md's numbers: 1.9 days, 8.6 hours, 4.5 minutes, against Theta = 3.15 days
     assert t_power / 86400 == pytest.approx(1.92, abs=0.01) and t_freq / 3600 == pytest.approx(8.6, abs=0.05)
     assert t_1e6 / 60 == pytest.approx(4.54, abs=0.01)
 

@@ -532,7 +532,7 @@ def _near(px, rgb, tol=40):
 
 @pytest.mark.parametrize("size", [(640, 360), (1280, 720)])
 def test_power_inset_pixels_in_the_default_scene(size):
-    """The README's main scene, in its pixels: inside the power plot's box both model colours
+    """The default scene (the quick start's), in its pixels: inside the power plot's box both model colours
     are drawn; the cursor (a muted column) stands where the plan puts it -- right above the time
     bar's cursor -- at the first, middle and last frames, with each model's dot on it; and late in
     the run the reduced (teal) curve runs far below the truncated (purple) one: its residual

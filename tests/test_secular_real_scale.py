@@ -1,5 +1,5 @@
 """secular where the paper's real particles live (tau0 |Omega0| << 1), against full integration:
-each test fails on the first-order averaging it replaced (measurements in the README)."""
+each test fails on the first-order averaging it replaced (measurements in docs/integrators.md)."""
 
 import math
 

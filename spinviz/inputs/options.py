@@ -73,7 +73,7 @@ def count_of(seeds) -> int:
 
 
 # --- check --sweep --------------------------------------------------------------------------
-SWEEP_S_PER_RUN = 0.2            # one secular-against-taylor comparison (README: 18 seeds x 40 runs in 142 s)
+SWEEP_S_PER_RUN = 0.2            # one secular-against-taylor comparison (docs/integrators.md: 18 seeds x 40 runs in 142 s)
 MAX_SEED = 2**63 - 1             # numpy's default_rng takes any non-negative integer; this one fits an int64
 
 
@@ -119,7 +119,7 @@ class SweepRequest:
 
 # --- bench, bench --process -----------------------------------------------------------------
 # One repeat runs every point of the plan once more (the minimum of the repeats is kept): from
-# the durations the README and the commands' help give for 3 repeats, with their warm-up and
+# the durations the docs and the commands' help give for 3 repeats, with their warm-up and
 # reference runs counted as one more repeat.
 BENCH_S_PER_REPEAT = {"quick": 40.0, "full": 600.0}
 PROCESS_S_PER_REPEAT = {"quick": 15.0, "full": 75.0}

@@ -17,7 +17,7 @@ dimensionless::
 
 Physical bodies are given in CGS with named units (``preset = "dast_cube"``,
 ``shape = "rod"`` with ``length_nm`` ...), and then omega is in rad/s and t_end in s; see
-the README for every key.  Angles are radians unless the key ends in ``_deg``.
+docs/scenes.md for every key.  Angles are radians unless the key ends in ``_deg``.
 
 Every table is declared once (``inputs.scene``, ``[render]`` in ``inputs.render``) and the
 simulation settings are checked by the same ``SimulationRequest`` that checks

@@ -73,7 +73,7 @@ class Integrator:
     solve(problem, rtol, atol, step) -> Solution;
     kinematics : the kinematics it supports; symmetric_only : needs I1 = I2; stiff : an
     implicit method; detects_stiffness : accepts ``stop_on_stiffness=True``;
-    description : one line for ``spinviz methods`` and the README.
+    description : one line for ``spinviz methods`` and docs/integrators.md.
     rtol_floor : the tolerance below which its error stops following rtol (measured on the
     benchmark's askew bodies, ``spinviz bench``), or None (fixed step, or reported per run).
     compiled : runs the numba kernels, which know a model by its ``kernel_id``

@@ -8,7 +8,7 @@ fixed (the torque across L turns with the spin and averages out), theta_L from t
 variables, psi = pi/2 - p from the body-frame phase, and phi the precession about L.
 
 What it guarantees, and what it reports (stats; measured against full integration at
-eps = tau0 |Omega0| = 1e-4 .. 1e-6, see the README):
+eps = tau0 |Omega0| = 1e-4 .. 1e-6, see docs/integrators.md):
 
 * slow variables (|Omega|, omega_perp, omega3, theta_L): about 10 eps^2 where averaged, the
   integrator's tolerance where in full, plus ~30 mu*^2 per hand-over;
@@ -260,7 +260,7 @@ def _stats(setup: Setup, cnt, switches, rtol: float, t) -> dict:
     """What the run did and how sure it is, before the resonance scan.
 
     The error statements are bounds fitted to measurements against full integration on random
-    bodies (README; ``spinviz check --sweep``, and a seed of it in
+    bodies (docs/integrators.md; ``spinviz check --sweep``, and a seed of it in
     tests/test_secular_real_scale.py): where averaged, the phases drift by ~ integral of
     mu^2 dt and at least 2 eps max(1, t/T), the slow variables are off by ~ max(15 eps^2,
     mu^2), with mu = eps |w|^2 / |delta w3| the radiation rate over the precession rate (small

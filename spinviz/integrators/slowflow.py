@@ -26,7 +26,7 @@ for the orientation: regular where e3 lines up with +-L, unlike phi and psi sepa
 Its rate includes the radiation part of the precession (``sigma_rate``).
 
 Units: spin units of spinviz (|omega(0)| = 1, coupling g with |g|^2 = eps).  J = (1, 1, J3).
-Ported from a research prototype; the measurements are in the README ("secular").
+Ported from a research prototype; the measurements are in docs/integrators.md ("secular").
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """The atlas at single points inside each domain: label shares, exponents and amplitudes
-against the paper's formulas (the README's validation table).
+against the paper's formulas (docs/atlas.md's validation table).
 
     spinviz atlas evidence validate [--members 32] [--workers 2] [--json]
 

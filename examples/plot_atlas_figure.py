@@ -31,10 +31,7 @@ import json
 import numpy as np
 import xarray as xr
 
-from spinviz.regimes.engine.classify import CODE
-from spinviz.regimes.figures.cells import shares
-from spinviz.regimes.figures.diagram import diagram
-from spinviz.regimes.figures.hodographs import hodographs
+from spinviz import regimes
 
 saved = np.load("data/atlas_figure_labels.npz")
 spec = json.loads(str(saved["spec"]))
@@ -46,7 +43,7 @@ print(f"{len(spec['delta'])} x {len(spec['chi'])} cells, {spec['members']['count
 # %%
 # Each level as the Dataset ``spinviz.atlas`` returns (``label`` and ``limit_label``: the
 # types' names, as ``store.open_atlas`` decodes them), the coarse grid first.
-NAMES = {code: name for name, code in CODE.items()}
+NAMES = {code: name for name, code in regimes.TYPE_CODES.items()}
 DIMS = ("model", "delta", "chi", "member")
 levels = []
 for k in range(int(saved["levels"])):
@@ -71,7 +68,7 @@ levels[0] = coarse.assign_coords(tau=("sample", saved["tau"]), start=np.arange(s
 # counts it (a run still approaching a type counts for that type; "failed": truncated starts too close
 # to that equation's singular surface, near δ = 1, refused rather than integrated through it).
 for model in levels[0]["model"].values:
-    by_type = {name: 100 * float(s.mean()) for name, s in shares(levels[0], str(model)).items()}
+    by_type = {name: 100 * float(s.mean()) for name, s in regimes.shares(levels[0], str(model)).items()}
     print(f"{model:>9}: " + ", ".join(f"{name} {p:.1f} %" for name, p in sorted(by_type.items(), key=lambda kv: -kv[1])))
 
 # %%
@@ -80,11 +77,11 @@ for model in levels[0]["model"].values:
 # its type at τ_end; a dot: two types coexist among the starts); thick lines are sharp
 # boundaries, a band under a line a coexistence band; black, the paper's boundaries as
 # printed; blue and red, the lines spinviz derived; grey, the DAST families of figure 5.
-diagram(levels, "atlas_figure.png")
+regimes.diagram(levels, "atlas_figure.png")
 
 # %%
 # The hodographs of the most confident run of each type: ω·√(τ + 1/ω₀²) in the body frame
 # (ω₀ the starting spin rate), as the paper's figure 3 draws them; a ring marks where a run
 # went over to the averaged flow (after it, the amplitudes are the run's, the phase the
 # averaged one).
-hodographs(levels[0], "atlas_figure_hodographs.png")
+regimes.hodographs(levels[0], "atlas_figure_hodographs.png")

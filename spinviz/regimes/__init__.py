@@ -16,7 +16,9 @@ data flows:
 * ``api`` -- ``atlas(spec, out, ...)``: levels, resume, execution; ``bench`` -- its
   benchmark; ``faults`` -- how the atlas fails, one line each.
 
-Importing this package is light (numba, dask and matplotlib load on first use).
+Public here: ``atlas``, ``open_atlas``, ``verify``, the failures, and the pictures of a store's
+levels (``diagram``, ``hodographs``, ``shares``; ``TYPE_CODES``: each type's name -> the code
+the store keeps).  Importing this package is light (numba, dask and matplotlib load on first use).
 """
 
 from __future__ import annotations
@@ -30,6 +32,11 @@ _API = {
     "verify": ("store.dataset", "verify"),
     "AtlasIncomplete": ("faults", "AtlasIncomplete"),
     "StoreDamaged": ("faults", "StoreDamaged"),
+    # the pictures of a store's levels, as ``atlas(..., plot=...)`` draws them, for a notebook
+    "diagram": ("figures.diagram", "diagram"),
+    "hodographs": ("figures.hodographs", "hodographs"),
+    "shares": ("figures.cells", "shares"),
+    "TYPE_CODES": ("engine.classify", "CODE"),
 }
 
 __all__ = sorted(_API)

@@ -101,7 +101,8 @@ class Averages:
     (the transform U); vcoef : rfft coefficients of the phase's oscillation V (zero where not
     computed).  w0 : rfft coefficients of Sigma_dot_free's zero-mean part (W0 = its integral /
     omega_p).  shifted : the forced offset is taken off (``Flow.shift_mode``).
-    mu_osc : largest oscillation of the slow variables over a period; mu_ad : relative change of
+    mu_osc : largest oscillation of the slow variables over a period; mu_slope : its largest
+    slope per radian of phase (what a phase error costs the slow variables); mu_ad : relative change of
     omega_p over one period; mu_sep : change of the separatrix distance over one period against
     that distance.  nodes : N.  pol : the ``Polhode``.
     """
@@ -119,6 +120,7 @@ class Averages:
     nodes: int
     pol: P.Polhode
     shifted: bool
+    mu_slope: float
 
 
 class Flow:
@@ -307,7 +309,9 @@ class Flow:
             if phases:
                 u_rate = omega_p + float(np.mean(gamma))
                 sigma_rate = self._sigma_rate(pol, x, u, w, a, f, omega_p, ffree, S, gamma)
-        return Averages(rates, omega_p, u_rate, sigma_rate, osc, vcoef, w0, mu_osc, mu_ad, mu_sep, N, pol, shifted)
+        mu_slope = float(np.max(np.abs(f_osc))) / omega_p
+        return Averages(rates, omega_p, u_rate, sigma_rate, osc, vcoef, w0, mu_osc, mu_ad, mu_sep, N, pol, shifted,
+                        mu_slope)
 
     def _grad_ln_frequency(self, x) -> np.ndarray:
         """d ln omega_p / dx (central differences)."""

@@ -293,3 +293,26 @@ def angle_range(pol: Polhode, d_body, n: int = 256) -> tuple[float, float]:
     L = np.asarray(pol.J, dtype=float) * w
     a = R.angle_between(np.broadcast_to(np.asarray(d_body, dtype=float), L.shape), L)
     return float(np.min(a)), float(np.max(a))
+
+
+def angle_variables(pol: Polhode, n: int = 64) -> tuple[float, float, np.ndarray]:
+    """(omega_p, nu_Sigma, c): the free motion's two frequencies -- the polhode's and Sigma's
+    mean rate -- and the rfft coefficients c (n // 2 + 1,) of Sigma_dot's zero-mean part over
+    one period, from which ``sigma_periodic`` gives Sigma - nu_Sigma t - const at any phase."""
+    u = pol.nodes(n)
+    w = pol.omega(u)
+    f = np.stack(free_rate(w[:, 0], w[:, 1], w[:, 2], pol.J, None), axis=-1)
+    c = np.fft.rfft(pol.sigma_rate(w, f)) / n
+    nu = float(np.real(c[0]))
+    c[0] = 0.0
+    return float(pol.frequency), nu, c
+
+
+def sigma_periodic(c: np.ndarray, omega_p: float, u) -> np.ndarray:
+    """W0(u): the periodic part of Sigma along the free motion at phases u (``angle_variables``'
+    coefficients c integrated over the phase, divided by omega_p); Sigma = Sigma_bar + W0(u)
+    with Sigma_bar advancing uniformly at nu_Sigma."""
+    u = np.asarray(u, dtype=float)
+    k = np.arange(1, c.size)
+    coef = 2.0 * c[1:] / (1j * k)
+    return np.real(np.sum(coef * np.exp(1j * u[..., None] * k), axis=-1)) / omega_p

@@ -58,6 +58,9 @@ def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", ste
     ``SpecError`` names "step" or "t_end"."""
     method = str(method).lower()
     auto = method == "auto"
+    if not body.is_symmetric and (auto or method == "polhode"):
+        # before any prediction: a horizon the averaged flow cannot represent is refused at once
+        _check_polhode_horizon(body, model, omega0, t_end, spin, "polhode")
     if auto:
         method = picked or choose_method(body, model, omega0, t_end, kinematics, spin=spin)[0]
     if method in HANDOVERS or method == "polhode":

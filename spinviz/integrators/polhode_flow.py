@@ -53,6 +53,7 @@ NODES_PER_K = 12.0       # and this many per quarter period K(m): the nome exp(-
 N_MAX = 4096
 SHIFT_RATIO = 0.1        # the forced offset taken off before averaging above this share of the polhode's size
 FD_REL = 1e-6            # relative step of the central differences in x and along a
+LN_P_MIN = -690.0        # ln(p / X) below which the polhode is taken as that size (float64 ends at -745)
 NEAR_AXIS = 1e-6         # p/X below which the radiation is split by degree in omega_perp (``_radiation_nodes``)
 
 
@@ -139,17 +140,22 @@ class Flow:
         self.free = system.model == "free"
         self.eps = float(np.dot(self.g, self.g))
         self._cache: dict = {}
+        o, m, _ = P.Polhode(self.J, self.c, self.s_c, 1.0, 1.0).labels
+        Jm, Jc = self.J[m], self.J[self.c]
+        self._ln_sep = math.log(abs(Jc - Jm) / Jm) if Jc != Jm else math.inf   # ln(p_sep / X)
 
     def polhode(self, x) -> P.Polhode:
         return P.Polhode(self.J, self.c, self.s_c, math.exp(x[0]), math.exp(x[1]))
 
     def x_of(self, omega) -> np.ndarray:
-        """(ln X, ln p) of body-frame states (..., 3) about this flow's axis."""
+        """(ln X, ln p) of body-frame states (..., 3) about this flow's axis (p at least 1e-200 X)."""
         w = np.asarray(omega, dtype=float)
         J = self.Jv
         X = np.sum(J * J * w * w, axis=-1)
         p = np.sum(J * np.abs(J[self.c] - J) * w * w, axis=-1)
-        return np.stack([np.log(X), np.log(p)], axis=-1)
+        # a spin exactly along the axis is the polhode of size 0: taken as one 1e-200 of |L|^2 (no
+        # rate, and no output, can tell them apart; the logarithm stays finite)
+        return np.stack([np.log(X), np.log(np.maximum(p, 1e-200 * X))], axis=-1)
 
     # --- the radiation along the polhode --------------------------------------------------------
     def _radiation(self, w) -> np.ndarray:
@@ -213,7 +219,9 @@ class Flow:
             system = System(self.system.model, self.J, tuple(math.sqrt(lam) * gi for gi in self.g))
             fn = Flow(system, self.c, self.s_c)
             self._cache[key] = fn
-        return lam, fn, np.array([0.0, float(x[1]) - float(x[0])])
+        # a trial state of the solver beyond the separatrix (p > p_sep) is held just inside it, and a
+        # polhode below e^-690 of |L|^2 (nothing in float64 tells it from the axis) at that size
+        return lam, fn, np.array([0.0, min(max(float(x[1]) - float(x[0]), LN_P_MIN), self._ln_sep - 1e-12)])
 
     def rates(self, x) -> np.ndarray:
         """The averaged (d ln X/dt, d ln p/dt) at x alone, first order (a plan's quick look)."""

@@ -78,13 +78,13 @@ def ellipj(u, m, m1=None):
         # one parameter for all u (a polhode's nodes): the Landen sequence once, in floats
         a, b, c = 1.0, math.sqrt(max(float(m1), 0.0)), math.sqrt(max(float(m), 0.0))
         as_, cs = [a], [c]
-        n = 0
-        for n in range(1, _MAX_ITER):
+        while len(as_) < _MAX_ITER:
             a, b, c = 0.5 * (a + b), math.sqrt(a * b), 0.5 * (a - b)
             as_.append(a)
             cs.append(c)
             if abs(c) <= _TOL * a:
                 break
+        n = len(as_) - 1
     else:
         u, m, m1 = np.broadcast_arrays(u, m, m1)
         a = np.ones(u.shape)
@@ -92,13 +92,13 @@ def ellipj(u, m, m1=None):
         c = np.sqrt(np.maximum(m, 0.0))
         cs = [c]
         as_ = [a]
-        n = 0
-        for n in range(1, _MAX_ITER):
+        while len(as_) < _MAX_ITER:
             a, b, c = 0.5 * (a + b), np.sqrt(a * b), 0.5 * (a - b)
             as_.append(a)
             cs.append(c)
             if np.all(np.abs(c) <= _TOL * a):
                 break
+        n = len(as_) - 1
     phi = (2.0 ** n) * a * u
     for i in range(n, 0, -1):
         phi = 0.5 * (phi + np.arcsin(np.clip(cs[i] * np.sin(phi) / as_[i], -1.0, 1.0)))

@@ -99,7 +99,6 @@ def choose_spin_mode(spec: RenderSpec, trajs: list[Trajectory], sim_t) -> tuple[
     ``MAX_TRUE_DEG_PER_FRAME`` between frames."""
     if not spec.needs_orientation:
         return "true", "no orientation shown"
-    body = trajs[0].body
     resolved = all(tr.phase_resolved and tr.q is not None for tr in trajs)
     if spec.spin == "true":
         if not resolved:

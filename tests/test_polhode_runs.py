@@ -44,14 +44,15 @@ def errors(a, b, J):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("model", ["reduced", "truncated"])
-@pytest.mark.parametrize("J, d, w", [(BOX, D_BOX, (0.3, 0.5, 0.81)), ((1.0, 0.57, 1.24), D_SKEW, (-0.6, 0.7, 0.4))],
+@pytest.mark.parametrize("J, d, w", [(BOX, D_BOX, (0.3, 0.5, 0.81)), ((1.0, 0.57, 1.24), D_SKEW, (0.3, 0.4, 0.87))],
                          ids=["dast-box", "skew-dipole"])
 def test_errors_within_the_statements_and_falling_as_eps_squared(model, J, d, w):
-    """tau0 |Omega0| = 1e-3, 1e-4, 1e-5 over one braking time (up to 1.6e4 turns), against Taylor at
-    rtol = atol = 1e-13: |L|, 2E, L's direction and the orientation within the stated errors;
-    |L| and 2E falling as eps^2 (second-order averaging with the first-order transform: fitted
-    exponent >= 1.7; the L direction falls as eps where no resonance is crossed, as sqrt(eps)
-    through one, both within its statement)."""
+    """tau0 |Omega0| = 1e-3, 1e-4, 1e-5 over one braking time (up to 1.6e4 turns), far from the
+    separatrix, against Taylor at rtol = atol = 1e-13: |L|, 2E, L's direction and the orientation
+    within the stated errors; |L| and 2E falling as eps^2 (second-order averaging with the
+    first-order transform: fitted exponent >= 1.7, measured 1.8-2.1; the L direction falls as eps
+    where no resonance is crossed, as sqrt(eps) through one, both within its statement).  Through
+    a separatrix the error is set by the hand-over instead (the crossing test below)."""
     slow = []
     for eps in (1e-3, 1e-4, 1e-5):
         pr = problem(J, d, model, eps, w, 1.0)

@@ -27,7 +27,7 @@ from ..errors import RenderError, SceneError, SimulationError, SpecError, Spinvi
 from .shared import EXIT_FAIL, EXIT_USAGE, Parser, Stream, WriteFailed, named, options_of, say
 
 COMMANDS = ("check", "info", "simulate", "render", "compare", "observe", "decide", "listen", "bench", "stress",
-            "report", "methods", "atlas")
+            "report", "methods", "atlas", "boxes")
 
 
 def command(name: str):

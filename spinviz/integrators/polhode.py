@@ -161,31 +161,19 @@ def _averaged_stage(run: _Run):
     except P.NoPolhode:
         return None                                  # on the separatrix itself: the full stage takes it
     flow = Flow(system, c, s_c)
-    x0 = flow.x_of(run.w)
-    if mu_of(flow.averages(x0, phases=False)) > MU_IN:
+    if mu_of(flow.averages(flow.x_of(run.w), phases=False)) > MU_IN:
         return None
     o2 = run.order2
-    xbar, u0, _, _ = flow.to_averaged(run.w, order2=o2)
-    with_q = run.q is not None
-    L_world = R.world_from_body(run.qs, np.asarray(system.inertia) * run.w)
-    q_L = R.quat_between((0.0, 0.0, 1.0), L_world)
-    av0 = flow.averages(xbar, phases=False, order2=o2)
-    pol_true = flow.polhode(flow.x_of(run.w))
-    u_true = float(flow._phase(run.w - (flow.forced_offset(float(run.w[c])) if av0.shifted else 0.0)))
-    sig0 = P.sigma_of(pol_true, q_L, run.qs) - float(flow.w0(av0, u_true))
-    y0 = np.array([xbar[0], xbar[1], u0, sig0])
-    t_all = run.t
-    t0 = run.s
+    y0, q_L, av0 = _averaged_start(run, flow)
+    t_all, t0 = run.t, run.s
     out_t = t_all[run.j:]
     count = {"n": 0}
     # the clock: s = ln(1 + (t - t0) / tb), tb the braking time at the start -- a spin braking as a power
     # of t is then nearly linear in s, and each decade of a long horizon costs a few steps, not tens
     r0 = av0.rates
-    tb = 1.0 / max(abs(float(r0[0])) + abs(float(r0[1])), 1.0 / max(float(t_all[-1]) - t0, 1e-300))
-    clock = _Clock(t0, tb)
+    clock = _Clock(t0, 1.0 / max(abs(float(r0[0])) + abs(float(r0[1])), 1.0 / max(float(t_all[-1]) - t0, 1e-300)))
     # beyond float64 the phases are not resolved whatever their error: their tolerance is then left out
-    atol = np.array([run.atol, run.atol, run.atol, run.atol]) if run.phase_corrections else \
-        np.array([run.atol, run.atol, 1e300, 1e300])
+    atol = np.array([run.atol] * 4) if run.phase_corrections else np.array([run.atol, run.atol, 1e300, 1e300])
 
     def rhs(s_, y):
         count["n"] += 1
@@ -209,25 +197,41 @@ def _averaged_stage(run: _Run):
         return f"the averaged flow: {sol.message}"
     t_end = float(clock.t(float(sol.t_events[0][0]))) if sol.status == 1 else float(t_all[-1])
     run.segments.append([t0, "averaged", c, s_c])
-    path = _Path(sol, clock)
-    # the outputs reached
+    _averaged_end(run, flow, _Path(sol, clock), q_L, t0, t_end, left=sol.status == 1)
+    run.axis_end = (c, s_c)
+    return None
+
+
+def _averaged_start(run: _Run, flow: Flow):
+    """(y0 = (x_bar, u_bar, Sigma_bar), q_L, the averages at x_bar) of the true state (run.w, run.qs)."""
+    system = run.problem.system
+    o2 = run.order2
+    xbar, u0, _, _ = flow.to_averaged(run.w, order2=o2)
+    q_L = R.quat_between((0.0, 0.0, 1.0), R.world_from_body(run.qs, np.asarray(system.inertia) * run.w))
+    av0 = flow.averages(xbar, phases=False, order2=o2)
+    pol_true = flow.polhode(flow.x_of(run.w))
+    u_true = float(flow._phase(run.w - (flow.forced_offset(float(run.w[flow.c])) if av0.shifted else 0.0)))
+    sig0 = P.sigma_of(pol_true, q_L, run.qs) - float(flow.w0(av0, u_true))
+    return np.array([xbar[0], xbar[1], u0, sig0]), q_L, av0
+
+
+def _averaged_end(run: _Run, flow: Flow, path, q_L, t0: float, t_end: float, left: bool):
+    """The outputs an averaged stretch reached, its error terms and resonances, and (``left`` for
+    the full stage) the true state where it ends."""
+    out_t = run.t[run.j:]
     k = int(np.searchsorted(out_t, t_end, side="right"))
     if k:
-        ys = path.state(out_t[:k]).T
-        _fill(run, flow, q_L, ys, with_q)
+        _fill(run, flow, q_L, path.state(out_t[:k]).T, run.q is not None)
         run.j += k
     _charge(run, flow, path, t0, t_end)
-    if sol.status == 1:                     # left for the full stage: what the averaged flow did not see there
-        mu_exit = flow.averages(path.state(t_end)[:2], phases=False, order2=o2).mu_osc
+    if left:                                 # left for the full stage: what the averaged flow did not see there
+        mu_exit = flow.averages(path.state(t_end)[:2], phases=False, order2=run.order2).mu_osc
         run.terms["slow_entry"] += mu_exit * mu_exit
         run.terms["phase_entry"] += mu_exit
     _resonances(run, flow, path, t0, t_end)
     run.s = t_end
-    if t_end < t_all[-1]:
-        w, q = _true_state(flow, q_L, path.state(t_end), o2)
-        run.w, run.qs = w, q
-    run.axis_end = (c, s_c)
-    return None
+    if t_end < run.t[-1]:
+        run.w, run.qs = _true_state(flow, q_L, path.state(t_end), run.order2)
 
 
 class _Clock:

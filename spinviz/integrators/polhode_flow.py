@@ -145,6 +145,7 @@ class Flow:
         self._ln_sep = math.log(abs(Jc - Jm) / Jm) if Jc != Jm else math.inf   # ln(p_sep / X)
 
     def polhode(self, x) -> P.Polhode:
+        """The free polhode at slow state x = (ln X, ln p) about this flow's axis."""
         return P.Polhode(self.J, self.c, self.s_c, math.exp(x[0]), math.exp(x[1]))
 
     def x_of(self, omega) -> np.ndarray:

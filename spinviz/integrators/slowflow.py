@@ -261,26 +261,31 @@ def initial_step(mode, sgn, model, J, g, cM, sM, equiv, y, f0, rtol, atol, n, h_
 @_jit
 def to_avg(model, J, g, cM, sM, y, p_unw, use_nit):
     """FULL state -> AVG state in place: the forced response z_f taken off, then the transform
-    inverted to first order; returns the shift of phi."""
+    inverted to first order; returns (the shift of phi, the shift of the phase by taking z_f off).
+    The caller adds sgn x the second to phi: Sigma = phi + sgn psi, the spin angle about e3, stays
+    what it was (where omega_perp is mostly z_f the body spins about e3 at omega3, and Sigma carries
+    that; the free circle's phase is then not omega_perp's)."""
     w3 = y[2]
     z1, z2 = forced_z(model, J, g, w3)
     v1, v2 = y[0] - z1, y[1] - z2
     wp = math.hypot(v1, v2)
     # the free circle's phase, on the branch of the unwrapped phase of omega_perp
     p = p_unw + (math.atan2(v2, v1) - p_unw + math.pi) % (2.0 * math.pi) - math.pi
+    dsplit = p - p_unw
     dphi = 0.0
     if use_nit:
         u = nit(model, J, g, cM, sM, wp, w3, p)
         wp, w3, p = wp - u[0], w3 - u[1], p - u[2]
         dphi = -u[3]
     y[0], y[1], y[2] = wp, w3, p
-    return dphi
+    return dphi, dsplit
 
 
 @_jit
 def to_full(model, J, g, cM, sM, y, use_nit):
     """AVG state -> FULL state in place (the forced response z_f added back); returns (unwrapped
-    phase of omega_perp, shift of phi)."""
+    phase of omega_perp, shift of phi, shift of the phase by adding z_f: the caller adds sgn x it
+    to phi, as for ``to_avg``)."""
     wp, w3, p = y[0], y[1], y[2]
     dphi = 0.0
     if use_nit:
@@ -290,7 +295,8 @@ def to_full(model, J, g, cM, sM, y, use_nit):
     z1, z2 = forced_z(model, J, g, w3)
     y[0], y[1], y[2] = wp * math.cos(p) + z1, wp * math.sin(p) + z2, w3
     # the unwrapped phase of omega_perp itself, on the free circle's branch
-    return p + (math.atan2(y[1], y[0]) - p + math.pi) % (2.0 * math.pi) - math.pi, dphi
+    p_true = p + (math.atan2(y[1], y[0]) - p + math.pi) % (2.0 * math.pi) - math.pi
+    return p_true, dphi, p_true - p
 
 
 @_jit
@@ -308,7 +314,8 @@ def phase_nodes(M):
 def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_steps, phi0, A, B, E3, E5, D, stop):
     """Integrate from the body-frame w0 (spin units) over t_eval.
 
-    Returns (out (N, 6): w1, w2, w3, phi, p, mode at each output; counters (16,); switches
+    Returns (out (N, 7): w1, w2, w3 (the forced response included), phi, p, mode and the free
+    circle's radius (the pose's nutation: in FULL mode |omega_perp|) at each output; counters (16,); switches
     (K, 2): time and new mode; crossings (K, 4): time, w_perp, w3 and m of every passage
     through a resonance |L|/I1 = m delta w3; status).  phi: the ZXZ precession angle about the
     fixed L, from phi0; p: the unwrapped body-frame phase of omega_perp (psi = pi/2 - p).
@@ -320,7 +327,7 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
     # Long on purpose: one compiled loop whose step, hand-over and dense output share ~20 local arrays and counters.
     N = t_eval.shape[0]
     n = 4
-    out = np.empty((N, 6))
+    out = np.empty((N, 7))
     cnt = np.zeros(16)
     cnt[13] = -1.0
     sw = np.zeros((MAX_SWITCHES, 2))
@@ -344,10 +351,11 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
     else:
         mode = FULL if mu_ad(FULL, y, eps, delta) > mu_star else AVG
     dphi = 0.0
+    dsplit = 0.0
     if mode == AVG:
-        dphi = to_avg(model, J, g, cM, sM, y, p_unw, not equiv)
+        dphi, dsplit = to_avg(model, J, g, cM, sM, y, p_unw, not equiv)
     sgn = 1.0 if w0[2] >= 0.0 else -1.0
-    y[3] = phi0 + dphi + sgn * (0.5 * math.pi - (y[2] if mode == AVG else p_unw))
+    y[3] = phi0 + dphi + sgn * dsplit + sgn * (0.5 * math.pi - (y[2] if mode == AVG else p_unw))
     detunings(mode, y, J[2], delta, Fold)
     t = t_eval[0]
     t_end = t_eval[-1]
@@ -355,6 +363,7 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
     out[0, 3] = phi0
     out[0, 4] = p_unw
     out[0, 5] = mode
+    out[0, 6] = math.hypot(w0[0], w0[1])
     j_out = 1
     rhs(mode, sgn, model, J, g, cM, sM, equiv, y, K[0])
     nf = 1
@@ -408,6 +417,7 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
                 if mode == FULL:
                     out[j_out, 0], out[j_out, 1], out[j_out, 2] = ys[0], ys[1], ys[2]
                     out[j_out, 4] = p_old + (math.atan2(ys[1], ys[0]) - p_old + math.pi) % (2.0 * math.pi) - math.pi
+                    out[j_out, 6] = math.hypot(ys[0], ys[1])
                     out[j_out, 3] = ys[3] - sgn * (0.5 * math.pi - out[j_out, 4])
                 else:
                     out[j_out, 3] = ys[3] - sgn * (0.5 * math.pi - ys[2])
@@ -421,9 +431,8 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
                     out[j_out, 0] = wp_o * math.cos(p_o) + z1
                     out[j_out, 1] = wp_o * math.sin(p_o) + z2
                     out[j_out, 2] = w3_o
-                    # the phase of omega_perp itself (the pose's psi), on the free circle's branch
-                    out[j_out, 4] = p_o + (math.atan2(out[j_out, 1], out[j_out, 0]) - p_o + math.pi) \
-                        % (2.0 * math.pi) - math.pi
+                    out[j_out, 4] = p_o
+                    out[j_out, 6] = wp_o
                 out[j_out, 5] = mode
                 j_out += 1
         if mode == FULL:
@@ -477,15 +486,16 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
             switch = False
             phi_now = y[3] - sgn * (0.5 * math.pi - (y[2] if mode == AVG else p_unw))
             if mode == FULL and mu < HYST * mu_star:
-                phi_now += to_avg(model, J, g, cM, sM, y, p_unw, True)
+                dphi, dsplit = to_avg(model, J, g, cM, sM, y, p_unw, True)
+                phi_now += dphi + sgn * dsplit
                 mode = AVG
                 switch = True
             elif mode == AVG:
                 if mu > cnt[6]:
                     cnt[6] = mu
                 if mu > mu_star:
-                    p_unw, dphi = to_full(model, J, g, cM, sM, y, True)
-                    phi_now += dphi
+                    p_unw, dphi, dsplit = to_full(model, J, g, cM, sM, y, True)
+                    phi_now += dphi + sgn * dsplit
                     mode = FULL
                     switch = True
             if switch:

@@ -32,7 +32,7 @@ def figure(ds, path: str, title: str, mark=None) -> None:
             w = (0.35 + 0.65 * np.nan_to_num(share))[..., None]
             rgb = np.where((dom == code)[..., None], 1.0 - w * (1.0 - c), rgb)
         xe, ye = _edges(bx), _edges(cy)
-        ax.pcolormesh(xe, ye, np.zeros(dom.shape), color=rgb.reshape(-1, 3), shading="flat")
+        ax.pcolormesh(xe, ye, rgb, shading="flat")                   # an RGB per box
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlim(xe[0], xe[-1])

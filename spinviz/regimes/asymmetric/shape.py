@@ -114,7 +114,7 @@ def shape_flow(J, d, model: str) -> Shape:
         parts_D.append(D[::-1])
         parts_r.append(_d_rate(l, l, qr)[::-1])
     out.D, out.rate = np.concatenate(parts_D), np.concatenate(parts_r)
-    for c, (q, D, qr, flow, r) in sides.items():
+    for c, (q, _, qr, flow, r) in sides.items():
         # the axis: the polhode shrinks onto it where q falls there
         if qr[0] < 0.0:
             alpha = -0.5 * r[0, 1] / r[0, 0] if r[0, 0] != 0.0 else -math.inf

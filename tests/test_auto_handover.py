@@ -165,3 +165,42 @@ def test_no_handover_where_braking_never_makes_the_spin_fast():
     assert A.choose_method(top, "reduced", w0, 1e12)[0] == "taylor"
     with pytest.raises(SpecError, match="nor does braking bring it to 0.001 by t_end"):
         simulate(top, "reduced", w0, t_end=1e12, samples=11)
+
+
+def test_the_kernel_forced_response_is_4_9():
+    """secular's kernel carries omega_perp's forced response apart: to second order it is
+    (4.9)'s B / tau (omega2 = -n1 n3 w3^2 / delta) and A tau^-3/2, as ``physics.averaged`` has them,
+    to the next order mu^2 = (w3 / delta)^2."""
+    from spinviz.integrators import kernels as KN
+    from spinviz.integrators import slowflow as SF
+    from spinviz.physics import averaged as AV
+
+    for delta, chi in ((-0.4, 0.5), (0.3, 0.7)):
+        J = np.array([1.0, 1.0, 1.0 - delta])
+        g = np.array([math.sin(chi), 0.0, math.cos(chi)])
+        for w3 in (1e-2, 1e-3):
+            z1, z2 = SF.forced_z(KN.MODEL_ID["reduced"], J, g, w3)
+            zf = complex(AV.flow("reduced", delta, chi).forced_response(w3, order=2))
+            mu2 = (w3 / delta) ** 2
+            assert z2 == pytest.approx(zf.imag, rel=3.0 * mu2) and z1 == pytest.approx(zf.real, rel=3.0 * mu2)
+
+
+@pytest.mark.slow
+def test_a_type_1_run_keeps_its_forced_response():
+    """The oblate type-1 case (delta -0.4, chi 0.5): after the hand-over omega_perp tau follows the full
+    integration and (4.9)'s B = -n3 (1 - delta) / (2 n1 delta) = 3.2034 (it fell to 1e-22 when the
+    forced response was averaged away with the circle): to 1e-5 of Taylor's at every sample, to 1e-4
+    of B from tau = 1e9 on."""
+    delta, chi = -0.4, 0.5
+    top = B.symmetric_top(delta, chi)
+    t = np.concatenate([[0.0], np.geomspace(1e5, 1e11, 7)])
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(A, "MAX_RESOLVED_TURNS", 1e3)
+        hand = simulate(top, "reduced", W0, t_eval=t)
+    assert hand.stats["method"] == "taylor -> secular"
+    full = simulate(top, "reduced", W0, t_eval=t, method="taylor", rtol=1e-12)
+    wp_h = np.hypot(hand.omega_body[:, 0], hand.omega_body[:, 1]) * t
+    wp_f = np.hypot(full.omega_body[:, 0], full.omega_body[:, 1]) * t
+    np.testing.assert_allclose(wp_h[1:], wp_f[1:], rtol=1e-5)
+    B49 = -math.cos(chi) * (1.0 - delta) / (2.0 * math.sin(chi) * delta)
+    np.testing.assert_allclose(wp_h[t >= 1e9], B49, rtol=1e-4)

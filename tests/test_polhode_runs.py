@@ -190,3 +190,23 @@ def test_refusals_name_what_neither_method_can_do():
     with pytest.raises(SpecError) as e:
         simulate(body, "reduced", (0.0, 0.0, 5e-3), t_end=1e12, samples=11)
     assert e.value.key == "t_end" and "nor does braking bring it to 0.001 by t_end" in e.value.reason
+
+
+@pytest.mark.slow
+def test_handover_to_polhode_agrees_with_a_full_taylor_run(monkeypatch):
+    """An asymmetric body started too fast to average (tau0 |Omega0| = 1e-2), made auto's pick below
+    1e6 turns for the test: Taylor's method in full until tau0 |Omega| = 1e-3, then polhode; |L| and
+    the energy at instants over four decades within polhode's stated error of a Taylor run at
+    rtol 1e-12 (and the same Taylor run before the hand-over)."""
+    monkeypatch.setattr(A, "MAX_RESOLVED_TURNS", 1e3)
+    body = B.custom((1.0, 0.8, 0.5), (0.6, 0.0, 0.8), units="dimensionless")
+    w0 = np.array([0.0, 0.006, 0.008])
+    t = np.concatenate([[0.0], np.geomspace(1e5, 1e9, 5)])
+    hand = simulate(body, "reduced", w0, t_eval=t)
+    assert hand.stats["method"] == "taylor -> polhode" and hand.stats["handover_at"] < 1e6
+    full = simulate(body, "reduced", w0, t_eval=t, method="taylor", rtol=1e-12)
+    J = np.asarray(body.inertia)
+    rel = [np.abs(np.sqrt(np.sum((J * h) ** 2, -1)) / np.sqrt(np.sum((J * f) ** 2, -1)) - 1.0)
+           for h, f in zip(hand.omega_body, full.omega_body)]
+    assert max(rel) <= hand.stats["slow_error_estimate"] + 1e-9
+    assert max(rel[: int(np.searchsorted(t, hand.stats["handover_at"]))]) < 1e-10

@@ -1,4 +1,6 @@
-"""``auto``'s hand-over for a symmetric top whose spin is not yet fast: ``taylor -> secular``.
+"""``auto``'s hand-over for a body whose spin is not yet fast: ``taylor -> secular`` (a
+symmetric top) and ``taylor -> polhode`` (any other body; the same stages, with
+``polhode.check_applicable`` as the test and ``polhode.predict`` as the predictor).
 
 ``secular`` needs a fast spin, tau0 |Omega| <= ``secular.EPS_MAX`` (otherwise the radiation
 changes the spin within a few turns and there is nothing to average over).  A top started

@@ -39,7 +39,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from .. import rotations as R
 from ..interrupt import check
@@ -155,6 +154,8 @@ def _sphere(problem: Problem, rtol: float, atol: float) -> Solution:
 def _averaged_stage(run: _Run):
     """From (run.s, run.w, run.qs): averaged while mu <= MU_IN, to the end or to the instant it
     is exceeded (then run.w, run.qs hold the true state there).  None, or why it cannot go on."""
+    from scipy.integrate import solve_ivp  # here: importing the integrators stays light
+
     system = run.problem.system
     try:
         c, s_c = P.encircled_axis(system.inertia, run.w)
@@ -544,6 +545,8 @@ def _predict(system, omega, target: float, t_max: float) -> tuple[float, float]:
 def _predict_leg(system, J, c: int, s_c: float, w, t: float, turns: float, target: float, t_max: float):
     """One leg of ``_predict`` about the axis c: (solve_ivp's solution in the clock's s, the clock);
     its events are |omega| reaching ``target`` and the separatrix coming within 1 %."""
+    from scipy.integrate import solve_ivp
+
     s, m, l = P.extreme_axes(J)
     flow = Flow(system, c, s_c)
     Jc, Jm = float(J[c]), float(J[m])

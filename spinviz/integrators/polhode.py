@@ -265,8 +265,18 @@ class _Path:
         return self.sol.sol(np.clip(self.clock.s(t), self.sol.sol.ts[0], self.sol.sol.ts[-1]))
 
 
+TRANSFORM_INVISIBLE = 1e-15      # tau0 |Omega| below which the transform (O(eps) of the state) is below float64
+
+
 def _true_state(flow: Flow, q_L, y, order2: bool):
-    """(omega, q) of the averaged state y = (x_bar, u_bar, Sigma_bar)."""
+    """(omega, q) of the averaged state y = (x_bar, u_bar, Sigma_bar).  Where the transform and the
+    forced tilt are O(eps) below float64's resolution of the state (real crystals) they are left
+    out: the free motion at (x_bar, u_bar) is the state to the last digit."""
+    if flow.eps * math.exp(0.5 * float(y[0])) < TRANSFORM_INVISIBLE:
+        pol = flow.polhode(y[:2])
+        om_p, _, c = P.angle_variables(pol)
+        w, q = pol.pose(q_L, y[3] + float(P.sigma_periodic(c, om_p, y[2])), y[2])
+        return w, R.normalize(q)
     w, x, u = flow.to_true(y[:2], y[2], order2=order2)
     av = flow.averages(y[:2], phases=False, order2=order2)
     sig = y[3] + float(flow.w0(av, u))
@@ -407,8 +417,8 @@ def _full_stage(run: _Run):
             span = FULL_CHUNK_PERIODS * 2.0 * math.pi / max(rate, 1e-300)
         end = min(t_end, run.s + span)
         if run.full_turns + rate * (end - run.s) / (2.0 * math.pi) > MAX_FULL_TURNS:
-            return (f"from t = {run.s:.6g} (spin units) averaging fails ({_why(system, run.w)}) and resolving it in "
-                    f"full would take more than {MAX_FULL_TURNS:g} turns")
+            return (f"averaging fails from here on ({_why(system, run.w)}) and resolving it in full would take more "
+                    f"than {MAX_FULL_TURNS:g} turns")
         k = int(np.searchsorted(t_all, end, side="right"))
         times = t_all[run.j:k] if k > run.j and t_all[k - 1] == end else np.concatenate([t_all[run.j:k], [end]])
         sub, e = spin_problem(system, run.w, np.concatenate([[run.s], times]) - run.s, q0=run.qs,
@@ -416,7 +426,7 @@ def _full_stage(run: _Run):
         sol = solve_taylor(sub, run.rtol, min(run.atol, run.rtol), None)
         run.full_steps += int(sol.stats.get("nsteps", 0))
         if not sol.success:
-            return f"the full stage (taylor) from t = {run.s:.6g}: {sol.message}"
+            return f"the full stage (taylor): {sol.message}"
         n = k - run.j
         run.omega[run.j:k] = sol.omega[1:1 + n] * e
         if run.q is not None:

@@ -120,7 +120,7 @@ def test_dipole_on_the_axis_is_5_2_and_5_4(model, form):
     s = System(model, (1.0, 1.0, 1.0 - delta), (0.0, 0.0, math.sqrt(1e-3)))
     t = np.concatenate([[0.0], np.geomspace(10.0, 3e4, 12)])
     sol = solve_polhode(Problem(s, np.array([0.0, w20, w30]), t, q0=Q0))
-    exact = form(t * 1e-3, delta, w20 * 1e-3, w30 * 1e-3) / 1e-3      # (4.1) units back to spin units
+    exact = form(t / 1e-3, delta, w20 * 1e-3, w30 * 1e-3) / 1e-3      # spin units: tau = t / eps, omega = eps w
     np.testing.assert_allclose(np.hypot(sol.omega[:, 0], sol.omega[:, 1]), np.hypot(exact[:, 0], exact[:, 1]),
                                rtol=1e-7)
     np.testing.assert_allclose(sol.omega[:, 2], exact[:, 2], rtol=1e-9)

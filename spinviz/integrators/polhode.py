@@ -513,8 +513,13 @@ _PREDICTIONS: dict = {}
 
 
 def predict(system, omega, target: float, t_max: float) -> tuple[float, float]:
-    """``_predict``, remembered for the last few questions (``auto`` asks the same one up to four
-    times for one run: the choice, the count of turns, the cost check and its message)."""
+    """(time, turns) from the spin-unit state ``omega`` (3,) until |omega| <= ``target``, as the
+    averaged flow predicts it (first order, no phases: a plan, not a result; a separatrix passed
+    continues on the other side at the same |L| and energy); (inf, turns to ``t_max``) when it
+    does not get there.  |omega| is read as sqrt(2E / J_s), its largest on the polhode, for the
+    target, and as sqrt(2E / J_m) for the turns.  Remembered for the last few questions (``auto``
+    asks the same one up to four times for one run: the choice, the turns, the cost check, its
+    message)."""
     key = (system, tuple(float(x) for x in omega), float(target), float(t_max))
     hit = _PREDICTIONS.get(key)
     if hit is None:
@@ -562,9 +567,9 @@ def _predict_leg(system, J, c: int, s_c: float, w, t: float, turns: float, targe
     Jc, Jm = float(J[c]), float(J[m])
     sig = 1.0 if c == l else -1.0      # 2E = (X + sig p) / J_c
 
-    def norm(y):
+    def norm(y, J_as=Jm):
         X, p = math.exp(y[0]), math.exp(y[1])
-        return math.sqrt(max((X + sig * p) / Jc, 0.0) / Jm)
+        return math.sqrt(max((X + sig * p) / Jc, 0.0) / J_as)
 
     x = flow.x_of(w)
     r0 = flow.rates(x)
@@ -575,7 +580,8 @@ def _predict_leg(system, J, c: int, s_c: float, w, t: float, turns: float, targe
         return np.array([r[0], r[1], norm(y) / (2.0 * math.pi)]) * clock.dtds(s_)
 
     def reached(_s, y):
-        return norm(y) - target
+        # |omega| <= sqrt(2E / J_s) all round the polhode: reached when even the largest is below target
+        return norm(y, float(J[s])) - target
 
     def separatrix(_s, y):
         return float(flow.polhode(y[:2]).separatrix_distance) - 0.01

@@ -60,7 +60,7 @@ class Attractor:
 
 
 @dataclass
-class Shape:
+class ShapeFlow:
     """The shape flow of one body and model: the attractors and, along D, the flow's sign."""
 
     J: tuple
@@ -93,7 +93,7 @@ def _d_rate(c: int, l: int, qrate):
     return qrate if c != l else -qrate
 
 
-def shape_flow(J, d, model: str) -> Shape:
+def shape_flow(J, d, model: str) -> ShapeFlow:
     """The shape flow of the body (moments J, dipole direction d) under ``model`` and its attractors."""
     J = np.asarray(J, dtype=float) / float(np.max(J))
     d = np.asarray(d, dtype=float) / np.linalg.norm(d)
@@ -103,7 +103,7 @@ def shape_flow(J, d, model: str) -> Shape:
     for c in (s, l):
         if J[c] != J[m]:
             sides[c] = _side(J, c, model, g)
-    out = Shape(tuple(J), tuple(d), model, sep_D=float(J[m]))
+    out = ShapeFlow(tuple(J), tuple(d), model, sep_D=float(J[m]))
     parts_D, parts_r = [], []
     if s in sides:
         q, D, qr, _, _ = sides[s]
@@ -167,7 +167,7 @@ def _odds(J, g, model, s, m, l, sides) -> dict:
     return out
 
 
-def fate(shape: Shape, D0: float, c0: int, s0: float) -> dict:
+def fate(shape: ShapeFlow, D0: float, c0: int, s0: float) -> dict:
     """{(attractor index, sign): probability} of a start at D0 in the lobe (c0, s0): the flow
     followed along D to the attractor it runs into, through the separatrix with its odds."""
     if not shape.attractors:
@@ -178,7 +178,7 @@ def fate(shape: Shape, D0: float, c0: int, s0: float) -> dict:
     return out
 
 
-def _walk(shape: Shape, D0, c0, s0, direction, weight, out, depth):
+def _walk(shape: ShapeFlow, D0, c0, s0, direction, weight, out, depth):
     if direction == 0.0:
         direction = 1.0
     ahead = [(k, a) for k, a in enumerate(shape.attractors) if a.kind != "separatrix"
@@ -205,7 +205,7 @@ def _walk(shape: Shape, D0, c0, s0, direction, weight, out, depth):
     out[(-1, 1.0)] = out.get((-1, 1.0), 0.0) + weight
 
 
-def _same_side(shape: Shape, a: float, b: float) -> bool:
+def _same_side(shape: ShapeFlow, a: float, b: float) -> bool:
     return (a - shape.sep_D) * (b - shape.sep_D) > 0.0
 
 
@@ -218,7 +218,7 @@ def isotropic_starts(n: int) -> np.ndarray:
     return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
 
 
-def shares(shape: Shape, starts: np.ndarray) -> dict:
+def shares(shape: ShapeFlow, starts: np.ndarray) -> dict:
     """{(attractor index, sign): share} over spin directions ``starts`` (n, 3) (the sign of L
     along an end axis; +1 for other attractors); (-1, 1) collects starts with no attractor."""
     J = np.asarray(shape.J)

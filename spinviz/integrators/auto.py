@@ -104,10 +104,10 @@ def _handover_note(body, model: str, omega0, t_end: float, spin=None) -> str:
 
 def _check_polhode_horizon(body, model: str, omega0, t_end: float, spin, method: str) -> None:
     """``SpecError("t_end")`` where the averaged stage of ``polhode`` (alone or after a hand-over)
-    cannot represent the horizon (``polhode.horizon_problem``)."""
+    cannot represent the horizon (``polhode_plan.horizon_problem``)."""
     if method == HANDOVER:
         return
-    from .polhode import horizon_problem
+    from .polhode_plan import horizon_problem
 
     problem, eps = spin if spin is not None else body_spin_problem(body, model, omega0)
     why = horizon_problem(problem.system, float(t_end) * eps / body.tau0)
@@ -127,7 +127,7 @@ def _polhode_note(body, model: str, omega0, t_end: float, spin=None) -> str:
             return str(e)
         S = float(t_end) * eps / body.tau0
         from .handover import TARGET_MARGIN, target_norm
-        from .polhode import predict
+        from .polhode_plan import predict
 
         t_h, turns_full = predict(problem.system, problem.omega0, TARGET_MARGIN * target_norm(problem), S)
         if math.isfinite(t_h):
@@ -159,7 +159,7 @@ def estimated_turns(body, model: str, omega0, t_end: float, spin=None) -> float:
         turns = max(turns, predict(problem.system, problem.omega0, 0.0, S)[1])
     elif model != "free" and turns > ASYMMETRIC_PREDICT_FROM and _has_polhode(problem):
         # kappa at the start misses that the braking slows as the spin settles about an axis
-        from .polhode import predict as predict_polhode
+        from .polhode_plan import predict as predict_polhode
 
         turns = max(turns, predict_polhode(problem.system, problem.omega0, 0.0, S)[1])
     return turns
@@ -279,10 +279,10 @@ def _handover_choice(body, model: str, omega0, t_end: float, problem, eps: float
 def _handover_polhode_choice(body, model: str, omega0, t_end: float, problem, eps: float, turns: float):
     """(``HANDOVER_POLHODE``, why) for an asymmetric body not fast at the start (tau0 |Omega0| >
     ``EPS_MAX``) whose braking, as the averaged flow over the polhode predicts it
-    (``polhode.predict``), brings tau0 |Omega| to ``EPS_MAX`` before t_end after at most
+    (``polhode_plan.predict``), brings tau0 |Omega| to ``EPS_MAX`` before t_end after at most
     ``HARD_MAX_TURNS`` turns in full; None otherwise."""
     from .handover import TARGET_MARGIN, target_norm
-    from .polhode import predict
+    from .polhode_plan import predict
 
     if not _has_polhode(problem):
         return None

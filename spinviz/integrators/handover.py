@@ -1,6 +1,6 @@
 """``auto``'s hand-over for a body whose spin is not yet fast: ``taylor -> secular`` (a
 symmetric top) and ``taylor -> polhode`` (any other body; the same stages, with
-``polhode.check_applicable`` as the test and ``polhode.predict`` as the predictor).
+``polhode.check_applicable`` as the test and ``polhode_plan.predict`` as the predictor).
 
 ``secular`` needs a fast spin, tau0 |Omega| <= ``secular.EPS_MAX`` (otherwise the radiation
 changes the spin within a few turns and there is nothing to average over).  A top started
@@ -126,9 +126,9 @@ def target_norm(problem: Problem) -> float:
 
 def predictor(target: str):
     """The predictor of the hand-over to ``target``: ``predict`` ((4.12): symmetric tops) or
-    ``polhode.predict`` (the averaged flow of any body)."""
+    ``polhode_plan.predict`` (the averaged flow of any body)."""
     if target == "polhode":
-        from .polhode import predict as predict_polhode
+        from .polhode_plan import predict as predict_polhode
 
         return predict_polhode
     return predict

@@ -27,7 +27,7 @@ from .errors import SimulationError, SpecTypeError, SpinvizError
 from .inputs.simulation import SimulationRequest
 from .integrators import Problem, Solution, get
 from .integrators import status as ST
-from .integrators.auto import HANDOVER, HARD_MAX_TURNS, choose_method, estimated_turns
+from .integrators.auto import HANDOVER, HANDOVERS, HARD_MAX_TURNS, choose_method, estimated_turns
 from .integrators.scaling import body_spin_problem, spin_problem
 from .physics.bodies import Body
 from .physics.equations import truncated_singularity
@@ -133,9 +133,9 @@ def simulate_request(request: SimulationRequest) -> Trajectory:
     else:
         reason = "chosen by the user"
     # a declining secular run can be handed to a resolving method when its cost check would pass
-    resolvable = (auto and method == "secular"
+    resolvable = (auto and method in ("secular", "polhode")
                   and estimated_turns(body, model, omega0, horizon, (problem, eps)) <= HARD_MAX_TURNS)
-    if method != HANDOVER:
+    if method not in HANDOVERS:
         _check_method(method, body, kinematics)
     start = time.perf_counter()
     try:
@@ -152,7 +152,7 @@ def simulate_request(request: SimulationRequest) -> Trajectory:
     if not sol.success:
         raise SimulationError(_failure_message(problem, sol, name, time_scale))
     stats = _stats_in_units(sol.stats, time_scale)
-    notes = accuracy_notes("taylor" if name == HANDOVER else name, rtol, atol)
+    notes = accuracy_notes("taylor" if name in HANDOVERS else name, rtol, atol)
     stats.update(method=name, method_reason=reason, runtime_s=runtime, eps_rad=eps, rtol=rtol, atol=atol,
                  tolerance_met=not notes)
     if notes:
@@ -197,6 +197,9 @@ def _stats_in_units(stats: dict, time_scale: float) -> dict:
         out["segments"] = [[t / time_scale, mode] for t, mode in out["segments"]]
     if "resonances" in out:
         out["resonances"] = [[m, t / time_scale, kick] for m, t, kick in out["resonances"]]
+    if "separatrix_crossings" in out:
+        out["separatrix_crossings"] = [{**c, "t": c["t"] / time_scale, "t_out": c["t_out"] / time_scale}
+                                       for c in out["separatrix_crossings"]]
     return out
 
 
@@ -245,29 +248,31 @@ def solve(problem: Problem, method: str, *, rtol: float, atol: float, step: floa
           reason: str = "chosen by the user", resolvable: bool = True) -> tuple[Solution, str, str]:
     """Run ``method`` on ``problem`` (spin units) and return (solution, method used, why).
 
-    Under ``auto``: a ``secular`` run that declines (a resonance, the oscillating regime) is
+    Under ``auto``: a ``secular`` or ``polhode`` run that declines (a resonance, the oscillating regime, a
+    stretch in full it cannot afford) is
     resolved in full by ``taylor`` when ``resolvable`` (affordable), and an explicit method
     that meets stiffness the estimate from the initial state missed is replaced by radau;
-    ``taylor -> secular`` (``integrators.taylor_secular``) runs as one method.
+    ``taylor -> secular`` (``integrators.full_to_averaged``) runs as one method.
     The solution is checked for non-finite values; ``success`` False keeps its samples so far."""
     kw = {"rtol": rtol, "atol": atol}
     if step is not None:
         kw["step"] = step
-    if method == HANDOVER:
-        from .integrators.taylor_secular import solve_handover
+    if method in HANDOVERS:
+        from .integrators.full_to_averaged import solve_handover
 
-        sol = solve_handover(problem, **kw)
+        sol = solve_handover(problem, **kw, target="secular" if method == HANDOVER else "polhode")
         if sol.success:
             _check_finite(sol)
-        return sol, HANDOVER, reason
+        return sol, method, reason
     integrator = get(method)
     extra = {"stop_on_stiffness": True} if auto and integrator.detects_stiffness else {}
     sol = integrator.solve(problem, **kw, **extra)
-    if auto and not sol.success and integrator.name == "secular" and resolvable:
+    if auto and not sol.success and integrator.name in ("secular", "polhode") and resolvable:
         reason = f"{reason}; but {sol.message} -- so resolved in full by taylor"
         integrator = get("taylor")
         sol = integrator.solve(problem, **kw, stop_on_stiffness=True)
-    if auto and not sol.success and not integrator.stiff and integrator.name != "secular" and "runaway_at" not in sol.stats:
+    if (auto and not sol.success and not integrator.stiff and integrator.name not in ("secular", "polhode")
+            and "runaway_at" not in sol.stats):
         stiff_at = sol.stats.get("stiff_at")
         why = f"stiffness detected at t = {stiff_at:.3g} (spin units)" if stiff_at is not None else sol.message
         reason = f"{integrator.name} gave up ({why}); switched to radau (implicit, exact Jacobian)"

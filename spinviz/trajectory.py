@@ -283,10 +283,21 @@ class Trajectory:
         theta_L = atan2(|w_perp|, J3 w3) while d sits at chi from e3, so the angle sweeps
         [|theta_L - chi|, theta_L + chi] (folded into [0, pi]) whatever the precession phase:
         it needs only the slow variables, so it is exact also where the phase is averaged
-        (``secular``).  For an asymmetric body it is the instantaneous angle twice."""
+        (``secular``).  For an asymmetric body L runs round the polhode through Omega (the
+        Euler-Poinsot motion, ``physics.polhode``): the range is taken over it, again whatever
+        the phase (``polhode``); on the separatrix itself, the instantaneous angle twice."""
         if not self.body.is_symmetric:
+            from .physics import polhode as PH
+
             a = self.angle_d_L()
-            return a, a.copy()
+            lo, hi = a.copy(), a.copy()
+            J, d = tuple(float(x) for x in self.body.inertia), self.body.dipole_direction
+            for i, w in enumerate(self.omega):
+                try:
+                    lo[i], hi[i] = PH.angle_range(PH.polhode_of(J, w), d)
+                except PH.NoPolhode:
+                    pass
+            return lo, hi
         J3 = self.body.I3 / self.body.I1
         theta_L = np.arctan2(np.hypot(self.omega[:, 0], self.omega[:, 1]), J3 * self.omega[:, 2])
         chi = self.body.chi

@@ -9,11 +9,12 @@ import pytest
 from spinviz.driver import simulate
 from spinviz.errors import SpecError
 from spinviz.integrators import auto as A
+from spinviz.integrators import full_to_averaged as FTA
 from spinviz.integrators import secular as SC
-from spinviz.integrators import taylor_secular as TS
 from spinviz.integrators.scaling import body_spin_problem
 from spinviz.physics import bodies as B
 from spinviz.physics import closed_forms as CF
+from spinviz.physics import models as M
 
 W0 = np.array([0.0, 0.006, 0.008])          # tau0 |Omega0| = 1e-2: ten times secular's bound
 TOP = B.symmetric_top(0.3, 0.7)
@@ -124,23 +125,22 @@ def test_the_predicted_handover_is_where_the_run_hands_over():
         for chi in (0.02, 0.7, 1.2):
             top = B.symmetric_top(0.3, chi)
             problem, eps = body_spin_problem(top, model, W0, np.linspace(0.0, 1e9, 3))
-            t_h, turns = TS.plan(problem)
+            t_h, turns = FTA.plan(problem)
             assert math.isfinite(t_h) and 0 < turns < 3e5
             if chi == 0.02 and model == "reduced":
                 continue                                 # 2.5e5 turns in full: ~4 s, the slow test's
-            sol = TS.solve_handover(problem)
+            sol = FTA.solve_handover(problem)
             assert sol.success and sol.stats["full_stage"]["chunks"] == 1
-            assert sol.stats["handover_eps_rad"] == pytest.approx(TS.TARGET_MARGIN * SC.EPS_MAX, rel=1e-2)
+            assert sol.stats["handover_eps_rad"] == pytest.approx(FTA.TARGET_MARGIN * SC.EPS_MAX, rel=1e-2)
 
 
-def test_asymmetric_body_still_gets_taylor_and_the_same_refusal():
+def test_asymmetric_body_gets_the_handover_to_polhode():
+    """The same slow start on an asymmetric body: below 1e6 turns Taylor's method; past them the
+    hand-over to the averaged flow over the polhode (``taylor -> polhode``), where the refusal
+    ("resolves each turn") stood before."""
     body = B.custom((1.0, 0.8, 0.5), (0.6, 0.0, 0.8), units="dimensionless")
     assert A.choose_method(body, "reduced", W0, 1e9)[0] == "taylor"
-    with pytest.raises(SpecError) as e:
-        simulate(body, "reduced", W0, t_end=T_LONG, samples=11)
-    assert e.value.key == "t_end"
-    assert e.value.reason == ("the body turns ~8.99e+07 times (estimated with braking) and every method for an "
-                              "asymmetric body resolves each turn: at most 5e+07 can finish")
+    assert A.choose_method(body, "reduced", W0, T_LONG)[0] == "taylor -> polhode"
 
 
 def test_a_full_stage_that_cannot_finish_is_refused_in_one_line():
@@ -162,7 +162,45 @@ def test_no_handover_where_braking_never_makes_the_spin_fast():
     top = B.symmetric_top(0.3, 0.0)
     w0 = (0.0, 0.006, 0.005)
     problem, _ = body_spin_problem(top, "reduced", w0, np.linspace(0.0, 1e12, 2))
-    assert TS.plan(problem)[0] == math.inf
+    assert FTA.plan(problem)[0] == math.inf
     assert A.choose_method(top, "reduced", w0, 1e12)[0] == "taylor"
     with pytest.raises(SpecError, match="nor does braking bring it to 0.001 by t_end"):
         simulate(top, "reduced", w0, t_end=1e12, samples=11)
+
+
+def test_the_kernel_forced_response_is_4_9():
+    """secular's kernel carries omega_perp's forced response apart: to second order it is
+    (4.9)'s B / tau (omega2 = -n1 n3 w3^2 / delta) and A tau^-3/2, as ``physics.averaged`` has them,
+    to the next order mu^2 = (w3 / delta)^2."""
+    from spinviz.integrators import slowflow as SF
+    from spinviz.physics import averaged as AV
+
+    for delta, chi in ((-0.4, 0.5), (0.3, 0.7)):
+        J = np.array([1.0, 1.0, 1.0 - delta])
+        g = np.array([math.sin(chi), 0.0, math.cos(chi)])
+        for w3 in (1e-2, 1e-3):
+            z1, z2 = SF.forced_z(M.get("reduced").kernel_id, J, g, w3)
+            zf = complex(AV.flow("reduced", delta, chi).forced_response(w3, order=2))
+            mu2 = (w3 / delta) ** 2
+            assert z2 == pytest.approx(zf.imag, rel=3.0 * mu2) and z1 == pytest.approx(zf.real, rel=3.0 * mu2)
+
+
+@pytest.mark.slow
+def test_a_type_1_run_keeps_its_forced_response():
+    """The oblate type-1 case (delta -0.4, chi 0.5): after the hand-over omega_perp tau follows the full
+    integration and (4.9)'s B = -n3 (1 - delta) / (2 n1 delta) = 3.2034 (it fell to 1e-22 when the
+    forced response was averaged away with the circle): to 1e-5 of Taylor's at every sample, to 1e-4
+    of B from tau = 1e9 on."""
+    delta, chi = -0.4, 0.5
+    top = B.symmetric_top(delta, chi)
+    t = np.concatenate([[0.0], np.geomspace(1e5, 1e11, 7)])
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(A, "MAX_RESOLVED_TURNS", 1e3)
+        hand = simulate(top, "reduced", W0, t_eval=t)
+    assert hand.stats["method"] == "taylor -> secular"
+    full = simulate(top, "reduced", W0, t_eval=t, method="taylor", rtol=1e-12)
+    wp_h = np.hypot(hand.omega_body[:, 0], hand.omega_body[:, 1]) * t
+    wp_f = np.hypot(full.omega_body[:, 0], full.omega_body[:, 1]) * t
+    np.testing.assert_allclose(wp_h[1:], wp_f[1:], rtol=1e-5)
+    B49 = -math.cos(chi) * (1.0 - delta) / (2.0 * math.sin(chi) * delta)
+    np.testing.assert_allclose(wp_h[t >= 1e9], B49, rtol=1e-4)

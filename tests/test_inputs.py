@@ -75,7 +75,7 @@ def test_a_scene_is_read_without_the_rendering_package():
     ("samples", "1000000000000", {"samples": 10**12},
      "must be at most 1000000 (memory: 11 numbers an instant per model), got 1000000000000"),
     ("samples", "1.5", {"samples": 1.5}, "must be an integer, got 1.5"),
-    ("method", '"rk99"', {"method": "rk99"}, "unknown method 'rk99'; valid: auto, bdf, dop853, lsoda, radau, rk45, "
+    ("method", '"rk99"', {"method": "rk99"}, "unknown method 'rk99'; valid: auto, bdf, dop853, lsoda, polhode, radau, rk45, "
                                            "secular, split2, split4, split6, split8, taylor, taylor-long"),
 ])
 def test_a_file_and_python_get_the_same_check_and_the_same_words(tmp_path, key, value, argument, reason):

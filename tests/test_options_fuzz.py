@@ -26,6 +26,7 @@ BASE = {                         # a valid invocation of each command, before th
     "compare": [SCENE], "observe": [SCENE], "decide": [SCENE], "listen": [SCENE, "--out", "s.wav"], "bench": [],
     "stress": [],
     "report": [], "methods": [], "atlas run": ["SPEC"], "atlas verify": ["nothing.zarr"], "atlas bench": ["SPEC"],
+    "atlas boxes": ["--out", "b.nc"],
 }
 STATUSES = {0, 1, 2, 75}         # success, a failed run, bad input, a busy store or lost cluster
 NUMBER_TYPES = {shared.whole, shared.real, shared.positive}
@@ -47,6 +48,7 @@ def heavy_entries():
     from spinviz.analysis import decide
     from spinviz.regimes import api
     from spinviz.regimes import bench as atlas_bench
+    from spinviz.regimes.asymmetric import atlas as boxes_atlas
     from spinviz.regimes.store import dataset
     from spinviz.validation import bench, checks, process_bench, render_bench, report, secular_sweep, stress
     from spinviz.validation.atlas import evidence
@@ -55,7 +57,7 @@ def heavy_entries():
             (render_bench, "require_render_stack"), (checks, "run_all"), (secular_sweep, "run_case"),
             (bench, "make_problem"), (process_bench, "problem"), (stress, "run_all"), (report, "generate"),
             (api, "_compute"), (atlas_bench, "atlas"), (dataset, "Writer"), (evidence, "_compute"),
-            (decide, "setup_from_scene"), (decide, "run")]
+            (decide, "setup_from_scene"), (decide, "run"), (boxes_atlas, "atlas")]
 
 
 @pytest.fixture

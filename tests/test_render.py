@@ -303,7 +303,8 @@ def scene_frames(path, frames=("first", "middle", "last"), size=(640, 360), **ov
     return plan, dict(zip(frames, imgs)), session
 
 
-@pytest.mark.parametrize("path", SCENES, ids=[p.stem for p in SCENES])
+@pytest.mark.parametrize("path", [pytest.param(p, marks=pytest.mark.slow) if p.stem == "dast_box" else p for p in SCENES],
+                         ids=[p.stem for p in SCENES])
 def test_every_scene_keeps_its_frame_edges_clear_and_labels_its_arrows(path):
     """At 640x360, the first, middle and last frames of every shipped scene leave the outermost
     2 rows and columns pure background (nothing clipped at the edge); every drawn arrow has its

@@ -114,13 +114,6 @@ def test_render_workers_not_a_number(tmp_path, capsys):
     assert e.value.code == 2 and "argument --workers: expected a whole number, got 'two'" in capsys.readouterr().err
 
 
-def test_slowed_spin_on_an_asymmetric_body_is_one_line(tmp_path, capsys):
-    p = scene(tmp_path, body='inertia = [1.0, 0.8, 0.5]\ndipole = [0.0, 0.0, 1.0]')
-    text = p.read_text().replace('show = ["dipole"]', 'show = ["dipole"]\nspin = "slowed"')
-    p.write_text(text)
-    one_line_error(capsys, ["render", p, "--out", tmp_path / "x.gif"], "needs a symmetric top")
-
-
 def test_sample_keeps_the_slow_frame_with_four_samples():
     """With exactly four stored instants the (4,) q_L must not be taken for a time series."""
     cube = P.dast_cube()

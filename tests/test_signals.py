@@ -82,8 +82,9 @@ def test_stop_signal_mid_render(tmp_path, sig, to_group, ext):
 
 @pytest.mark.slow
 def test_sigterm_stops_a_compiled_run_promptly(tmp_path):
-    """An asymmetric body over ~5e6 turns (allowed; about a minute of compiled loop, ~3 s per
-    1e5 turns measured): SIGTERM ends it within a second with nothing written."""
+    """An asymmetric body over ~5e6 turns resolved by Taylor's method (asked for: ``auto`` would
+    average it; about a minute of compiled loop, ~3 s per 1e5 turns measured): SIGTERM ends it
+    within a second with nothing written."""
     scene = tmp_path / "long.toml"
     scene.write_text("""
 [body]
@@ -93,6 +94,7 @@ dipole = [0.3, 0.2, 0.9]
 omega = [0.0, 0.001, 0.002]
 [simulation]
 model = "reduced"
+method = "taylor"
 t_end = 1e14
 samples = 10
 """)

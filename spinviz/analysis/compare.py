@@ -116,6 +116,14 @@ def summarize(tr: Trajectory) -> ModelSummary:
     ang_wd = float(_angle(w[-1:], d[None, :])[0])
     ang_wd = min(ang_wd, 180.0 - ang_wd)             # rotation about d or about -d is the same state
     cone = _angle(L_body, np.broadcast_to(d, L_body.shape))
+    tumbling = None
+    if not tr.body.is_symmetric and not tr.phase_resolved:
+        # an asymmetric body at an averaged phase: L runs round its polhode, so the slow quantity is
+        # the swing of angle(d, L) over one period (``Trajectory.angle_d_L_range``): its lower end, the
+        # nearest d comes to L, is compared (the swing about its middle is what the torque changes)
+        lo, hi = tr.angle_d_L_range()
+        cone = np.degrees(lo)
+        tumbling = (float(np.degrees(lo[-1])), float(np.degrees(hi[-1])))
     late = tr.t >= tr.t[-1] * (2.0 / 3.0)
     late &= tr.t > 0
     expo = float(np.polyfit(np.log(tr.t[late]), np.log(mag[late]), 1)[0]) if late.sum() >= 3 else float("nan")
@@ -126,7 +134,22 @@ def summarize(tr: Trajectory) -> ModelSummary:
         state = f"spinning down to rest (|Omega| ~ t^{expo:.2f}, now {ratio:.3g} |Omega0|)"
     else:
         state = f"still evolving (|Omega| ~ t^{expo:.2f}, angle(Omega, d) = {ang_wd:.3g} deg)"
+    if tumbling is not None:
+        state += _tumbling_words(tr, tumbling)
     return ModelSummary(tr.model, float(mag[-1]), ratio, expo, ang_wd, cone, state)
+
+
+def _tumbling_words(tr: Trajectory, swing) -> str:
+    """'; tumbling about e3 (largest moment), d 41-69 deg from L' for an asymmetric body's end."""
+    from ..physics import polhode as PH
+
+    J = tuple(float(x) for x in tr.body.inertia)
+    try:
+        c, s_c = PH.encircled_axis(J, tr.omega_body[-1])
+    except PH.NoPolhode:
+        return "; on the separatrix at the end"
+    which = "largest" if J[c] == max(J) else "smallest"
+    return f"; tumbling about {'+' if s_c > 0 else '-'}e{c + 1} ({which} moment), d {swing[0]:.3g}-{swing[1]:.3g} deg from L"
 
 
 def compare(trajs: list[Trajectory]) -> Comparison:

@@ -1,6 +1,7 @@
 """``spinviz atlas run SPEC``, ``spinviz atlas verify STORE``, ``spinviz atlas bench SPEC`` and
-``spinviz atlas evidence KIND``: the regime atlas's four jobs, one sub-command each with
-exactly its own options.  ``spinviz atlas SPEC`` (a spec where the job's name would be) is
+``spinviz atlas evidence KIND`` and ``spinviz atlas boxes``: the regime atlas's jobs, one
+sub-command each with exactly its own options (``boxes``: the atlas of an asymmetric crystal's
+boxes, ``regimes.asymmetric``).  ``spinviz atlas SPEC`` (a spec where the job's name would be) is
 ``spinviz atlas run SPEC``.
 
 Exit statuses of its own: 75 when the cluster failed and runs were not computed (sysexits'
@@ -21,7 +22,7 @@ from ..errors import UsageError, printable
 from ..interrupt import check
 from .shared import Parser, positive, real, reals
 
-JOBS = ("run", "verify", "bench", "evidence")
+JOBS = ("run", "verify", "bench", "evidence", "boxes")
 # what each evidence option is, for the sub-command of a kind that takes it
 _EVIDENCE_OPTIONS = {
     "workers": ("--workers", positive, None, "worker processes (default: one per core)"),
@@ -82,6 +83,19 @@ def add_parser(sub) -> None:
     b.add_argument("--json", action="store_true", help="print the rows as JSON")
     b.add_argument("--quiet", action="store_true", help="no progress bar")
     _add_evidence(jobs)
+    x = jobs.add_parser(
+        "boxes", help="where a DAST box a x b x c's spin ends as tau -> oo, over the plane of edge ratios (b/a, c/a)",
+        description="For every box of the grid: the averaged flow's shape (a flow on one line between the two extreme "
+                    "axes), its attractors, and the share of evenly spread spin directions ending about each edge; "
+                    "written as netCDF, drawn as a PNG with the families a = b and b = c of the paper's figure 5.")
+    x.add_argument("--grid", type=positive, default=25, help="boxes per ratio (default 25: 625 boxes per model)")
+    x.add_argument("--lo", type=real, default=0.5, help="smallest b/a and c/a (default 0.5)")
+    x.add_argument("--hi", type=real, default=2.0, help="largest b/a and c/a (default 2)")
+    x.add_argument("--starts", type=positive, default=600, help="spin directions per box (default 600)")
+    x.add_argument("--models", default="reduced,truncated", help="reduced, truncated or both (default both)")
+    x.add_argument("--out", default="boxes.nc", help="the netCDF file (default boxes.nc)")
+    x.add_argument("--plot", metavar="PATH", help="also draw the atlas (PNG)")
+    x.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def _add_evidence(jobs) -> None:
@@ -107,6 +121,8 @@ def run(args) -> int:
     """Carry out ``spinviz atlas JOB`` with the parsed ``args``; return its exit status."""
     if args.job == "verify":
         return verify(args.store, as_json=args.json)
+    if args.job == "boxes":
+        return _boxes(args)
     if args.job == "evidence":
         from ..validation.atlas import evidence
 
@@ -118,6 +134,30 @@ def run(args) -> int:
     if args.job == "bench":
         return _bench(spec, args)
     return _run(spec, args)
+
+
+def _boxes(args) -> int:
+    """``atlas boxes``: the boxes atlas of the DAST crystal (``regimes.asymmetric.atlas``)."""
+    from ..inputs.boxes import BoxesRequest
+    from ..progress import Progress
+    from ..regimes.asymmetric.atlas import run as boxes
+
+    req = BoxesRequest(grid=args.grid, lo=args.lo, hi=args.hi, starts=args.starts, models=args.models, out=args.out,
+                       plot=args.plot)
+    bar = Progress(req.grid * req.grid * len(req.models), "boxes", unit="boxes", enabled=not args.quiet)
+    done = [0]
+
+    def step():
+        done[0] += 1
+        bar.update(done[0])
+
+    try:
+        ds = boxes(req, progress=step)
+    finally:
+        bar.finish()
+    print(printable(f"{req.out}: {ds.attrs['cells']} boxes x models in {ds.attrs['seconds']:.1f} s "
+                    f"({ds.attrs['cpu_seconds']:.1f} s CPU)" + (f"; {req.plot}" if req.plot else ""), 2000))
+    return 0
 
 
 def _run(spec, args) -> int:

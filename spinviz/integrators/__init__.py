@@ -5,6 +5,7 @@ Importing this package registers the built-in methods; ``get(name)`` returns one
 """
 
 from . import (
+    polhode,  # noqa: F401  (registers polhode)
     scipy_ivp,  # noqa: F401  (registers rk45, dop853, radau, bdf, lsoda)
     secular,  # noqa: F401  (registers secular)
     splitting,  # noqa: F401  (registers split2, split4, split6, split8)

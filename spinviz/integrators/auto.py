@@ -8,9 +8,11 @@ import numpy as np
 
 from ..errors import SpecError
 from .base import get
+from .full_to_averaged import NAME as HANDOVER
+from .full_to_averaged import NAME_POLHODE as HANDOVER_POLHODE
+from .full_to_averaged import NAMES as HANDOVERS
 from .scaling import body_spin_problem
 from .secular import EPS_MAX
-from .taylor_secular import NAME as HANDOVER
 
 MAX_RESOLVED_TURNS = 1e6     # beyond this, resolving every turn costs more than ~10 s
 HARD_MAX_TURNS = 5e7         # taylor resolves an askew asymmetric body at ~17 us a turn (rtol 1e-10, 7.7 steps a turn): ~15 min
@@ -42,6 +44,7 @@ def braking_coefficient(problem) -> float:
 
 
 MAX_FIXED_STEPS = 1e10
+AVERAGED = ("secular", "polhode")   # methods that follow the slow variables, not each turn
 
 
 def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", step: float | None = None,
@@ -55,21 +58,28 @@ def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", ste
     ``SpecError`` names "step" or "t_end"."""
     method = str(method).lower()
     auto = method == "auto"
+    if not body.is_symmetric and (auto or method == "polhode"):
+        # before any prediction: a horizon the averaged flow cannot represent is refused at once
+        _check_polhode_horizon(body, model, omega0, t_end, spin, "polhode")
     if auto:
         method = picked or choose_method(body, model, omega0, t_end, kinematics, spin=spin)[0]
-    if method == HANDOVER:
-        return                                  # choose_method picks it only where its full stage can finish
+    if method in HANDOVERS or method == "polhode":
+        # the full stage: choose_method picks a hand-over only where it can finish; the averaged stage:
+        # refused at once where its horizon is beyond what it can represent
+        _check_polhode_horizon(body, model, omega0, t_end, spin, method)
+        return
     if get(method).fixed_step:
         if step is not None and t_end / step > MAX_FIXED_STEPS:
             raise SpecError("step", f"t_end / step = {t_end / step:.3g} steps; at most {MAX_FIXED_STEPS:g} can finish")
         return
-    if method == "secular":
+    if method in AVERAGED:
         return
     turns = estimated_turns(body, model, omega0, t_end, spin)
     if turns > HARD_MAX_TURNS:
         who = method
         if auto:
-            who = ("every method for an asymmetric body" if not body.is_symmetric else
+            who = (f"{method} (averaging over the polhode does not apply: {_polhode_note(body, model, omega0, t_end, spin)})"
+                   if not body.is_symmetric else
                    f"{method} (averaging does not apply: tau0 |Omega0| is not small"
                    f"{_handover_note(body, model, omega0, t_end, spin)})")
         raise SpecError("t_end", f"the body turns ~{turns:.3g} times (estimated with braking) and {who} resolves each "
@@ -82,7 +92,7 @@ def _handover_note(body, model: str, omega0, t_end: float, spin=None) -> str:
     problem, eps = spin if spin is not None else body_spin_problem(body, model, omega0)
     if not eps > EPS_MAX or model == "free":
         return ""
-    from .taylor_secular import TARGET_MARGIN, predict, target_norm
+    from .full_to_averaged import TARGET_MARGIN, predict, target_norm
 
     S = float(t_end) * eps / body.tau0
     t_h, turns_full = predict(problem.system, problem.omega0, TARGET_MARGIN * target_norm(problem), S)
@@ -90,6 +100,42 @@ def _handover_note(body, model: str, omega0, t_end: float, spin=None) -> str:
         return (f", and the averaged flow predicts it to fall to {EPS_MAX:g} only after ~{turns_full:.3g} turns "
                 f"in full")
     return f", nor does braking bring it to {EPS_MAX:g} by t_end (predicted by the averaged flow)"
+
+
+def _check_polhode_horizon(body, model: str, omega0, t_end: float, spin, method: str) -> None:
+    """``SpecError("t_end")`` where the averaged stage of ``polhode`` (alone or after a hand-over)
+    cannot represent the horizon (``polhode_plan.horizon_problem``)."""
+    if method == HANDOVER:
+        return
+    from .polhode_plan import horizon_problem
+
+    problem, eps = spin if spin is not None else body_spin_problem(body, model, omega0)
+    why = horizon_problem(problem.system, float(t_end) * eps / body.tau0)
+    if why:
+        raise SpecError("t_end", f"{t_end:g}: {why}")
+
+
+def _polhode_note(body, model: str, omega0, t_end: float, spin=None) -> str:
+    """Why an asymmetric body gets neither ``polhode`` nor the hand-over to it: what stops it."""
+    from .polhode import NotApplicable, check_applicable
+
+    problem, eps = spin if spin is not None else body_spin_problem(body, model, omega0)
+    try:
+        check_applicable(problem)
+    except NotApplicable as e:
+        if not eps > EPS_MAX or model == "free":
+            return str(e)
+        S = float(t_end) * eps / body.tau0
+        from .full_to_averaged import TARGET_MARGIN, target_norm
+        from .polhode_plan import predict
+
+        t_h, turns_full = predict(problem.system, problem.omega0, TARGET_MARGIN * target_norm(problem), S)
+        if math.isfinite(t_h):
+            return (f"tau0 |Omega0| = {eps:.3g} > {EPS_MAX:g}, and the averaged flow predicts it to fall to {EPS_MAX:g} "
+                    f"only after ~{turns_full:.3g} turns in full")
+        return (f"tau0 |Omega0| = {eps:.3g} > {EPS_MAX:g}, nor does braking bring it to {EPS_MAX:g} by t_end "
+                f"(predicted by the averaged flow)")
+    return "it applies"
 
 
 def estimated_turns(body, model: str, omega0, t_end: float, spin=None) -> float:
@@ -108,10 +154,28 @@ def estimated_turns(body, model: str, omega0, t_end: float, spin=None) -> float:
     else:
         turns = (math.sqrt(1.0 + 2.0 * k * S) - 1.0) / (2.0 * math.pi * k)
     if body.is_symmetric and model != "free":
-        from .taylor_secular import predict
+        from .full_to_averaged import predict
 
         turns = max(turns, predict(problem.system, problem.omega0, 0.0, S)[1])
+    elif model != "free" and turns > ASYMMETRIC_PREDICT_FROM and _has_polhode(problem):
+        # kappa at the start misses that the braking slows as the spin settles about an axis
+        from .polhode_plan import predict as predict_polhode
+
+        turns = max(turns, predict_polhode(problem.system, problem.omega0, 0.0, S)[1])
     return turns
+
+
+ASYMMETRIC_PREDICT_FROM = 1e4    # turns (from kappa) above which an asymmetric body's count is also predicted
+
+
+def _has_polhode(problem) -> bool:
+    from ..physics.polhode import NoPolhode, encircled_axis
+
+    try:
+        encircled_axis(problem.system.inertia, problem.omega0)
+        return True
+    except NoPolhode:
+        return False
 
 
 def stiffness_ratio(body, model: str, omega0, problem=None) -> float:
@@ -165,11 +229,25 @@ def choose_method(body, model: str, omega0, t_end: float, kinematics: str = "qua
                                f"{eps:.2g}){phase}")
         except NotApplicable:
             pass                                        # tau0 |Omega0| too large for a fast spin
+    if turns > MAX_RESOLVED_TURNS and not body.is_symmetric:
+        from .polhode import NotApplicable as NoAverage
+        from .polhode import check_applicable
+
+        try:
+            check_applicable(problem)
+            ulp = float(np.spacing(2.0 * math.pi * turns))
+            phase = f"; the spin phase is beyond float64 (1 ulp = {ulp:.2g} rad)" if ulp > 1e-3 else ""
+            return "polhode", (f"~{turns:.3g} turns of an asymmetric body (estimated with braking): the torque averaged "
+                               f"over the Euler-Poinsot polhode (tau0 |Omega0| = {eps:.2g}), separatrix crossings in "
+                               f"full{phase}")
+        except NoAverage:
+            pass
     ratio = stiffness_ratio(body, model, omega0, problem)
     if ratio > STIFF_RATIO:
         return "radau", f"stiff: decay rate {ratio:.3g} x the spin rate; implicit Radau with the exact Jacobian"
-    if turns > MAX_RESOLVED_TURNS and body.is_symmetric and model != "free":
-        picked = _handover_choice(body, model, omega0, t_end, problem, eps, turns)
+    if turns > MAX_RESOLVED_TURNS and model != "free":
+        choice = _handover_choice if body.is_symmetric else _handover_polhode_choice
+        picked = choice(body, model, omega0, t_end, problem, eps, turns)
         if picked is not None:
             return picked
     stiff = (f"decay/spin = {ratio:.2g}: stiff for Runge-Kutta, not yet for Taylor's method (faster than radau "
@@ -185,7 +263,7 @@ def _handover_choice(body, model: str, omega0, t_end: float, problem, eps: float
     ``EPS_MAX``) whose braking, as the averaged flow predicts it (``handover.plan``), brings
     tau0 |Omega| to ``EPS_MAX`` before t_end after at most ``HARD_MAX_TURNS`` turns in full;
     None otherwise (then it is resolved in full, within the usual limit)."""
-    from .taylor_secular import TARGET_MARGIN, predict, target_norm
+    from .full_to_averaged import TARGET_MARGIN, predict, target_norm
 
     S = float(t_end) * eps / body.tau0
     t_h, turns_full = predict(problem.system, problem.omega0, TARGET_MARGIN * target_norm(problem), S)
@@ -196,3 +274,24 @@ def _handover_choice(body, model: str, omega0, t_end: float, problem, eps: float
                       f"tau0 |Omega| to {EPS_MAX:g} (predicted by the averaged flow after ~{turns_full:.3g} turns, at "
                       f"t ~ {t_h / eps * body.tau0:.3g}), then secular to t_end; the spin phase after the hand-over "
                       f"is not resolved")
+
+
+def _handover_polhode_choice(body, model: str, omega0, t_end: float, problem, eps: float, turns: float):
+    """(``HANDOVER_POLHODE``, why) for an asymmetric body not fast at the start (tau0 |Omega0| >
+    ``EPS_MAX``) whose braking, as the averaged flow over the polhode predicts it
+    (``polhode_plan.predict``), brings tau0 |Omega| to ``EPS_MAX`` before t_end after at most
+    ``HARD_MAX_TURNS`` turns in full; None otherwise."""
+    from .full_to_averaged import TARGET_MARGIN, target_norm
+    from .polhode_plan import predict
+
+    if not _has_polhode(problem):
+        return None
+    S = float(t_end) * eps / body.tau0
+    t_h, turns_full = predict(problem.system, problem.omega0, TARGET_MARGIN * target_norm(problem), S)
+    if not (math.isfinite(t_h) and turns_full <= HARD_MAX_TURNS):
+        return None
+    return HANDOVER_POLHODE, (f"~{turns:.3g} turns of an asymmetric body whose spin is not fast at the start "
+                              f"(tau0 |Omega0| = {eps:.2g} > {EPS_MAX:g}): Taylor's method in full, with quaternions, "
+                              f"until braking brings tau0 |Omega| to {EPS_MAX:g} (predicted by the averaged flow after "
+                              f"~{turns_full:.3g} turns, at t ~ {t_h / eps * body.tau0:.3g}), then polhode to t_end; the "
+                              f"spin phase after the hand-over is not resolved")

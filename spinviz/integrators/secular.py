@@ -196,12 +196,16 @@ def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, st
         return failed(refusal, stats)
     o = out
     phi, p = o[:, 3], o[:, 4]
-    wp, w3 = np.hypot(o[:, 0], o[:, 1]), o[:, 2]
+    # the pose is built on the free circle (radius o[:, 6], phase p): where omega_perp is mostly the
+    # forced response (type 1) L_world turns round the spin axis and the body spins at omega3 about it,
+    # which the free circle's phase carries; Omega itself is the kernel's, the forced response included
+    wp, w3 = o[:, 6], o[:, 2]
     J3 = setup.J3
     theta_L = np.arctan2(wp, J3 * w3)
     psi = 0.5 * np.pi - p
-    omega, q = pose_about_L(setup.q_L, phi, theta_L, psi, wp, w3, setup.q_frame,
-                            with_q=problem.kinematics == "quaternion")
+    _, q = pose_about_L(setup.q_L, phi, theta_L, psi, wp, w3, setup.q_frame,
+                        with_q=problem.kinematics == "quaternion")
+    omega = R.body_from_world(setup.q_frame, o[:, :3])
     biggest = float(np.max(np.abs(phi)))
     resolution = float(np.spacing(biggest))
     # the orientation is no better than the direction of L it is built about

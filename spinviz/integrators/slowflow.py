@@ -66,20 +66,46 @@ def detunings(mode, y, J3, delta, F):
 
 
 @_jit
-def forced_response(model, J, g, wp, w3):
-    """How far averaging in (w_perp, p) misses the forced response of omega_perp (the late type
-    "1"), |c| = |a_perp(0, 0, w3)| / |delta w3|: |c|^2 / w_perp while the transform carries it,
-    2 |c| where the transform is off because |c| > NIT_MAX w_perp: started off its forced state,
-    omega_perp swings up to twice the forced amplitude (measured: 1.8 |c| from omega_perp(0) = 0 at
-    delta = 0.3, chi = 0.5; 0.93-1.05 |c| from omega_perp(0) = 1e-3 omega3)."""
+def forced_z(model, J, g, w3):
+    """(z_f1, z_f2): the forced response of omega_perp to the torque's omega_perp-independent
+    part F = a_perp(0, 0, w3) (the paper's n1 n3 w3^3 of (4.2): type "1", (4.9)), to second
+    order: x1 = -M^-1 F with M = [[0, delta w3], [-delta w3, 0]] the free precession, then
+    x2 = -(M + M_rad)^-1 (F - dx1/dt), M_rad the radiation's own linear part in omega_perp and
+    dx1/dt = 2 x1 a3(0, 0, w3) / w3 (x1 ~ w3^2).  The free precession is linear in omega_perp,
+    so omega_perp = z_f + a free circle exactly at first order, whatever the circle's size:
+    secular carries the circle averaged and z_f apart (order 1: -i n1 n3 w3^2 / delta, the
+    B / tau of (4.9); order 2 its real A tau^-3/2)."""
     delta = 1.0 - J[2]
     if w3 == 0.0 or delta == 0.0:
-        return 0.0
-    a = KN.radiation(model, 0.0, 0.0, w3, J, g)
-    c = math.hypot(a[0], a[1]) / abs(delta * w3)
-    if c > NIT_MAX * wp:
-        return 2.0 * c
-    return c * c / wp
+        return 0.0, 0.0
+    a0 = KN.radiation(model, 0.0, 0.0, w3, J, g)
+    F1, F2 = a0[0], a0[1]
+    if F1 == 0.0 and F2 == 0.0:
+        return 0.0, 0.0
+    nu = delta * w3
+    # M x = (nu x2, -nu x1) = -F  ->  x1 = F2 / nu, x2 = -F1 / nu
+    x1, x2 = F2 / nu, -F1 / nu
+    h = 1e-6 * abs(w3)
+    ap = KN.radiation(model, h, 0.0, w3, J, g)
+    am = KN.radiation(model, -h, 0.0, w3, J, g)
+    bp = KN.radiation(model, 0.0, h, w3, J, g)
+    bm = KN.radiation(model, 0.0, -h, w3, J, g)
+    m11, m21 = (ap[0] - am[0]) / (2.0 * h), (ap[1] - am[1]) / (2.0 * h)
+    m12, m22 = (bp[0] - bm[0]) / (2.0 * h), (bp[1] - bm[1]) / (2.0 * h)
+    r1 = F1 - 2.0 * x1 / w3 * a0[2]
+    r2 = F2 - 2.0 * x2 / w3 * a0[2]
+    # (M + M_rad) x = -r, M = [[0, nu], [-nu, 0]]
+    A11, A12, A21, A22 = m11, nu + m12, -nu + m21, m22
+    det = A11 * A22 - A12 * A21
+    return -(A22 * r1 - A12 * r2) / det, -(-A21 * r1 + A11 * r2) / det
+
+
+@_jit
+def forced_response(model, J, g, wp, w3, mu):
+    """What carrying the forced response apart leaves: its third-order residual, 5 mu^2 |z_f|
+    (the atlas engine's measured residual of the same transform), mu = eps |w|^2 / |delta w3|."""
+    z1, z2 = forced_z(model, J, g, w3)
+    return 5.0 * mu * mu * math.hypot(z1, z2)
 
 
 @_jit
@@ -172,13 +198,16 @@ def nit(model, J, g, cM, sM, wp, w3, p):
     Fwp = np.empty(M)
     Fw3 = np.empty(M)
     G = np.empty(M)
+    # the forcing a_perp(0, 0, w3) is carried apart as z_f (``forced_z``): out of the transform
+    a0 = KN.radiation(model, 0.0, 0.0, w3, J, g)
     for k in range(M):
         w1 = wp * cM[k]
         w2 = wp * sM[k]
         a = KN.radiation(model, w1, w2, w3, J, g)
-        Fwp[k] = (w1 * a[0] + w2 * a[1]) / wp
+        b1, b2 = a[0] - a0[0], a[1] - a0[1]
+        Fwp[k] = (w1 * b1 + w2 * b2) / wp
         Fw3[k] = a[2]
-        G[k] = (w1 * a[1] - w2 * a[0]) / (wp * wp)
+        G[k] = (w1 * b2 - w2 * b1) / (wp * wp)
     Uwp = 0.0
     Uw3 = 0.0
     Vp = 0.0
@@ -231,30 +260,43 @@ def initial_step(mode, sgn, model, J, g, cM, sM, equiv, y, f0, rtol, atol, n, h_
 
 @_jit
 def to_avg(model, J, g, cM, sM, y, p_unw, use_nit):
-    """FULL state -> AVG state in place (transform inverted to first order); returns the shift of phi."""
-    wp = math.hypot(y[0], y[1])
+    """FULL state -> AVG state in place: the forced response z_f taken off, then the transform
+    inverted to first order; returns (the shift of phi, the shift of the phase by taking z_f off).
+    The caller adds sgn x the second to phi: Sigma = phi + sgn psi, the spin angle about e3, stays
+    what it was (where omega_perp is mostly z_f the body spins about e3 at omega3, and Sigma carries
+    that; the free circle's phase is then not omega_perp's)."""
     w3 = y[2]
-    p = p_unw
+    z1, z2 = forced_z(model, J, g, w3)
+    v1, v2 = y[0] - z1, y[1] - z2
+    wp = math.hypot(v1, v2)
+    # the free circle's phase, on the branch of the unwrapped phase of omega_perp
+    p = p_unw + (math.atan2(v2, v1) - p_unw + math.pi) % (2.0 * math.pi) - math.pi
+    dsplit = p - p_unw
     dphi = 0.0
     if use_nit:
         u = nit(model, J, g, cM, sM, wp, w3, p)
         wp, w3, p = wp - u[0], w3 - u[1], p - u[2]
         dphi = -u[3]
     y[0], y[1], y[2] = wp, w3, p
-    return dphi
+    return dphi, dsplit
 
 
 @_jit
 def to_full(model, J, g, cM, sM, y, use_nit):
-    """AVG state -> FULL state in place; returns (unwrapped p, shift of phi)."""
+    """AVG state -> FULL state in place (the forced response z_f added back); returns (unwrapped
+    phase of omega_perp, shift of phi, shift of the phase by adding z_f: the caller adds sgn x it
+    to phi, as for ``to_avg``)."""
     wp, w3, p = y[0], y[1], y[2]
     dphi = 0.0
     if use_nit:
         u = nit(model, J, g, cM, sM, wp, w3, p)
         wp, w3, p = wp + u[0], w3 + u[1], p + u[2]
         dphi = u[3]
-    y[0], y[1], y[2] = wp * math.cos(p), wp * math.sin(p), w3
-    return p, dphi
+    z1, z2 = forced_z(model, J, g, w3)
+    y[0], y[1], y[2] = wp * math.cos(p) + z1, wp * math.sin(p) + z2, w3
+    # the unwrapped phase of omega_perp itself, on the free circle's branch
+    p_true = p + (math.atan2(y[1], y[0]) - p + math.pi) % (2.0 * math.pi) - math.pi
+    return p_true, dphi, p_true - p
 
 
 @_jit
@@ -272,7 +314,8 @@ def phase_nodes(M):
 def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_steps, phi0, A, B, E3, E5, D, stop):
     """Integrate from the body-frame w0 (spin units) over t_eval.
 
-    Returns (out (N, 6): w1, w2, w3, phi, p, mode at each output; counters (16,); switches
+    Returns (out (N, 7): w1, w2, w3 (the forced response included), phi, p, mode and the free
+    circle's radius (the pose's nutation: in FULL mode |omega_perp|) at each output; counters (16,); switches
     (K, 2): time and new mode; crossings (K, 4): time, w_perp, w3 and m of every passage
     through a resonance |L|/I1 = m delta w3; status).  phi: the ZXZ precession angle about the
     fixed L, from phi0; p: the unwrapped body-frame phase of omega_perp (psi = pi/2 - p).
@@ -284,7 +327,7 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
     # Long on purpose: one compiled loop whose step, hand-over and dense output share ~20 local arrays and counters.
     N = t_eval.shape[0]
     n = 4
-    out = np.empty((N, 6))
+    out = np.empty((N, 7))
     cnt = np.zeros(16)
     cnt[13] = -1.0
     sw = np.zeros((MAX_SWITCHES, 2))
@@ -308,10 +351,11 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
     else:
         mode = FULL if mu_ad(FULL, y, eps, delta) > mu_star else AVG
     dphi = 0.0
+    dsplit = 0.0
     if mode == AVG:
-        dphi = to_avg(model, J, g, cM, sM, y, p_unw, not equiv)
+        dphi, dsplit = to_avg(model, J, g, cM, sM, y, p_unw, not equiv)
     sgn = 1.0 if w0[2] >= 0.0 else -1.0
-    y[3] = phi0 + dphi + sgn * (0.5 * math.pi - (y[2] if mode == AVG else p_unw))
+    y[3] = phi0 + dphi + sgn * dsplit + sgn * (0.5 * math.pi - (y[2] if mode == AVG else p_unw))
     detunings(mode, y, J[2], delta, Fold)
     t = t_eval[0]
     t_end = t_eval[-1]
@@ -319,6 +363,7 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
     out[0, 3] = phi0
     out[0, 4] = p_unw
     out[0, 5] = mode
+    out[0, 6] = math.hypot(w0[0], w0[1])
     j_out = 1
     rhs(mode, sgn, model, J, g, cM, sM, equiv, y, K[0])
     nf = 1
@@ -372,18 +417,22 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
                 if mode == FULL:
                     out[j_out, 0], out[j_out, 1], out[j_out, 2] = ys[0], ys[1], ys[2]
                     out[j_out, 4] = p_old + (math.atan2(ys[1], ys[0]) - p_old + math.pi) % (2.0 * math.pi) - math.pi
+                    out[j_out, 6] = math.hypot(ys[0], ys[1])
                     out[j_out, 3] = ys[3] - sgn * (0.5 * math.pi - out[j_out, 4])
                 else:
                     out[j_out, 3] = ys[3] - sgn * (0.5 * math.pi - ys[2])
                     wp_o, w3_o, p_o = ys[0], ys[1], ys[2]
+                    z1 = z2 = 0.0
                     if not equiv:
                         u = nit(model, J, g, cM, sM, wp_o, w3_o, p_o)
                         wp_o, w3_o, p_o = wp_o + u[0], w3_o + u[1], p_o + u[2]
                         out[j_out, 3] += u[3]
-                    out[j_out, 0] = wp_o * math.cos(p_o)
-                    out[j_out, 1] = wp_o * math.sin(p_o)
+                        z1, z2 = forced_z(model, J, g, w3_o)
+                    out[j_out, 0] = wp_o * math.cos(p_o) + z1
+                    out[j_out, 1] = wp_o * math.sin(p_o) + z2
                     out[j_out, 2] = w3_o
                     out[j_out, 4] = p_o
+                    out[j_out, 6] = wp_o
                 out[j_out, 5] = mode
                 j_out += 1
         if mode == FULL:
@@ -406,10 +455,11 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
                 ncross += 1
             Fold[i] = Fnew[i]
         if mode == AVG and not equiv:
+            mu_now = 0.0
             if delta * w3_n != 0.0:
                 mu_now = eps * (wp_n * wp_n + w3_n * w3_n) / abs(delta * w3_n)
                 cnt[10] += mu_now * mu_now * (t - t_old)
-            fr = forced_response(model, J, g, wp_n, w3_n)
+            fr = forced_response(model, J, g, wp_n, w3_n, mu_now)
             if fr > cnt[12]:
                 cnt[12] = fr
         nf = 0
@@ -436,15 +486,16 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
             switch = False
             phi_now = y[3] - sgn * (0.5 * math.pi - (y[2] if mode == AVG else p_unw))
             if mode == FULL and mu < HYST * mu_star:
-                phi_now += to_avg(model, J, g, cM, sM, y, p_unw, True)
+                dphi, dsplit = to_avg(model, J, g, cM, sM, y, p_unw, True)
+                phi_now += dphi + sgn * dsplit
                 mode = AVG
                 switch = True
             elif mode == AVG:
                 if mu > cnt[6]:
                     cnt[6] = mu
                 if mu > mu_star:
-                    p_unw, dphi = to_full(model, J, g, cM, sM, y, True)
-                    phi_now += dphi
+                    p_unw, dphi, dsplit = to_full(model, J, g, cM, sM, y, True)
+                    phi_now += dphi + sgn * dsplit
                     mode = FULL
                     switch = True
             if switch:

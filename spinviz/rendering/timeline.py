@@ -13,7 +13,7 @@ show them.  Two honest modes:
 
 * ``true`` -- each frame shows the simulated orientation at its time.  Used when the body
   turns less than 30 deg between frames and the phase is resolved.
-* ``slowed`` -- for symmetric tops.  The motion is written in ZXZ angles about L_world:
+* ``slowed`` -- for symmetric tops the motion is written in ZXZ angles about L_world:
   nutation theta_L (angle of e3 from L), precession phase phi_L (rate |L|/I1) and spin
   phase psi_L (rate delta Omega3).  theta_L and L are shown exactly; the two phases advance
   at ``spin_turns_per_second`` x (their true rate)/(|L|/I1 at t = 0) turns per video
@@ -30,6 +30,7 @@ import numpy as np
 
 from .. import rotations as R
 from ..inputs.render import RenderSpec
+from ..physics import polhode as PH
 from ..physics.free_top import pose_about_L
 from ..trajectory import radiated_power
 from .frameplan import FramePlan, Panel, ShapeInfo
@@ -92,16 +93,13 @@ def choose_spin_mode(spec: RenderSpec, trajs: list[Trajectory], sim_t) -> tuple[
     """("true" | "slowed" | "aliased", why).
 
     A phase that is not resolved (``Trajectory.phase_resolved`` False: float64 resolution,
-    or an averaged ``secular`` run) is never shown as the true one: symmetric tops are then
-    shown slowed (slow geometry exact, phases re-timed and labelled); an asymmetric body has
-    no slow form, so it is shown as computed with an on-screen note that the pose is
-    illustrative."""
+    or an averaged ``secular`` or ``polhode`` run) is never shown as the true one: the body is
+    then shown slowed (slow geometry exact -- L, the nutation of a symmetric top, the polhode
+    of an asymmetric body -- phases re-timed and labelled), as it is where it turns more than
+    ``MAX_TRUE_DEG_PER_FRAME`` between frames."""
     if not spec.needs_orientation:
         return "true", "no orientation shown"
-    body = trajs[0].body
     resolved = all(tr.phase_resolved and tr.q is not None for tr in trajs)
-    if spec.spin == "slowed" and not body.is_symmetric:
-        raise ValueError("spin = \"slowed\" needs a symmetric top (I1 = I2); this body is asymmetric")
     if spec.spin == "true":
         if not resolved:
             raise ValueError("spin = \"true\" needs a resolved spin phase; this run's phase is not resolved "
@@ -109,16 +107,12 @@ def choose_spin_mode(spec: RenderSpec, trajs: list[Trajectory], sim_t) -> tuple[
         return "true", "requested"
     if spec.spin == "slowed":
         return "slowed", "requested"
-    if body.is_symmetric and not resolved:
+    if not resolved:
         return "slowed", "spin phase not resolved (float64 or averaging)"
     deg = _rotation_per_frame(trajs, sim_t)
     if deg <= MAX_TRUE_DEG_PER_FRAME and resolved:
         return "true", f"at most {deg:.3g} deg per frame"
-    if body.is_symmetric:
-        return "slowed", f"up to {deg:.3g} deg per frame"
-    if not resolved:
-        return "aliased", "asymmetric body whose spin phase is not resolved: shown as computed, labelled illustrative"
-    return "aliased", f"asymmetric body turning up to {deg:.3g} deg per frame: shown as simulated, aliased"
+    return "slowed", f"up to {deg:.3g} deg per frame"
 
 
 def time_scale(trajs: list[Trajectory], t_end: float) -> tuple[str, float] | None:
@@ -201,6 +195,8 @@ def _shown_motion(spec: RenderSpec, samples, body, mode: str, video_t, slope):
     t = 0 of the first panel) turns per video second."""
     if mode != "slowed":
         return [(s.q, s.omega) for s in samples], None
+    if not body.is_symmetric:
+        return _shown_polhode(spec, samples, body, video_t, slope)
     geo = [_slow_geometry(s, body) for s in samples]
     rate_ref = geo[0]["phidot"][0] or 1.0
     two_pi_r0 = 2.0 * math.pi * spec.spin_turns_per_second
@@ -212,6 +208,55 @@ def _shown_motion(spec: RenderSpec, samples, body, mode: str, video_t, slope):
         omega_body, q = pose_about_L(g["q_L"], phi, g["theta_L"], psi, g["wp"], g["w3"], g["q_frame"])
         shown.append((q, omega_body))
     # true rad per video second / shown rad per video second (the same for every panel)
+    return shown, rate_ref * slope / two_pi_r0
+
+
+def _shown_polhode(spec: RenderSpec, samples, body, video_t, slope):
+    """Slowed mode for an asymmetric body: at each frame the polhode through the simulated
+    Omega (its size and axis exact) and L_world exact; the two phases of the free motion -- the
+    polhode phase u and the turn Sigma about L (``physics.polhode``) -- advance at
+    ``spin_turns_per_second`` x (their true rates) / (Sigma's rate at t = 0 of the first panel)
+    turns per video second.  Where the encircled axis changes (a separatrix crossing) the
+    phases start again from the simulated state."""
+    J = tuple(float(x) for x in body.inertia)
+    per = []
+    for s in samples:
+        L_world = s.angular_momentum_world()
+        rows = []
+        for f in range(len(s.t)):
+            try:
+                pol = PH.polhode_of(J, s.omega[f])
+            except PH.NoPolhode:
+                rows.append(None)
+                continue
+            wp, nu, c = PH.angle_variables(pol)
+            rows.append((pol, wp, nu, c, R.quat_between((0.0, 0.0, 1.0), L_world[f])))
+        per.append(rows)
+    first = next((r for r in per[0] if r is not None), None)
+    rate_ref = abs(first[2]) if first is not None and first[2] != 0.0 else 1.0
+    two_pi_r0 = 2.0 * math.pi * spec.spin_turns_per_second
+    scale = two_pi_r0 / rate_ref
+    shown = []
+    for s, rows in zip(samples, per):
+        q_out, w_out = np.array(s.q, dtype=float), np.array(s.omega, dtype=float)
+        u = sig = 0.0
+        prev = None
+        for f, row in enumerate(rows):
+            if row is None:
+                prev = None
+                continue
+            pol, wp, nu, c, q_L = row
+            if prev is None or (prev[0].c, prev[0].s_c) != (pol.c, pol.s_c):
+                u = float(pol.phase(s.omega[f]))
+                sig = PH.sigma_of(pol, q_L, s.q[f]) - float(PH.sigma_periodic(c, wp, u))
+            else:
+                dv = video_t[f] - video_t[f - 1]
+                u += 0.5 * scale * (wp + prev[1]) * dv
+                sig += 0.5 * scale * (nu + prev[2]) * dv
+            w, q = pol.pose(q_L, sig + float(PH.sigma_periodic(c, wp, u)), u)
+            q_out[f], w_out[f] = q, w
+            prev = row
+        shown.append((R.unflip(q_out), w_out))
     return shown, rate_ref * slope / two_pi_r0
 
 

@@ -1,4 +1,6 @@
-"""``auto``'s hand-over for a symmetric top whose spin is not yet fast: ``taylor -> secular``.
+"""``auto``'s hand-over for a body whose spin is not yet fast: ``taylor -> secular`` (a
+symmetric top) and ``taylor -> polhode`` (any other body; the same stages, with
+``polhode.check_applicable`` as the test and ``polhode_plan.predict`` as the predictor).
 
 ``secular`` needs a fast spin, tau0 |Omega| <= ``secular.EPS_MAX`` (otherwise the radiation
 changes the spin within a few turns and there is nothing to average over).  A top started
@@ -41,6 +43,8 @@ from .base import Problem, Solution
 from .scaling import spin_problem
 
 NAME = "taylor -> secular"
+NAME_POLHODE = "taylor -> polhode"     # the same hand-over for any body, to ``polhode``
+NAMES = (NAME, NAME_POLHODE)
 TARGET_MARGIN = 0.98       # each chunk aims at 0.98 x the bound, so one chunk usually suffices
 MAX_CHUNKS = 40            # chunk ends at which the test is asked; then the full stage runs to t_end
 PREDICT_STEP = 0.05        # the predictor's step: ln wp and ln |w3| change by at most ~5 % a step
@@ -111,7 +115,7 @@ def predict(system, omega, target: float, t_max: float) -> tuple[float, float]:
 
 
 def target_norm(problem: Problem) -> float:
-    """|omega| (spin units of ``problem``) at which ``secular`` applies: tau0 |Omega| =
+    """|omega| (spin units of ``problem``) at which ``secular`` (and ``polhode``) applies: tau0 |Omega| =
     eps |omega| <= ``secular.EPS_MAX``."""
     from .secular import EPS_MAX
 
@@ -119,11 +123,21 @@ def target_norm(problem: Problem) -> float:
     return EPS_MAX / eps
 
 
-def plan(problem: Problem) -> tuple[float, float]:
-    """(hand-over time, turns resolved in full before it), spin units, as ``predict`` sees them
+def predictor(target: str):
+    """The predictor of the hand-over to ``target``: ``predict`` ((4.12): symmetric tops) or
+    ``polhode_plan.predict`` (the averaged flow of any body)."""
+    if target == "polhode":
+        from .polhode_plan import predict as predict_polhode
+
+        return predict_polhode
+    return predict
+
+
+def plan(problem: Problem, target: str = "secular") -> tuple[float, float]:
+    """(hand-over time, turns resolved in full before it), spin units, as the predictor sees them
     from the start of ``problem``: inf when the hand-over does not come by t_end."""
     t = np.asarray(problem.t_eval, dtype=float)
-    return predict(problem.system, problem.omega0, TARGET_MARGIN * target_norm(problem), float(t[-1] - t[0]))
+    return predictor(target)(problem.system, problem.omega0, TARGET_MARGIN * target_norm(problem), float(t[-1] - t[0]))
 
 
 def _stage(problem: Problem, omega, q, t0: float, times):
@@ -134,15 +148,16 @@ def _stage(problem: Problem, omega, q, t0: float, times):
     return sub, e
 
 
-def solve_handover(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, step: float | None = None) -> Solution:
-    """Taylor's method in full until ``secular`` applies, then ``secular`` to t_end (module
-    docstring).  ``problem`` in spin units, a symmetric top, kinematics "quaternion" or "none";
-    ``step`` caps Taylor's steps.  A stage that fails fails the run, with its reason and the
-    samples so far."""
+def solve_handover(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, step: float | None = None,
+                   target: str = "secular") -> Solution:
+    """Taylor's method in full until ``target`` ("secular": a symmetric top; "polhode": any
+    body) applies, then ``target`` to t_end (module docstring).  ``problem`` in spin units,
+    kinematics "quaternion" or "none"; ``step`` caps Taylor's steps.  A stage that fails fails
+    the run, with its reason and the samples so far."""
     from . import secular as SC
 
     t = np.asarray(problem.t_eval, dtype=float)
-    full = _FullStage(problem, rtol, atol, step)
+    full = _FullStage(problem, rtol, atol, step, target)
     failure = full.run()
     stats = {"full_stage": {"method": "taylor", "nsteps": full.steps, "chunks": full.chunks, "until": full.s},
              "nsteps": full.steps}
@@ -157,10 +172,15 @@ def solve_handover(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, s
         return Solution(t=t, omega=full.omega, q=full.q_out, stats=stats)
     sub, e = full.handover
     j, s = full.j, full.s
-    sol = SC.solve_secular(sub, rtol, atol)
+    if target == "polhode":
+        from .polhode import solve_polhode
+
+        sol = solve_polhode(sub, rtol, atol)
+    else:
+        sol = SC.solve_secular(sub, rtol, atol)
     if not sol.success:
         return Solution(t=t, omega=full.omega, q=full.q_out, success=False, stats=stats, status=sol.status or 1,
-                        message=f"after the hand-over at t = {s:.4g} (spin units), secular: {sol.message}", reached=j)
+                        message=f"after the hand-over at t = {s:.4g} (spin units), {target}: {sol.message}", reached=j)
     full.omega[j:] = sol.omega[1:] * e
     if full.q_out is not None:
         full.q_out[j:] = sol.q[1:]
@@ -171,9 +191,14 @@ def solve_handover(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, s
         sec["resonances"] = [[m, s + a / e, kick] for m, a, kick in sec["resonances"]]
     if sec.get("regime_5_from") is not None:
         sec["regime_5_from"] = s + sec["regime_5_from"] / e
+    if "separatrix_crossings" in sec:
+        sec["separatrix_crossings"] = [{**c, "t": s + c["t"] / e, "t_out": s + c["t_out"] / e}
+                                       for c in sec["separatrix_crossings"]]
     stats.update(sec)
     stats.update(nsteps=full.steps + int(sec.get("nsteps", 0)), handover_at=s,
                  handover_eps_rad=float(np.dot(sub.system.coupling, sub.system.coupling)), phases_resolved=False)
+    if target == "polhode":
+        return Solution(t=t, omega=full.omega, q=full.q_out, stats=stats)
     q_full = None if full.q_out is None else full.q_out[:j]
     slow = _slow_series(sol.slow, q_full, full.q, full.omega[:j], problem)
     return Solution(t=t, omega=full.omega, q=full.q_out, stats=stats, slow=slow)
@@ -185,8 +210,9 @@ class _FullStage:
     applies (``handover``: its problem and scale) or t_end.  j: the next output index; s, w, q:
     the time (spin units of ``problem``) and state reached."""
 
-    def __init__(self, problem: Problem, rtol: float, atol: float, step: float | None):
+    def __init__(self, problem: Problem, rtol: float, atol: float, step: float | None, target: str = "secular"):
         self.problem, self.rtol, self.atol, self.step = problem, rtol, atol, step
+        self.target = target
         self.t = t = np.asarray(problem.t_eval, dtype=float)
         self.omega = np.full((t.size, 3), np.nan)
         self.w = self.omega[0] = np.asarray(problem.omega0, dtype=float)
@@ -199,10 +225,15 @@ class _FullStage:
 
     def run(self):
         """Advance to the hand-over or t_end; None, or (message, status, stats) of a failure."""
-        from .secular import NotApplicable, prepare
+        if self.target == "polhode":
+            from .polhode import NotApplicable
+            from .polhode import check_applicable as prepare
+        else:
+            from .secular import NotApplicable, prepare
 
         target = target_norm(self.problem)
         t_end = float(self.t[-1])
+        ahead = predictor(self.target)
         while self.s < t_end:
             if self.chunks > 0 or float(np.linalg.norm(self.w)) <= target:
                 sub, e = _stage(self.problem, self.w, self.q, self.s, self.t[self.j:])
@@ -212,7 +243,7 @@ class _FullStage:
                     return None
                 except NotApplicable:
                     pass
-            dt, _ = predict(self.problem.system, self.w, TARGET_MARGIN * target, t_end - self.s)
+            dt, _ = ahead(self.problem.system, self.w, TARGET_MARGIN * target, t_end - self.s)
             end = t_end if self.chunks >= MAX_CHUNKS or not math.isfinite(dt) else min(t_end, self.s + max(dt, 1.0))
             failure = self._chunk(end)
             if failure is not None:

@@ -159,8 +159,11 @@ def solve_handover(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, s
     j, s = full.j, full.s
     sol = SC.solve_secular(sub, rtol, atol)
     if not sol.success:
+        stats.update(handover_at=s)
+        if "failed_at" in sol.stats:
+            stats["failed_at"] = s + sol.stats["failed_at"] / e
         return Solution(t=t, omega=full.omega, q=full.q_out, success=False, stats=stats, status=sol.status or 1,
-                        message=f"after the hand-over at t = {s:.4g} (spin units), secular: {sol.message}", reached=j)
+                        message=f"secular, after the hand-over: {sol.message}", reached=j)
     full.omega[j:] = sol.omega[1:] * e
     if full.q_out is not None:
         full.q_out[j:] = sol.q[1:]

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import rotations as R
 from . import units as U
-from .atomic import atomic_path, open_regular, plain
+from .atomic import JsonTooDeep, atomic_path, loads_json, open_regular, plain
 from .errors import SpecTypeError, TrajectoryFileError
 from .physics import models as M
 from .physics.bodies import Body
@@ -403,12 +403,14 @@ class Trajectory:
                     raise TrajectoryFileError(path, "a single NumPy array, not a spinviz trajectory (.npz)")
                 if "metadata" not in z.files:
                     raise TrajectoryFileError(path, "not a spinviz trajectory (no metadata entry)")
-                meta = json.loads(str(z["metadata"]))
+                meta = loads_json(str(z["metadata"]))
                 if not isinstance(meta, dict) or meta.get("format") != FORMAT:
                     raise TrajectoryFileError(path, f"not a spinviz trajectory of format {FORMAT!r}")
                 arrays = {k: np.array(z[k]) for k in z.files if k != "metadata"}
         except TrajectoryFileError:
             raise
+        except JsonTooDeep as e:
+            raise TrajectoryFileError(path, f"metadata {e}") from None
         except FileNotFoundError:
             raise TrajectoryFileError(path, "no such file") from None
         except OSError as e:

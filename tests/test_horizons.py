@@ -91,6 +91,7 @@ def test_a_scene_horizon_that_cannot_finish_is_refused_naming_its_key(where):
 
 def test_the_command_line_refuses_it_in_one_line(tmp_path, capsys):
     from spinviz.commands import main
+
     from tomlgen import dumps
 
     scene = tmp_path / "hand.toml"

@@ -58,7 +58,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..atomic import check_parent_writable, special_kind
+from ..atomic import check_parent_writable, loads_json, special_kind
 from ..errors import SceneError, SpecTypeError, UsageError
 from ..physics.bodies import MIN_INERTIA_RATIO
 from . import atlas as IA
@@ -206,7 +206,7 @@ def spec_from_record(attrs: dict, where: str) -> AtlasSpec:
     import dataclasses
 
     try:
-        canonical = json.loads(attrs["spec"])
+        canonical = loads_json(attrs["spec"])
         if not isinstance(canonical, dict):
             raise ValueError
     except (KeyError, TypeError, ValueError):
@@ -224,7 +224,7 @@ def spec_from_record(attrs: dict, where: str) -> AtlasSpec:
     axes = None
     if "grid_axes" in attrs:
         try:
-            raw = json.loads(attrs["grid_axes"])
+            raw = loads_json(attrs["grid_axes"])
             axes = {k: (float(raw[k][0]), float(raw[k][1]), int(raw[k][2])) for k in ("delta", "chi")}
         except (KeyError, TypeError, ValueError, IndexError):
             raise SceneError(where, "grid_axes", "not {delta: [min, max, cells], chi: [...]}") from None

@@ -129,24 +129,21 @@ def forecast(system, omega, t_max: float, scale: float = 1.0, limit: float = mat
         ln_new = 0.5 * math.log(max(math.exp(2.0 * y[0]) + math.exp(2.0 * y[1]), tiny))
         end = y[2] >= t_max
 
-        def at(r):
-            return [x[i] + r * (y[i] - x[i]) for i in range(4)]
-
         if not math.isfinite(t_stage) and ln_new <= math.log(scale):
             r = (ln_old - math.log(scale)) / (ln_old - ln_new) if ln_old > ln_new else 1.0
-            z = at(r)
+            z = _between(x, y, r)
             t_stage, base = z[2], z[3]
             if t_stage >= t_max:
                 return Forecast(0.0, math.inf, math.inf, t_stage)
         if ln_new <= math.log(max(floor_norm, tiny)) and ln_old > ln_new:
             r = (ln_old - math.log(floor_norm)) / (ln_old - ln_new)
-            z = at(r)
+            z = _between(x, y, r)
             if z[2] < t_max:
                 t_floor = z[2]
                 return Forecast(steps_at(z, z[2]), t_floor, t_steps, t_stage)
         if end:
             r = (t_max - x[2]) / (y[2] - x[2]) if y[2] > x[2] else 1.0
-            z = at(r)
+            z = _between(x, y, r)
             n = steps_at(z, t_max)
             if n > limit and not math.isfinite(t_steps):
                 t_steps = _crossing(x, y, limit, steps_at)
@@ -157,6 +154,11 @@ def forecast(system, omega, t_max: float, scale: float = 1.0, limit: float = mat
     # the flow has not reached t_max in MAX_STEPS steps of sigma: |w| falls by ~e^-2000 over them,
     # far below the floor, which has been met (returned above) unless nothing brakes
     return Forecast(steps_at(x, x[2]), t_floor, t_steps, t_stage)
+
+
+def _between(x, y, r: float) -> list:
+    """The forecast's state a fraction ``r`` of the way from x to y (linear)."""
+    return [x[i] + r * (y[i] - x[i]) for i in range(4)]
 
 
 def _crossing(x, y, limit, steps_at) -> float:

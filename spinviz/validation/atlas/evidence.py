@@ -25,6 +25,7 @@ Each prints a table (``--json``: the rows as JSON instead) and its progress on s
 
 from __future__ import annotations
 
+import contextlib
 import json
 import sys
 
@@ -51,9 +52,15 @@ def run(kind: str, members: int | None = None, *, workers: int | None = None, ta
         raise UsageError(f"--evidence: {printable(kind, 40)} is not one of {', '.join(KINDS)}")
     check_accepts(kind, {"workers": workers, "tau_end": tau_end, "horizons": horizons, "out": out})
     req = EvidenceRequest(kind=kind, members=members, workers=workers, tau_end=tau_end, horizons=horizons, out=out)
-    if req.out is not None:
-        _check_store(req.out)
-    rows, table, status = _compute(req)
+    with contextlib.ExitStack() as held:
+        if req.out is not None:
+            from ...regimes.store.lock import StoreLock
+
+            _check_store(req.out)
+            # the store's lock before the study, not after it: refused at once when another
+            # command writes the store, and no one writes it while the rows are computed
+            held.enter_context(StoreLock(req.out, exclusive=True, what=f"--evidence {req.kind} --out"))
+        rows, table, status = _compute(req)
     print(json.dumps(rows, indent=2, default=float) if as_json else table)
     return status
 
@@ -113,12 +120,10 @@ def _compute(req) -> tuple:
 
 
 def _keep(req, rows: list, key: str) -> None:
-    """The rows kept in the atlas store ``--out`` names (if any), under ``key``, one writer at
-    a time (the store's lock)."""
+    """The rows kept in the atlas store ``--out`` names (if any), under ``key``; ``run`` holds
+    the store's lock from before the study."""
     if not req.out:
         return
-    from ...regimes.store.lock import StoreLock
     from . import convergence as CV
 
-    with StoreLock(req.out, exclusive=True, what=f"--evidence {req.kind} --out"):
-        CV.record(req.out, rows, key=key)
+    CV.record(req.out, rows, key=key)

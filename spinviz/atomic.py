@@ -133,6 +133,22 @@ def loads_json(text, max_depth: int = MAX_JSON_DEPTH):
     return json.loads(text)
 
 
+_WRITTEN: list[str] = []       # outputs renamed into place since ``forget_written`` (the command's start)
+
+
+def written() -> tuple[str, ...]:
+    """The outputs committed since ``forget_written()`` that are still there, in order: what a
+    command stopped by a signal had written (its line says so, rather than "nothing was
+    written").  A file written whole into a group's temporary file, and renamed from there
+    with the group, is named once, by its final path."""
+    return tuple(dict.fromkeys(p for p in _WRITTEN if os.path.lexists(p)))
+
+
+def forget_written() -> None:
+    """Start a new record of committed outputs (the command line calls it as a command starts)."""
+    _WRITTEN.clear()
+
+
 def _umask() -> int:
     mask = os.umask(0)
     os.umask(mask)
@@ -169,6 +185,7 @@ class AtomicPath:
         refuse_special_output(self.path)
         os.chmod(self.tmp, 0o666 & ~_umask())
         os.replace(self.tmp, self.path)
+        _WRITTEN.append(self.path)
 
     def discard(self):
         """Delete the temporary file, if any, and the directories made for it while they are empty."""

@@ -18,7 +18,7 @@ import sys
 
 from ..errors import UsageError, printable
 from ..interrupt import check
-from .shared import positive, real, reals
+from .shared import positive, progress, real, reals
 
 EVIDENCE = ("validate", "crosscheck", "physical", "convergence", "tolerance", "handover", "basins", "flows")
 
@@ -155,7 +155,7 @@ def _bench(spec, args) -> int:
         if not os.path.isfile(args.peer):
             raise UsageError(f"--peer: {printable(args.peer, 200)}: no such file")
         rows = bench.against_peer(spec, args.peer, progress=None if args.quiet else
-                                  lambda m: print(f"  {m}", file=sys.stderr, flush=True))
+                                  progress)
         print(bench.format_peer(rows) if not args.json else json.dumps(rows, indent=2, default=float))
         return 0
     if args.write_path:

@@ -62,7 +62,7 @@ from ..atomic import check_parent_writable, loads_json, special_kind
 from ..errors import SceneError, SpecTypeError, UsageError
 from ..physics.bodies import MIN_INERTIA_RATIO
 from . import atlas as IA
-from .base import fields_of
+from .base import fields_of, shown
 from .toml import document, read_document, table
 
 FORMAT = 2                       # the store's version (identity): 2 = Taylor's method (heyoka), no atol
@@ -315,7 +315,7 @@ def _axis(path, k: str, v, bounds: tuple, open_ends: bool, unit: str) -> np.ndar
     if isinstance(v, IA.AxisRange):
         if v.min < lo or v.max > hi:
             raise SceneError(path, f"[grid.{k}].{'min' if v.min < lo else 'max'}",
-                             f"the range must lie within {ends}{unit}, got [{v.min:g}, {v.max:g}]")
+                             f"the range must lie within {ends}{unit}, got [{shown(v.min, lo)}, {shown(v.max, hi)}]")
         return _centres(v)
     for x in v:
         if not (lo < x < hi if open_ends else lo <= x <= hi):

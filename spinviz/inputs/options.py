@@ -23,7 +23,7 @@ from typing import Annotated, Any, Literal
 from pydantic import Field, PlainValidator, model_validator
 
 from ..errors import SpecError, brief
-from .base import Flag, Int, Path, Real, between, request, wrong_type
+from .base import Flag, Int, Path, Real, between, request, shown, wrong_type
 
 MAX_DAYS_ENV = "SPINVIZ_MAX_DAYS"
 MAX_DAYS = 30.0                  # default cap on the estimated work of one command, days
@@ -201,7 +201,7 @@ def _horizons(v):
         lo, hi = TAU_END_RANGE[0], HANDOVER_TAU_MAX
         if not lo <= x <= hi:
             raise ValueError(f"each must lie in [{lo:g}, {hi:g}] (the classifier's windows and 100 braking times below, "
-                             f"where the hand-over engine was measured to hold above), got {x:g}")
+                             f"where the hand-over engine was measured to hold above), got {shown(x, lo, hi)}")
         out.append(x)
     if not 2 <= len(out) <= MAX_HORIZONS:
         raise ValueError(f"give 2 to {MAX_HORIZONS} horizons, got {len(out)}")
@@ -233,7 +233,7 @@ class EvidenceRequest:
                 raise SpecError("workers", f"must be at most {cores}, the cores this process may use, got {self.workers}")
         if self.kind == "handover" and self.horizons and max(self.horizons) > TAU_END_RANGE[1]:
             raise SpecError("horizons", f"each must be at most {TAU_END_RANGE[1]:g} for handover (brute force integrates "
-                                        f"in full to each), got {max(self.horizons):g}")
+                                        f"in full to each), got {shown(max(self.horizons), TAU_END_RANGE[1])}")
         n = self.n_members
         key = "members" if self.members is not None else {"physical": "tau_end", "convergence": "horizons",
                                                           "handover": "horizons", "basins": "tau_end"}.get(self.kind,

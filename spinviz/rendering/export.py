@@ -13,6 +13,7 @@ import time
 from dataclasses import dataclass, field
 
 from ..atomic import atomic_path
+from ..errors import printable
 from ..inputs.render import MODEL_FORMATS
 from . import gltf, keyframes, webpage
 
@@ -36,9 +37,10 @@ class ExportResult:
     poster: str | None = None
 
     def describe(self) -> str:
-        """One line for the command line."""
+        """One line for the command line, the path escaped (``errors.printable``) as every echoed name is."""
         kind = {"glb": "glTF model (binary)", "gltf": "glTF model", "html": "web page"}[self.format]
-        return (f"{self.path}: {kind}, {self.bytes / 1e3:.0f} kB, {self.keyframes} keyframes of {self.frames} frames "
+        return (f"{printable(self.path, 300)}: {kind}, {self.bytes / 1e3:.0f} kB, {self.keyframes} keyframes of "
+                f"{self.frames} frames "
                 f"(within {self.tolerance_deg:g} deg of every frame; largest {self.max_error_deg:.3g} deg), "
                 f"written in {self.seconds:.1f} s")
 

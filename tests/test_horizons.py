@@ -18,7 +18,7 @@ from spinviz.errors import SceneError, SimulationError, SpecError
 from spinviz.inputs.scene_spec import parse_scene
 from spinviz.integrators import secular as SC
 from spinviz.physics import bodies as B
-from spinviz.physics import presets as PR
+from spinviz.physics import presets as P
 
 TOP = B.symmetric_top(0.3, 0.7)
 W0 = (0.0, 0.05, 0.3)                  # tau0 |Omega0| = 0.3: not fast, so auto hands the run over
@@ -63,7 +63,7 @@ def test_a_secular_horizon_beyond_the_step_limit_is_refused_at_once():
     """The DAST cube to 1e30 Theta: at its residual rotation the slow flow's explicit steps are
     held by the decay of omega_perp (~0.16 a Theta, measured), 1e29 steps; refused before the
     minutes it ran, by auto and by method = "secular" alike."""
-    cube = PR.dast_cube()
+    cube = P.dast_cube()
     theta = cube.residual_time_Theta(CUBE_W0[2])
     for method in ("auto", "secular"):
         e, cpu = refused(lambda m=method: simulate(cube, "reduced", CUBE_W0, t_end=1e30 * theta, samples=11, method=m))
@@ -107,7 +107,7 @@ def test_horizons_within_the_limits_are_accepted():
     the slow test) and the cube's requests to 1e6 Theta (1.6e5 steps, 0.3 s, measured) are
     accepted."""
     spinviz.SimulationRequest(body=TOP, model="reduced", omega0=W0, t_end=1e100, samples=5)
-    cube = PR.dast_cube()
+    cube = P.dast_cube()
     spinviz.SimulationRequest(body=cube, model="reduced", omega0=CUBE_W0,
                               t_end=1e6 * cube.residual_time_Theta(CUBE_W0[2]), samples=11)
 

@@ -12,7 +12,7 @@ from spinviz import experiment
 from spinviz.analysis import decide as DC
 from spinviz.commands import main
 from spinviz.errors import SpecError
-from spinviz.inputs import options as OP
+from spinviz.inputs import options as O
 
 ROOT = Path(__file__).resolve().parents[1]
 CUBE = str(ROOT / "scenes" / "dast_cube.toml")
@@ -66,7 +66,7 @@ def test_the_estimate_follows_the_trials_the_mode_and_the_workers():
 def test_the_shared_check_for_work_of_alike_pieces(monkeypatch):
     """What other long commands call: units x measured seconds each, over their workers."""
     monkeypatch.setenv("SPINVIZ_MAX_DAYS", "1")
-    assert OP.check_units("runs", 1000, 0.5, "1000 runs", workers=4) == pytest.approx(125.0)
+    assert O.check_units("runs", 1000, 0.5, "1000 runs", workers=4) == pytest.approx(125.0)
     with pytest.raises(SpecError) as e:
-        OP.check_units("runs", 1e6, 0.5, "1e6 runs", workers=1)
+        O.check_units("runs", 1e6, 0.5, "1e6 runs", workers=1)
     assert e.value.key == "runs" and "~5.79 days here, more than the cap of 1 days" in e.value.reason, e.value

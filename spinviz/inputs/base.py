@@ -123,6 +123,7 @@ def between(lo: float, hi: float, why: str = "", lo_open: bool = False):
             raise ValueError(f"must lie in {ends}{because}, got {shown(v, lo, hi)}")
         return v
 
+    check.bounds = (lo, hi)            # the range, for whoever draws values from the schema (the fuzz tests)
     return AfterValidator(check)
 
 

@@ -28,7 +28,7 @@ import json
 import os
 
 from ..atomic import JsonTooDeep, NotRegularFile, loads_json, read_regular
-from ..errors import SceneError, SpecError, brief
+from ..errors import SceneError, SpecError, SpecTypeError, brief
 from .base import Line, NonNegative, Positive, Real, request
 from .toml import MAX_FILE_BYTES
 
@@ -128,7 +128,10 @@ def read_measurements(path) -> tuple[dict, str]:
     """The measurements in the CSV or JSON file at ``path`` as arrays ({column: list of floats},
     ``t_s`` only when given) and the unit of the powers; ``SceneError(path, where, reason)`` on
     the first problem."""
-    path = os.fspath(path)
+    if not isinstance(path, str | bytes | os.PathLike):
+        raise SpecTypeError("measurements", f"must be the path of a CSV or JSON file (str or os.PathLike), got "
+                                            f"{type(path).__name__} {brief(path)}")
+    path = os.fsdecode(path)
     kind = os.path.splitext(path)[1].lower()
     if kind not in (".csv", ".json"):
         raise SceneError(path, "(file)", "a measurements file ends in .csv or .json")

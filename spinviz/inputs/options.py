@@ -306,10 +306,12 @@ SOUND_SECONDS = (0.5, 600.0, "seconds of sound")
 LISTEN_SAMPLES = 100_000         # instants of each model's run (the detector's memory per instant)
 
 
-def _extension(ext: str, what: str):
-    """A path (str or os.PathLike) ending in ``ext``, kept as str."""
+def _extension(ext: str, what: str, required: bool = False):
+    """A path (str or os.PathLike) ending in ``ext``, kept as str (None allowed unless ``required``)."""
 
     def check(v):
+        if v is None and required:
+            raise wrong_type(f"must be a path ending in {ext}, got None")
         if v is None:
             return None
         if not isinstance(v, str | os.PathLike):
@@ -328,7 +330,7 @@ class ListenRequest:
     spectrogram ``png``, default beside it), how long, at which pitch, how sound time and pitch
     follow the run's, how much dynamic range, from how many instants."""
 
-    out: _extension(".wav", "the sound is written as WAV")
+    out: _extension(".wav", "the sound is written as WAV", required=True)
     png: _extension(".png", "the spectrogram is a PNG") = None
 
     duration: Annotated[Real, between(*SOUND_SECONDS)] = 20.0

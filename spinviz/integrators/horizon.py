@@ -42,6 +42,7 @@ STEPS_PER_DECADE = 30.0     # accuracy-bound steps of the averaged flow per deca
 FLOOR = 1e-300              # eps |w|^4 (secular's spin units) below which its rates leave float64's normal range
 STEP = 0.2                  # the forecast's RK4 step: ln wp and ln |w3| change by at most ~20 % of their share a step
 MAX_STEPS = 50_000          # forecast steps (ln |w| falls by ~0.2 a step: 1e4 covers float64's whole range)
+TINY = 1e-300
 
 
 @dataclass(frozen=True)
@@ -82,6 +83,40 @@ def _decay_rate(P, Q, R, S, a, b) -> float:
     return max(abs(0.5 * (tr - disc)), abs(0.5 * (tr + disc)))
 
 
+class _Flow:
+    """The averaged flow in sigma on x = (ln wp, ln |w3|, t, stability-bound steps), and the step
+    count of a secular stage that starts at ``t_stage`` (``base``: the steps counted before it)."""
+
+    def __init__(self, coef, eps: float):
+        self.coef, self.eps = coef, eps
+        self.t_stage, self.base = math.inf, 0.0
+
+    def rate(self, x):
+        """d/dsigma of x."""
+        P, Q, R, S = self.coef
+        a, b = math.exp(2.0 * x[0]), math.exp(2.0 * x[1])
+        n2 = max(a + b, TINY)
+        return (-(P * a + Q * b) / n2, -(R * a + S * b) / n2, 1.0 / (self.eps * n2),
+                _decay_rate(P, Q, R, S, a, b) / (n2 * STABILITY_EDGE))
+
+    def step(self, x, t_max: float):
+        """(the next state, ln |w| before, after): a step holding each component's log to ``STEP``
+        of its share of |w|^2 (a dying component falls as it likes), never far past t_max."""
+        k1 = self.rate(x)
+        a, b = math.exp(2.0 * x[0]), math.exp(2.0 * x[1])
+        n2 = a + b
+        h = STEP * n2 / max(abs(k1[0]) * a, abs(k1[1]) * b, TINY)
+        h = min(h, 2.0 * (t_max - x[2]) * self.eps * max(n2, TINY))     # t would overflow far past t_max
+        y = _rk4(self.rate, x, k1, h)
+        return y, 0.5 * math.log(max(n2, TINY)), 0.5 * math.log(max(math.exp(2.0 * y[0]) + math.exp(2.0 * y[1]), TINY))
+
+    def steps_at(self, x, t: float) -> float:
+        """The secular stage's steps up to the state x at time t."""
+        if t < self.t_stage:
+            return 0.0
+        return (x[3] - self.base) + STEPS_PER_DECADE * math.log10(1.0 + self.eps * (t - self.t_stage))
+
+
 def forecast(system, omega, t_max: float, scale: float = 1.0, limit: float = math.inf) -> Forecast:
     """The slow flow's steps and range over [0, t_max] from the spin-unit state ``omega`` (3,),
     the secular stage starting where |w| first falls to ``scale`` (1: at once; the hand-over's
@@ -90,70 +125,46 @@ def forecast(system, omega, t_max: float, scale: float = 1.0, limit: float = mat
     w = np.asarray(omega, dtype=float)
     eps = float(np.dot(system.coupling, system.coupling))
     wp, w3 = math.hypot(w[0], w[1]), abs(float(w[2]))
-    norm0 = math.hypot(wp, w3)
     coef = _coefficients(system)
-    floor_norm = (FLOOR * scale**3 / eps) ** 0.25 if eps > 0 else 0.0     # eps |w|^4 / scale^3 = FLOOR
-    if coef is None or eps == 0.0 or norm0 == 0.0:
-        steps = STEPS_PER_DECADE * math.log10(1.0 + max(eps, 1e-300) * t_max)
+    if coef is None or eps == 0.0 or math.hypot(wp, w3) == 0.0:
+        steps = STEPS_PER_DECADE * math.log10(1.0 + max(eps, TINY) * t_max)
         return Forecast(steps, math.inf, math.inf if steps <= limit else 0.0, 0.0)
-    P, Q, Rc, S = coef
-    tiny = 1e-300
-
-    def f(x):            # d/dsigma of (ln wp, ln w3, t, stability-bound steps)
-        a, b = math.exp(2.0 * x[0]), math.exp(2.0 * x[1])
-        n2 = max(a + b, tiny)
-        return (-(P * a + Q * b) / n2, -(Rc * a + S * b) / n2, 1.0 / (eps * n2),
-                _decay_rate(P, Q, Rc, S, a, b) / (n2 * STABILITY_EDGE))
-
-    x = [math.log(max(wp, tiny)), math.log(max(w3, tiny)), 0.0, 0.0]
-    t_stage = 0.0 if norm0 <= scale else math.inf
-    base = 0.0                      # the stability-bound steps counted before the stage
-    t_floor = t_steps = math.inf
-
-    def steps_at(x_, t_):
-        if t_ < t_stage:
-            return 0.0
-        return (x_[3] - base) + STEPS_PER_DECADE * math.log10(1.0 + eps * (t_ - t_stage))
-
+    flow = _Flow(coef, eps)
+    ln_floor = 0.25 * math.log(FLOOR * scale**3 / eps)                 # eps |w|^4 / scale^3 = FLOOR
+    x = [math.log(max(wp, TINY)), math.log(max(w3, TINY)), 0.0, 0.0]
+    if math.hypot(wp, w3) <= scale:
+        flow.t_stage = 0.0
+    t_steps = math.inf
     for _ in range(MAX_STEPS):
-        k1 = f(x)
-        a, b = math.exp(2.0 * x[0]), math.exp(2.0 * x[1])
-        n2 = a + b
-        h = STEP * n2 / max(abs(k1[0]) * a, abs(k1[1]) * b, tiny)
-        h = min(h, 2.0 * (t_max - x[2]) * eps * max(n2, tiny))     # no step far past t_max (t would overflow)
-        k2 = f([x[i] + 0.5 * h * k1[i] for i in range(4)])
-        k3 = f([x[i] + 0.5 * h * k2[i] for i in range(4)])
-        k4 = f([x[i] + h * k3[i] for i in range(4)])
-        y = [x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) for i in range(4)]
-        ln_old = 0.5 * math.log(max(n2, tiny))
-        ln_new = 0.5 * math.log(max(math.exp(2.0 * y[0]) + math.exp(2.0 * y[1]), tiny))
-        end = y[2] >= t_max
-
-        if not math.isfinite(t_stage) and ln_new <= math.log(scale):
-            r = (ln_old - math.log(scale)) / (ln_old - ln_new) if ln_old > ln_new else 1.0
-            z = _between(x, y, r)
-            t_stage, base = z[2], z[3]
-            if t_stage >= t_max:
-                return Forecast(0.0, math.inf, math.inf, t_stage)
-        if ln_new <= math.log(max(floor_norm, tiny)) and ln_old > ln_new:
-            r = (ln_old - math.log(floor_norm)) / (ln_old - ln_new)
-            z = _between(x, y, r)
+        y, ln_old, ln_new = flow.step(x, t_max)
+        if not math.isfinite(flow.t_stage) and ln_new <= math.log(scale):
+            z = _between(x, y, (ln_old - math.log(scale)) / (ln_old - ln_new) if ln_old > ln_new else 1.0)
+            flow.t_stage, flow.base = z[2], z[3]
+            if flow.t_stage >= t_max:
+                return Forecast(0.0, math.inf, math.inf, flow.t_stage)
+        if ln_new <= ln_floor < ln_old:
+            z = _between(x, y, (ln_old - ln_floor) / (ln_old - ln_new))
             if z[2] < t_max:
-                t_floor = z[2]
-                return Forecast(steps_at(z, z[2]), t_floor, t_steps, t_stage)
+                return Forecast(flow.steps_at(z, z[2]), z[2], t_steps, flow.t_stage)
+        end = y[2] >= t_max
         if end:
-            r = (t_max - x[2]) / (y[2] - x[2]) if y[2] > x[2] else 1.0
-            z = _between(x, y, r)
-            n = steps_at(z, t_max)
-            if n > limit and not math.isfinite(t_steps):
-                t_steps = _crossing(x, y, limit, steps_at)
-            return Forecast(n, t_floor, t_steps, t_stage)
-        if not math.isfinite(t_steps) and steps_at(y, y[2]) > limit:
-            t_steps = _crossing(x, y, limit, steps_at)
+            y = _between(x, y, (t_max - x[2]) / (y[2] - x[2]) if y[2] > x[2] else 1.0)
+        if not math.isfinite(t_steps) and flow.steps_at(y, y[2]) > limit:
+            t_steps = _crossing(x, y, limit, flow.steps_at)
+        if end:
+            return Forecast(flow.steps_at(y, t_max), math.inf, t_steps, flow.t_stage)
         x = y
     # the flow has not reached t_max in MAX_STEPS steps of sigma: |w| falls by ~e^-2000 over them,
     # far below the floor, which has been met (returned above) unless nothing brakes
-    return Forecast(steps_at(x, x[2]), t_floor, t_steps, t_stage)
+    return Forecast(flow.steps_at(x, x[2]), math.inf, t_steps, flow.t_stage)
+
+
+def _rk4(f, x, k1, h: float) -> list:
+    """One classical Runge-Kutta step of size h from x (k1 = f(x) given)."""
+    k2 = f([x[i] + 0.5 * h * k1[i] for i in range(4)])
+    k3 = f([x[i] + 0.5 * h * k2[i] for i in range(4)])
+    k4 = f([x[i] + h * k3[i] for i in range(4)])
+    return [x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) for i in range(4)]
 
 
 def _between(x, y, r: float) -> list:

@@ -1,6 +1,6 @@
 """The embedded cluster under load: it waits for its workers in proportion to the machine's
 load (a spawned interpreter that imports Dask and the integrators takes seconds on an idle
-machine and many times that at a load of 30 on 2 cores, where a fixed 120 s gave up), keeps
+machine and many times that at a load of 30 on 2 cores, where a fixed 120 s is too short), keeps
 waiting while workers keep arriving, and when it does give up says so in one line, with the
 load, and leaves no process behind."""
 

@@ -52,9 +52,9 @@ def lines_for(name: str, out) -> set:
 @pytest.mark.slow
 @pytest.mark.parametrize("dask", [False, True], ids=["processes", "dask"])
 def test_a_stop_signal_at_any_instant_of_decide(tmp_path, dask):
-    """Worker processes that took the signal themselves printed their tracebacks beside the
-    command's line; ones that ignored SIGTERM kept ``Pool.terminate`` (which sends SIGTERM)
-    waiting forever."""
+    """A worker process that took the signal itself would print its traceback beside the
+    command's line; one that ignores SIGTERM keeps ``multiprocessing``'s own terminate (which
+    sends SIGTERM) waiting forever, so the pool is killed."""
     rng = random.Random(35 + dask)
     p, t0 = start(tmp_path / "whole", tmp_path, dask)               # the whole command, timed once
     _, err = p.communicate(timeout=600)

@@ -35,7 +35,7 @@ size = [64, 48]
 
 @pytest.mark.parametrize("ext", [".glb", ".html"])
 def test_an_export_prints_its_path_escaped_on_one_line(tmp_path, capsys, ext):
-    """The glTF and page exports printed the path raw (video and WAV names were escaped)."""
+    """The glTF and page exports' lines escape their path as the video's and the WAV's do."""
     scene = tmp_path / "s.toml"
     scene.write_text(SCENE)
     out = tmp_path / f"{HOSTILE}{ext}"

@@ -23,7 +23,7 @@ from spinviz.physics import presets as P
 TOP = B.symmetric_top(0.3, 0.7)
 W0 = (0.0, 0.05, 0.3)                  # tau0 |Omega0| = 0.3: not fast, so auto hands the run over
 CUBE_W0 = (0.0, math.pi * 1e10, math.pi * 1e10)
-REFUSAL_CPU_S = 0.5                    # the refusal's own cost (the runs it spares took 37 s and minutes)
+REFUSAL_CPU_S = 0.5                    # the refusal's own cost (the runs it spares take 37 s and minutes)
 
 HANDOVER_SCENE = {
     "body": {"delta": 0.3, "chi": 0.7},
@@ -51,7 +51,7 @@ def with_(scene: dict, table: str, **keys) -> dict:
 
 def test_a_handed_over_horizon_beyond_float64_is_refused_at_once():
     """t_end = 1e300 for a top auto hands over to secular: the slow flow's spin would fall below
-    what its rates hold in float64 (they overflowed, after 37 s of work); refused before it,
+    what its rates hold in float64 (they overflow after ~37 s of work); refused before it,
     naming t_end and how far the slow flow can go."""
     e, cpu = refused(lambda: simulate(TOP, "reduced", W0, t_end=1e300, samples=11))
     assert e.key == "t_end" and "\n" not in str(e), e
@@ -62,7 +62,7 @@ def test_a_handed_over_horizon_beyond_float64_is_refused_at_once():
 def test_a_secular_horizon_beyond_the_step_limit_is_refused_at_once():
     """The DAST cube to 1e30 Theta: at its residual rotation the slow flow's explicit steps are
     held by the decay of omega_perp (~0.16 a Theta, measured), 1e29 steps; refused before the
-    minutes it ran, by auto and by method = "secular" alike."""
+    minutes it would run, by auto and by method = "secular" alike."""
     cube = P.dast_cube()
     theta = cube.residual_time_Theta(CUBE_W0[2])
     for method in ("auto", "secular"):
@@ -121,7 +121,7 @@ def test_a_long_accepted_horizon_finishes():
 def test_a_run_failing_late_names_the_instant_it_failed(monkeypatch):
     """A hand-over whose slow flow gives up (here: its step limit lowered below what the run
     needs) names when: after the hand-over, inside the horizon -- not the last sample it had
-    reached (t = 0 before)."""
+    reached."""
     monkeypatch.setattr(SC, "MAX_STEPS", 9000)             # the secular stage takes ~1e4 steps
     with pytest.raises(SimulationError) as e:
         simulate(TOP, "reduced", W0, t_end=1e20, samples=11)

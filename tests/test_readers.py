@@ -69,7 +69,8 @@ def test_a_directory_as_measurements_is_named(tmp_path):
                                  '{"f_hz": ' + "[" * 40 + "1" + "]" * 40 + "}"],
                          ids=["array", "inside-an-object", "just-past-the-limit"])
 def test_a_deeply_nested_measurements_json_is_named_in_one_line(tmp_path, doc):
-    """It was "maximum recursion depth exceeded while decoding a JSON array", naming no file."""
+    """Python's parser would end in "maximum recursion depth exceeded while decoding a JSON
+    array", naming no file."""
     path = tmp_path / "m.json"
     path.write_text(doc)
     with pytest.raises(SceneError) as e:
@@ -86,7 +87,7 @@ def test_brackets_inside_strings_do_not_count():
 
 
 def test_a_csv_field_beyond_the_parsers_limit_is_named(tmp_path, capsys):
-    """A 200 kB field raised csv's own error through the command line (a traceback)."""
+    """A 200 kB field: csv's own error would reach the command line as a traceback."""
     path = tmp_path / "m.csv"
     path.write_text(HEADER + '"' + "1" * 200_000 + '",1,1,1\n' + ROWS)
     with pytest.raises(SceneError) as e:

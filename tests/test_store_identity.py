@@ -56,7 +56,8 @@ def test_a_link_to_a_store_not_made_yet_shares_its_lock(tmp_path):
 
 
 def test_verify_through_an_alias_during_a_write_answers_busy(store, tmp_path, capsys):
-    """It answered "DAMAGED: 1 chunk(s) to recompute" about a half-written store."""
+    """Judged in the middle of a write, a store would look damaged ("DAMAGED: 1 chunk(s) to
+    recompute")."""
     alias = tmp_path / "alias.zarr"
     alias.symlink_to(store)
     with StoreLock(str(store), exclusive=True):
@@ -72,8 +73,8 @@ class Reached(Exception):
 
 def test_evidence_is_refused_at_once_on_a_held_lock(refined_atlas, tmp_path, monkeypatch, capsys):
     """Another command writes the store: ``--evidence convergence --out STORE`` is refused before
-    its study starts (it computed for minutes, then was refused and its work thrown away), by
-    the store's real name and through a link to it."""
+    its study starts (refused after it, minutes of work would be thrown away), by the store's
+    real name and through a link to it."""
     copy = tmp_path / "s.zarr"
     shutil.copytree(refined_atlas.store, copy)
     alias = tmp_path / "alias.zarr"

@@ -40,8 +40,9 @@ def _render(scene, out, cwd):
 
 @pytest.mark.slow
 def test_a_stop_signal_to_the_group_of_a_parallel_render(tmp_path):
-    """Spawned render workers took a Ctrl-C while importing (KeyboardInterrupt tracebacks), and
-    a hang-up killed the resource tracker they started, whose successor printed KeyErrors."""
+    """A spawned render worker that took a Ctrl-C while importing would print a
+    KeyboardInterrupt traceback, and a resource tracker killed by a hang-up is relaunched and
+    prints KeyErrors: both are born with the signals blocked."""
     scene = tmp_path / "s.toml"
     scene.write_text(SCENE)
     p, t0 = _render(scene, tmp_path / "whole.mp4", tmp_path)
@@ -92,8 +93,8 @@ def alarm():
 @pytest.mark.slow
 def test_a_process_mapper_stops_at_once_whatever_its_workers_ignore(alarm):
     """The pool's workers ignore SIGTERM (the parent alone answers a terminal's signals), so
-    ``multiprocessing``'s own terminate, which sends SIGTERM, waited for them forever: stopping
-    the mapper on an exception kills them, at once."""
+    ``multiprocessing``'s own terminate, which sends SIGTERM, would wait for them forever:
+    stopping the mapper on an exception kills them, at once."""
     t0 = time.monotonic()
     with pytest.raises(RuntimeError, match="stop"):
         with ProcessMapper(2) as m:

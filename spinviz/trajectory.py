@@ -403,6 +403,10 @@ class Trajectory:
                     raise TrajectoryFileError(path, "a single NumPy array, not a spinviz trajectory (.npz)")
                 if "metadata" not in z.files:
                     raise TrajectoryFileError(path, "not a spinviz trajectory (no metadata entry)")
+                size = z.zip.getinfo("metadata.npy").file_size
+                if size > MAX_METADATA_BYTES:
+                    raise TrajectoryFileError(path, f"metadata of {size} bytes; a trajectory's are at most "
+                                                    f"{MAX_METADATA_BYTES}")
                 meta = loads_json(str(z["metadata"]))
                 if not isinstance(meta, dict) or meta.get("format") != FORMAT:
                     raise TrajectoryFileError(path, f"not a spinviz trajectory of format {FORMAT!r}")
@@ -449,6 +453,7 @@ class Trajectory:
 
 
 FORMAT = "spinviz-trajectory-1"
+MAX_METADATA_BYTES = 16_000_000      # a trajectory's metadata (body, stats, slow geometry's labels) are a few kB
 
 
 def _plain_stats(stats: dict) -> dict:

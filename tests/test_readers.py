@@ -123,9 +123,9 @@ def test_a_trajectory_whose_metadata_nests_too_deep_is_named(tmp_path):
 
 
 def test_a_trajectory_whose_metadata_is_too_large_is_named(tmp_path, monkeypatch):
-    import spinviz.trajectory as T
+    import spinviz.trajectory as TJ
 
-    monkeypatch.setattr(T, "MAX_METADATA_BYTES", 1000)
+    monkeypatch.setattr(TJ, "MAX_METADATA_BYTES", 1000)
     path = tmp_path / "t.npz"
     np.savez(path, metadata=np.array("x" * 2000), t=np.zeros(3))
     with pytest.raises(TrajectoryFileError, match="metadata of 8128 bytes; a trajectory's are at most 1000"):

@@ -188,7 +188,7 @@ def accuracy_notes(method: str, rtol: float, atol: float) -> list[str]:
 def _stats_in_units(stats: dict, time_scale: float) -> dict:
     """The integrator's stats with its times (spin units) in the trajectory's (s or tau0)."""
     out = dict(stats)
-    for key in ("stiff_at", "runaway_at", "handover_at", "regime_5_from"):
+    for key in ("stiff_at", "runaway_at", "handover_at", "regime_5_from", "failed_at"):
         if out.get(key) is not None:
             out[key] = out[key] / time_scale
     if "full_stage" in out:
@@ -284,9 +284,15 @@ def solve(problem: Problem, method: str, *, rtol: float, atol: float, step: floa
 
 
 def _failure_message(problem: Problem, sol: Solution, name: str, time_scale: float) -> str:
-    """One line: why a run failed, and when."""
+    """One line: why a run failed, and when: where the integrator stopped (``failed_at``, with
+    the hand-over's instant for ``taylor -> secular``), else the last output instant it reached."""
     if "runaway_at" in sol.stats:
         return _runaway_message(problem, sol.stats, time_scale)
+    at = sol.stats.get("failed_at")
+    if at is not None:
+        handed = sol.stats.get("handover_at")
+        tail = f"; handed over at t = {handed / time_scale:.4g}" if handed is not None else ""
+        return f"{name}: {sol.message} (at t = {at / time_scale:.4g}{tail})"
     if sol.reached is not None and 0 < sol.reached < len(sol.t):
         return f"{name}: {sol.message} (by t = {sol.t[sol.reached - 1] / time_scale:.4g})"
     return f"{name}: {sol.message}"

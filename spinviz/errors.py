@@ -93,7 +93,8 @@ class SpecError(SpinvizError, ValueError):
 
     def __init__(self, key: str, reason: str):
         self.key, self.reason = key, reason
-        super().__init__(f"{key}: {reason}")
+        # escaped: a key may be a caller's argument name, a reason quotes values (printable)
+        super().__init__(f"{printable(key, 100)}: {printable(reason, 4 * MAX_MESSAGE)}")
 
 
 class SpecTypeError(SpecError, TypeError):
@@ -120,7 +121,8 @@ class SceneError(SpinvizError, ValueError):
 
     def __init__(self, path: str, key: str, reason: str):
         self.path, self.key, self.reason = str(path), key, reason
-        super().__init__(f"{self.path}: {key}: {reason}")
+        # escaped and cut in the middle: a path may hold any byte a file system allows
+        super().__init__(f"{shortened(self.path, 300)}: {printable(key, 100)}: {printable(reason, 4 * MAX_MESSAGE)}")
 
 
 class SimulationError(SpinvizError, RuntimeError):

@@ -150,6 +150,7 @@ def decide(scene, *, trials: int = 200, seed: int = 1, spin_range=(0.5, 2.0), ta
     sc = _scene(scene)
     rx = receiver_of(sc, **receiver)
     setup = DC.setup_from_scene(sc.require("decide"), rx, sc.observe.t_end or sc.t_end, spec.spin_range, spec.tau0)
+    DC.check_work(setup, spec.trials, _workers(spec))          # SPINVIZ_MAX_DAYS, before any trial
     group = _plots(sc, [plot]) if plot is not None else None
     with contextlib.ExitStack() as stack:
         mapper = _mapper(stack, spec, say)
@@ -166,7 +167,7 @@ def decide(scene, *, trials: int = 200, seed: int = 1, spin_range=(0.5, 2.0), ta
 def _mapper(stack: contextlib.ExitStack, spec, say):
     """Where decide's trials run: a Dask cluster when large or asked for, worker processes
     otherwise (None: this process, for a handful of trials on one core)."""
-    from .executors.processes import ProcessMapper, usable_cores
+    from .executors.processes import ProcessMapper
 
     if spec.scheduler is not None or spec.trials >= DASK_TRIALS:
         from .executors.cluster import Cluster, mapper
@@ -175,8 +176,19 @@ def _mapper(stack: contextlib.ExitStack, spec, say):
         if say is not None:
             say(f"decide: {spec.trials} trials on {cl.describe}")
         return mapper(cl)
-    workers = min(spec.workers or usable_cores(), max(1, spec.trials // 8))
+    workers = _workers(spec)
     return None if workers == 1 else stack.enter_context(ProcessMapper(workers))
+
+
+def _workers(spec) -> int:
+    """The processes decide's trials run on: the given workers or one per core, no more than
+    the batches of 8 trials; on Dask, the embedded cluster's (an existing cluster's size is not
+    known before it is reached: its work is estimated as on this machine)."""
+    from .executors.processes import usable_cores
+
+    if spec.scheduler is not None or spec.trials >= DASK_TRIALS:
+        return spec.workers or usable_cores()
+    return min(spec.workers or usable_cores(), max(1, spec.trials // 8))
 
 
 def test_measurements(scene, measurements):

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import rotations as R
 from . import units as U
-from .atomic import atomic_path, open_regular, plain
+from .atomic import JsonTooDeep, atomic_path, loads_json, open_regular, plain
 from .errors import SpecTypeError, TrajectoryFileError
 from .physics import models as M
 from .physics.bodies import Body
@@ -414,12 +414,18 @@ class Trajectory:
                     raise TrajectoryFileError(path, "a single NumPy array, not a spinviz trajectory (.npz)")
                 if "metadata" not in z.files:
                     raise TrajectoryFileError(path, "not a spinviz trajectory (no metadata entry)")
-                meta = json.loads(str(z["metadata"]))
+                size = z.zip.getinfo("metadata.npy").file_size
+                if size > MAX_METADATA_BYTES:
+                    raise TrajectoryFileError(path, f"metadata of {size} bytes; a trajectory's are at most "
+                                                    f"{MAX_METADATA_BYTES}")
+                meta = loads_json(str(z["metadata"]))
                 if not isinstance(meta, dict) or meta.get("format") != FORMAT:
                     raise TrajectoryFileError(path, f"not a spinviz trajectory of format {FORMAT!r}")
                 arrays = {k: np.array(z[k]) for k in z.files if k != "metadata"}
         except TrajectoryFileError:
             raise
+        except JsonTooDeep as e:
+            raise TrajectoryFileError(path, f"metadata {e}") from None
         except FileNotFoundError:
             raise TrajectoryFileError(path, "no such file") from None
         except OSError as e:
@@ -458,6 +464,7 @@ class Trajectory:
 
 
 FORMAT = "spinviz-trajectory-1"
+MAX_METADATA_BYTES = 16_000_000      # a trajectory's metadata (body, stats, slow geometry's labels) are a few kB
 
 
 def _plain_stats(stats: dict) -> dict:

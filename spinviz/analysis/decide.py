@@ -407,6 +407,26 @@ def summarize(out: Outcome) -> Outcome:
     return out
 
 
+def work_seconds(setup: Setup, trials: int, workers: int = 1) -> float:
+    """The estimated wall time of ``trials`` trials of ``setup`` on ``workers`` processes, s:
+    the measured cost of a trial (``inputs.options.DECIDE_S_PER_TRIAL``, by tau0 mode, for a
+    trial that is decided: the dearest) times the share of records beyond the measured ones."""
+    from ..inputs.options import DECIDE_RECORDS, DECIDE_S_PER_TRIAL
+
+    records = setup.edges().size - 1
+    each = DECIDE_S_PER_TRIAL[setup.tau0_mode] * max(1.0, records / DECIDE_RECORDS)
+    return trials * each / max(1, int(workers))
+
+
+def check_work(setup: Setup, trials: int, workers: int) -> float:
+    """Refuse, before any trial, a Monte Carlo estimated above the cap on one command's work
+    (``SPINVIZ_MAX_DAYS``; ``SpecError`` naming ``trials``); returns the estimate, s."""
+    from ..inputs.options import check_units
+
+    return check_units("trials", trials, work_seconds(setup, 1), f"{trials} trials (tau0 {setup.tau0_mode}, "
+                                                                  f"{setup.edges().size - 1} records a trial)", workers)
+
+
 def run(setup: Setup, trials: int, seed: int = 1, mapper=None, batch: int = 8) -> Outcome:
     """``trials`` trials in batches of ``batch``, by ``mapper(fn, list_of_batches)`` (default:
     in this process), summarized."""

@@ -220,7 +220,7 @@ def wav_bytes(samples: np.ndarray, rate: int, title: str, mapping: Mapping) -> b
 def read_info(path) -> dict:
     """The LIST/INFO items of a WAV (INAM, ICMT, ...) and, from ICMT, the mapping as a dict
     under "mapping"."""
-    from ..atomic import read_regular
+    from ..atomic import loads_json, read_regular
 
     raw = read_regular(path)                  # a FIFO or device is refused at once, never waited on
     if raw[:4] != b"RIFF" or raw[8:12] != b"WAVE":
@@ -237,7 +237,7 @@ def read_info(path) -> dict:
         pos += 8 + size + (size % 2)
     for line in out.get("ICMT", "").splitlines():
         if line.startswith("spinviz-mapping: "):
-            out["mapping"] = json.loads(line[len("spinviz-mapping: "):])
+            out["mapping"] = loads_json(line[len("spinviz-mapping: "):])
     return out
 
 

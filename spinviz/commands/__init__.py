@@ -24,7 +24,7 @@ import sys
 import warnings
 
 from .. import interrupt
-from ..errors import RenderError, SceneError, SimulationError, SpecError, SpinvizError, UsageError
+from ..errors import RenderError, SceneError, SimulationError, SpecError, SpinvizError, UsageError, printable
 from .shared import EXIT_FAIL, EXIT_USAGE, Parser, Stream, WriteFailed, named, options_of, say
 
 COMMANDS = ("check", "info", "simulate", "render", "compare", "observe", "decide", "listen", "bench", "stress",
@@ -112,8 +112,11 @@ def _subparser(top: argparse.ArgumentParser, args) -> argparse.ArgumentParser:
 def _run(args) -> int:
     """The command's exit status; a stop signal at any point of it -- its error reports
     included -- ends it with 128 + the signal and the command's own line (``stopped``)."""
+    from ..atomic import forget_written
+
     mod = command(args.command)
     code = None
+    forget_written()
     try:
         code = _dispatch(mod, args)
         interrupt.hold()                               # the work is over: a signal now is only recorded
@@ -125,12 +128,24 @@ def _run(args) -> int:
             say("interrupted by ", f"{e} as the command ended; it had finished (exit status {code})")
         else:
             line = getattr(mod, "stopped", None)
-            say("", line(args, e) if line is not None else f"interrupted by {e}; nothing was written")
+            say("", line(args, e) if line is not None else _stopped(e))
         return e.exit_status
     except KeyboardInterrupt:                          # a library's own Ctrl-C handling
         interrupt.hold()
         say("interrupted", "; nothing was written")
         return 130
+
+
+def _stopped(e) -> str:
+    """The line of a command stopped by a signal: what it had written before (outputs land
+    whole or not at all, ``atomic``), or that it wrote nothing."""
+    from ..atomic import written
+
+    done = written()
+    if not done:
+        return f"interrupted by {e}; nothing was written"
+    names = ", ".join(printable(x, 200) for x in done)
+    return f"interrupted by {e} after writing {names}; nothing else was written"
 
 
 def _dispatch(mod, args) -> int:

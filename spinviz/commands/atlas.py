@@ -20,7 +20,7 @@ import sys
 
 from ..errors import UsageError, printable
 from ..interrupt import check
-from .shared import Parser, positive, real, reals
+from .shared import Parser, positive, progress, real, reals
 
 JOBS = ("run", "verify", "bench", "evidence", "boxes")
 # what each evidence option is, for the sub-command of a kind that takes it
@@ -37,7 +37,7 @@ def shorthand(argv: list[str]) -> list[str]:
     if argv and argv[0] not in JOBS and not argv[0].startswith("-"):
         return ["run", *argv]
     if argv and argv[0] in ("--verify", "--evidence", "--bench"):
-        raise UsageError(f"{argv[0]}: a job of its own: spinviz atlas {argv[0][2:]} ... (see 'spinviz atlas --help')")
+        raise UsageError(f"{argv[0]}: a job of its own: spinviz atlas {argv[0][2:]} ...")
     return argv
 
 
@@ -208,7 +208,7 @@ def _bench(spec, args) -> int:
         if not os.path.isfile(args.peer):
             raise UsageError(f"--peer: {printable(args.peer, 200)}: no such file")
         rows = bench.against_peer(spec, args.peer, progress=None if args.quiet else
-                                  lambda m: print(f"  {m}", file=sys.stderr, flush=True))
+                                  progress)
         print(bench.format_peer(rows) if not args.json else json.dumps(rows, indent=2, default=float))
         return 0
     if args.write_path:

@@ -172,8 +172,9 @@ def out(text: str) -> None:
 
 
 def progress(msg: str) -> None:
-    """One progress line on stderr, indented."""
-    sys.stderr.write(f"  {msg}\n")
+    """One progress line on stderr, indented, escaped as every echoed text is (a name in it
+    cannot split the line or colour the terminal)."""
+    sys.stderr.write(f"  {printable(msg, 2000)}\n")
     sys.stderr.flush()
 
 

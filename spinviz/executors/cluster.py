@@ -18,6 +18,12 @@ callback or a garbage-collection hook could swallow it -- is acted on within ~50
 Dask is doing.  The LocalCluster's processes (its workers and multiprocessing's resource
 tracker) are started with SIGINT, SIGTERM and SIGHUP blocked: a terminal's signal to the
 whole process group reaches only the client, which stops them.
+
+Start-up under load.  A LocalCluster's worker is a spawned interpreter that imports Dask and
+the integrators: seconds on an idle machine, many times that on a loaded one.  The client
+waits ``start_timeout()`` -- ``START_TIMEOUT_S`` stretched by the load average per core -- for
+each next worker, and gives up in one line (``ClusterSlow``, exit status 75) only when none
+has joined for that long; the processes being started are killed, none is left.
 """
 
 from __future__ import annotations
@@ -32,18 +38,26 @@ import time
 
 from distributed.diagnostics.plugin import WorkerPlugin
 
-from ..errors import OptionError, printable
-from ..interrupt import SIGNALS, check
-from .processes import usable_cores
+from ..errors import OptionError, SpinvizError, printable
+from ..interrupt import check
+from .processes import deaf_children, usable_cores
 
 __all__ = ["Cluster", "WorkerSetup", "GaveUp", "polled", "check_workers", "worker_info", "mapper"]
 
 CONNECT_TIMEOUT_S = 10.0
-START_TIMEOUT_S = 120.0          # LocalCluster workers (spawned Python, imports, the Taylor integrators loaded)
+START_TIMEOUT_S = 120.0          # LocalCluster workers (spawned Python, imports, the Taylor integrators loaded), idle machine
+MAX_START_S = 3600.0             # however loaded the machine, no longer than this without a new worker
 NO_WORKER_S = 60.0               # an existing cluster without any worker this long: the atlas gives up
 POLL_S = 0.05                    # how often the client looks at a stop signal while it waits
 HEALTH_S = 0.5                   # how often the monitor asks the scheduler how many workers it has
 STALL_S = 10.0                   # nothing arrived this long: ask the scheduler whether a task erred unreported
+
+
+def _load() -> str:
+    try:
+        return f"{os.getloadavg()[0]:.1f}"
+    except (AttributeError, OSError):
+        return "unknown"
 
 
 def worker_info() -> dict:
@@ -81,6 +95,25 @@ class GaveUp(Exception):
     """``polled``'s ``give_up`` said the call can no longer succeed."""
 
 
+class ClusterSlow(SpinvizError):
+    """The embedded cluster's workers did not start in time (a machine loaded far beyond its
+    cores); nothing was computed, no process is left, and the same command works later: exit
+    status 75, as a lost cluster."""
+
+    exit_status = 75
+
+
+def start_timeout() -> float:
+    """How long the embedded cluster waits for a worker: ``START_TIMEOUT_S`` on an idle machine,
+    stretched in proportion to the load average per usable core (a worker's start-up is CPU
+    work that a loaded machine shares out), at most ``MAX_START_S``."""
+    try:
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):
+        load = 0.0
+    return min(MAX_START_S, START_TIMEOUT_S * max(1.0, load / usable_cores()))
+
+
 def polled(fn, *args, give_up=None, **kwargs):
     """``fn(*args, **kwargs)`` in a helper thread while this one waits in ``POLL_S`` slices,
     looking at ``interrupt.check()``: a blocking Dask call (connect, gather, an RPC) never
@@ -114,20 +147,10 @@ def _children_deaf_to_terminal():
     blocked; this thread's mask is restored after (a signal meanwhile stays pending, then
     arrives).  multiprocessing's resource tracker is started here first: started later, from
     Dask's thread, it would unblock SIGINT and SIGTERM in that thread (its own start-up
-    does), and it would die of a SIGHUP to the group and be relaunched with tracebacks."""
-    if not hasattr(signal, "pthread_sigmask"):
+    does), and it would die of a SIGHUP to the group and be relaunched with tracebacks
+    (``processes.deaf_children``)."""
+    with deaf_children(tracker=True):
         yield
-        return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
-    try:
-        with contextlib.suppress(Exception):
-            from multiprocessing import resource_tracker
-
-            resource_tracker.ensure_running()
-        signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)       # ensure_running unblocked SIGINT, SIGTERM
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 @contextlib.contextmanager
@@ -220,11 +243,18 @@ class Cluster:
             self.cluster = LocalCluster(**opts)
         self.client = Client(self.cluster)
         self.cluster.scale(n)
-        t0 = time.monotonic()
-        while len(self.cluster.scheduler.workers) < n:
+        # the wait follows the load, and starts again with each worker that joins: a slow start is
+        # waited for as long as it makes progress
+        last, joined, limit = time.monotonic(), 0, start_timeout()
+        while (now := len(self.cluster.scheduler.workers)) < n:
             check()
-            if time.monotonic() - t0 > START_TIMEOUT_S:
-                raise RuntimeError(f"the embedded cluster's {n} workers did not start within {START_TIMEOUT_S:g} s")
+            if now > joined:
+                last, joined, limit = time.monotonic(), now, start_timeout()
+            elif time.monotonic() - last > limit:
+                raise ClusterSlow(f"the embedded cluster's workers did not start: {joined} of {n} up, none more "
+                                  f"for {time.monotonic() - last:.0f} s (the wait at load average {_load()} on "
+                                  f"{usable_cores()} cores); nothing was computed: run it again when the machine is "
+                                  f"less loaded, or with fewer workers")
             time.sleep(POLL_S)
         polled(self.client.register_plugin, WorkerSetup(self.warm, quiet_terminal=self.processes))
 

@@ -28,7 +28,7 @@ from pydantic_core import PydanticCustomError
 
 from ..errors import SpecError, brief
 from ..physics import models as M
-from .base import Flag, Int, Path, Positive, Real, Text, between, check_vector, refused, registered, request, wrong_type
+from .base import Flag, Int, Path, Positive, Real, Text, between, check_vector, refused, registered, request, shown, wrong_type
 from .toml import Table
 
 MAX_RUNS = 100_000_000
@@ -105,7 +105,7 @@ class AxisRange:
     @model_validator(mode="after")
     def _order(self):
         if not self.min < self.max:
-            raise SpecError("max", f"must exceed min ({self.min:g}), got {self.max:g}")
+            raise SpecError("max", f"must exceed min ({shown(self.min, self.max)}), got {shown(self.max, self.min)}")
         return self
 
 
@@ -141,7 +141,8 @@ def _start_list(v):
             raise ValueError(f"each start must be finite, got {brief(row)}") from None
         n = math.hypot(*r)
         if not OMEGA_RANGE[0] <= n <= OMEGA_RANGE[1]:
-            raise ValueError(f"|omega(0)| must lie in [{OMEGA_RANGE[0]:g}, {OMEGA_RANGE[1]:g}], got {n:g} for {brief(row)}")
+            raise ValueError(f"|omega(0)| must lie in [{OMEGA_RANGE[0]:g}, {OMEGA_RANGE[1]:g}], got "
+                             f"{shown(n, *OMEGA_RANGE)} for {brief(row)}")
         rows.append(r)
     return tuple(rows)
 
@@ -189,7 +190,7 @@ class RunTable:
     def _together(self):
         cap = TAU_END_MAX[self.engine]
         if self.tau_end > cap:
-            raise SpecError("tau_end", f"must be at most {cap:g} with engine = {self.engine!r}, got {self.tau_end:g}"
+            raise SpecError("tau_end", f"must be at most {cap:g} with engine = {self.engine!r}, got {shown(self.tau_end, cap)}"
                             + ("; engine = \"handover\" reaches 1e20" if self.engine == "taylor" else ""))
         return self
 

@@ -58,11 +58,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..atomic import check_parent_writable, special_kind
+from ..atomic import check_parent_writable, loads_json, special_kind
 from ..errors import SceneError, SpecTypeError, UsageError
 from ..physics.bodies import MIN_INERTIA_RATIO
 from . import atlas as IA
-from .base import fields_of
+from .base import fields_of, shown
 from .toml import document, read_document, table
 
 FORMAT = 2                       # the store's version (identity): 2 = Taylor's method (heyoka), no atol
@@ -206,7 +206,7 @@ def spec_from_record(attrs: dict, where: str) -> AtlasSpec:
     import dataclasses
 
     try:
-        canonical = json.loads(attrs["spec"])
+        canonical = loads_json(attrs["spec"])
         if not isinstance(canonical, dict):
             raise ValueError
     except (KeyError, TypeError, ValueError):
@@ -224,7 +224,7 @@ def spec_from_record(attrs: dict, where: str) -> AtlasSpec:
     axes = None
     if "grid_axes" in attrs:
         try:
-            raw = json.loads(attrs["grid_axes"])
+            raw = loads_json(attrs["grid_axes"])
             axes = {k: (float(raw[k][0]), float(raw[k][1]), int(raw[k][2])) for k in ("delta", "chi")}
         except (KeyError, TypeError, ValueError, IndexError):
             raise SceneError(where, "grid_axes", "not {delta: [min, max, cells], chi: [...]}") from None
@@ -315,7 +315,7 @@ def _axis(path, k: str, v, bounds: tuple, open_ends: bool, unit: str) -> np.ndar
     if isinstance(v, IA.AxisRange):
         if v.min < lo or v.max > hi:
             raise SceneError(path, f"[grid.{k}].{'min' if v.min < lo else 'max'}",
-                             f"the range must lie within {ends}{unit}, got [{v.min:g}, {v.max:g}]")
+                             f"the range must lie within {ends}{unit}, got [{shown(v.min, lo)}, {shown(v.max, hi)}]")
         return _centres(v)
     for x in v:
         if not (lo < x < hi if open_ends else lo <= x <= hi):

@@ -38,7 +38,7 @@ from pydantic_core import PydanticCustomError
 from ..errors import SpecError, SpecTypeError, brief
 
 __all__ = ["request", "Real", "Positive", "NonNegative", "Int", "Text", "Line", "vector", "Direction", "check_vector",
-           "between",
+           "between", "shown", "shown_bound",
            "at_most", "refused", "registered", "wrong_type", "one_line", "fields_of", "terms", "SpecError", "SpecTypeError"]
 
 CONFIG = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False, arbitrary_types_allowed=True)
@@ -115,14 +115,15 @@ Line = Annotated[str, PlainValidator(one_line)]
 def between(lo: float, hi: float, why: str = "", lo_open: bool = False):
     """A validator: ``lo <= v <= hi`` (``lo < v`` with ``lo_open``), the whole range and the
     reason in the message, e.g. "must lie in [0.1, 1e+09] (from an atom to a metre), got -315"."""
-    ends = f"{'(' if lo_open else '['}{lo:g}, {hi:g}]"
+    ends = f"{'(' if lo_open else '['}{_g(lo)}, {_g(hi)}]"
     because = f" ({why})" if why else ""
 
     def check(v):
         if v is not None and not ((lo < v if lo_open else lo <= v) and v <= hi):
-            raise ValueError(f"must lie in {ends}{because}, got {v:g}")
+            raise ValueError(f"must lie in {ends}{because}, got {shown(v, lo, hi)}")
         return v
 
+    check.bounds = (lo, hi)            # the range, for whoever draws values from the schema (the fuzz tests)
     return AfterValidator(check)
 
 
@@ -131,7 +132,7 @@ def at_most(hi, why: str):
 
     def check(v):
         if v is not None and v > hi:
-            raise ValueError(f"must be at most {_g(hi)} ({why}), got {_g(v)}")
+            raise ValueError(f"must be at most {_g(hi)} ({why}), got {shown(v, hi)}")
         return v
 
     return AfterValidator(check)
@@ -283,16 +284,47 @@ def spec_error(e: ValidationError, cls=None) -> SpecError:
         return type(inner)(f"{key}.{inner.key}" if key and inner.key else (inner.key or key), inner.reason)
     lo, lo_open, hi, hi_open = _bounds(cls, key)
     if kind in ("greater_than", "greater_than_equal", "less_than", "less_than_equal") and lo is not None and hi is not None:
-        reason = f"must lie in {'(' if lo_open else '['}{_g(lo)}, {_g(hi)}{')' if hi_open else ']'}, got {_g(value)}"
+        reason = (f"must lie in {'(' if lo_open else '['}{_g(lo)}, {_g(hi)}{')' if hi_open else ']'}, "
+                  f"got {shown(value, lo, hi)}")
     else:
         reason = _reason(kind, ctx, value, err.get("msg", ""))
     return (SpecTypeError if kind in _TYPE_ERRORS else SpecError)(key, reason)
 
 
 def _g(x) -> str:
+    """A bound for a message: whole numbers exactly (to 21 digits), floats in the short form
+    when it is exact, else with every digit."""
+    x = _plain_number(x)
     if isinstance(x, int) and not isinstance(x, bool):
-        return str(x) if abs(x) < 10**16 else f"{x:.3g}"
-    return f"{x:g}" if isinstance(x, float) else brief(x)
+        return str(x) if abs(x) < 10**21 else f"{x:.3g}"
+    if isinstance(x, float):
+        return f"{x:g}" if not math.isfinite(x) or float(f"{x:g}") == x else repr(x)
+    return brief(x)
+
+
+shown_bound = _g
+
+
+def shown(x, *bounds) -> str:
+    """A value for a message, with the digits that tell it from each of ``bounds``: whole
+    numbers exactly (to 21 digits), floats in the short form (6 significant digits) unless
+    that would print a value outside a bound as the bound itself or put it on the bound's
+    other side ("must lie in (0, 1e+20], got 1.0000001e+20", not "got 1e+20"): then with as
+    many digits as that takes, at most all 17."""
+    x = _plain_number(x)
+    if isinstance(x, bool) or not isinstance(x, int | float):
+        return brief(x)
+    if isinstance(x, int):
+        return str(x) if abs(x) < 10**21 else f"{x:.6g}"
+    if not math.isfinite(x):
+        return f"{x:g}"
+    marks = [float(_plain_number(b)) for b in bounds if isinstance(_plain_number(b), int | float)]
+    for digits in range(6, 18):
+        s = f"{x:.{digits}g}"
+        y = float(s)
+        if all((y < b) == (x < b) and (y > b) == (x > b) for b in marks):
+            return s
+    return repr(x)
 
 
 def _reason(kind: str, ctx: dict, value, msg: str) -> str:
@@ -310,14 +342,15 @@ def _reason(kind: str, ctx: dict, value, msg: str) -> str:
         valid = ctx.get("expected", "").replace("'", "").replace(" or ", ", ")
         return f"unknown value {brief(value)}; valid: {valid}"
     if kind == "greater_than":
-        return f"must be positive, got {_g(value)}" if ctx["gt"] == 0 else f"must be above {_g(ctx['gt'])}, got {_g(value)}"
+        got = shown(value, ctx["gt"])
+        return f"must be positive, got {got}" if ctx["gt"] == 0 else f"must be above {_g(ctx['gt'])}, got {got}"
     if kind == "greater_than_equal":
-        return (f"must not be negative, got {_g(value)}" if ctx["ge"] == 0
-                else f"must be at least {_g(ctx['ge'])}, got {_g(value)}")
+        got = shown(value, ctx["ge"])
+        return f"must not be negative, got {got}" if ctx["ge"] == 0 else f"must be at least {_g(ctx['ge'])}, got {got}"
     if kind == "less_than":
-        return f"must be below {_g(ctx['lt'])}, got {_g(value)}"
+        return f"must be below {_g(ctx['lt'])}, got {shown(value, ctx['lt'])}"
     if kind == "less_than_equal":
-        return f"must be at most {_g(ctx['le'])}, got {_g(value)}"
+        return f"must be at most {_g(ctx['le'])}, got {shown(value, ctx['le'])}"
     if kind == "finite_number":
         return f"must be finite, got {_g(value)}"
     if kind == "int_type":

@@ -9,7 +9,7 @@ from pydantic import Field, model_validator
 
 from ..errors import SpecError
 from .atlas import check_cluster
-from .base import Int, Text, between, request, vector
+from .base import Int, Text, between, request, shown, vector
 
 MAX_TRIALS = 100_000
 
@@ -35,6 +35,6 @@ class DecideArguments:
         lo, hi = self.spin_range
         if not (1e-3 <= lo <= hi <= 1e3):
             raise SpecError("spin_range", f"must be LO,HI with 1e-3 <= LO <= HI <= 1e3 (factors of the scene's "
-                                          f"|Omega0|), got {lo:g},{hi:g}")
+                                          f"|Omega0|), got {shown(lo, 1e-3, hi)},{shown(hi, lo, 1e3)}")
         check_cluster(self.workers, self.scheduler)
         return self

@@ -10,14 +10,15 @@ starting with ``#`` are skipped::
     ...
 
 JSON (``.json``): an object of equally long arrays under the same names, and optionally a
-``"power_unit"`` string::
+``"power_unit"`` string (nested at most ``atomic.MAX_JSON_DEPTH`` levels)::
 
     {"f_hz": [...], "power": [...], "sigma_f_hz": [...], "sigma_power": [...], "power_unit": "W"}
 
 Every row is checked by ``MeasurementRow`` (f_hz and power positive, sigma_power positive,
 sigma_f_hz not negative, all finite); a problem is one line naming the file, the row (and its
 line in a CSV) and the column.  At least ``MIN_ROWS`` rows: the general law has three
-parameters.
+parameters.  The file is read as every input is: a regular file only (a FIFO is refused at
+once, never waited on), at most ``MAX_FILE_BYTES``, UTF-8 (a byte order mark is skipped).
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ import csv
 import json
 import os
 
-from ..errors import SceneError, SpecError, brief
+from ..atomic import JsonTooDeep, NotRegularFile, loads_json, read_regular
+from ..errors import SceneError, SpecError, SpecTypeError, brief
 from .base import Line, NonNegative, Positive, Real, request
 from .toml import MAX_FILE_BYTES
 
@@ -62,12 +64,21 @@ def _number(text: str, path: str, where: str, col: str):
         raise SceneError(path, f"{where}, {col}", f"expected a number, got {brief(text)}") from None
 
 
+def _cells(line: str, path: str, where: str) -> list[str]:
+    """One CSV line's fields; the parser's own refusals (a field beyond its size limit, a NUL)
+    said as the file's, at ``where``."""
+    try:
+        return next(csv.reader([line]))
+    except csv.Error as e:
+        raise SceneError(path, where, f"not a CSV line ({e})") from None
+
+
 def _rows_from_csv(text: str, path: str) -> list[tuple[str, dict]]:
     lines = [(i + 1, s) for i, s in enumerate(text.splitlines()) if s.strip() and not s.lstrip().startswith("#")]
     if not lines:
         raise SceneError(path, "(file)", f"no header: the first line names the columns {', '.join(COLUMNS)}")
     header_line, header = lines[0]
-    names = [c.strip() for c in next(csv.reader([header]))]
+    names = [c.strip() for c in _cells(header, path, f"line {header_line}")]
     for c in names:
         if c not in COLUMNS + OPTIONAL:
             raise SceneError(path, f"line {header_line}", f"unknown column {brief(c)}; valid: {', '.join(COLUMNS + OPTIONAL)}")
@@ -76,8 +87,8 @@ def _rows_from_csv(text: str, path: str) -> list[tuple[str, dict]]:
             raise SceneError(path, f"line {header_line}", f"missing column {c!r}")
     rows = []
     for n, (lineno, s) in enumerate(lines[1:], start=1):
-        cells = [c.strip() for c in next(csv.reader([s]))]
         where = f"row {n} (line {lineno})"
+        cells = [c.strip() for c in _cells(s, path, where)]
         if len(cells) != len(names):
             raise SceneError(path, where, f"{len(cells)} values for {len(names)} columns")
         rows.append((where, {c: _number(v, path, where, c) for c, v in zip(names, cells)}))
@@ -86,7 +97,9 @@ def _rows_from_csv(text: str, path: str) -> list[tuple[str, dict]]:
 
 def _rows_from_json(text: str, path: str) -> tuple[list[tuple[str, dict]], dict]:
     try:
-        data = json.loads(text)
+        data = loads_json(text)
+    except JsonTooDeep as e:
+        raise SceneError(path, "(file)", str(e)) from None
     except json.JSONDecodeError as e:
         raise SceneError(path, "(file)", f"invalid JSON: {e}") from None
     if not isinstance(data, dict):
@@ -115,13 +128,17 @@ def read_measurements(path) -> tuple[dict, str]:
     """The measurements in the CSV or JSON file at ``path`` as arrays ({column: list of floats},
     ``t_s`` only when given) and the unit of the powers; ``SceneError(path, where, reason)`` on
     the first problem."""
-    path = os.fspath(path)
+    if not isinstance(path, str | bytes | os.PathLike):
+        raise SpecTypeError("measurements", f"must be the path of a CSV or JSON file (str or os.PathLike), got "
+                                            f"{type(path).__name__} {brief(path)}")
+    path = os.fsdecode(path)
     kind = os.path.splitext(path)[1].lower()
     if kind not in (".csv", ".json"):
         raise SceneError(path, "(file)", "a measurements file ends in .csv or .json")
     try:
-        with open(path, "rb") as fh:
-            raw = fh.read(MAX_FILE_BYTES + 1)
+        raw = read_regular(path, MAX_FILE_BYTES)          # a FIFO or a device is refused at once, never waited on
+    except NotRegularFile as e:
+        raise SceneError(path, "(file)", f"{e.strerror}; measurements are a CSV or JSON file") from None
     except FileNotFoundError:
         raise SceneError(path, "(file)", "no such file") from None
     except (OSError, ValueError) as e:
@@ -129,7 +146,7 @@ def read_measurements(path) -> tuple[dict, str]:
     if len(raw) > MAX_FILE_BYTES:
         raise SceneError(path, "(file)", f"larger than {MAX_FILE_BYTES} bytes")
     try:
-        text = raw.decode("utf-8")
+        text = raw.decode("utf-8-sig")                    # a spreadsheet's byte order mark is not a column's name
     except UnicodeDecodeError:
         raise SceneError(path, "(file)", "not a text (UTF-8) file") from None
     if kind == ".csv":

@@ -12,6 +12,12 @@ above ``max_days()`` -- 30 days unless the environment variable ``SPINVIZ_MAX_DA
 otherwise, which is how someone who means it (on a machine or cluster that can take it)
 raises the cap; the message says so.  The atlas's own feasibility check
 (``regimes.engine.cost.check_feasible``) reads the same cap.
+
+A new long command joins in with one call, before any work: ``check_units(key, units,
+seconds_each, what, workers)`` for work made of alike pieces (trials, runs, starts), each
+measured on one core of this machine (the constant beside the others here, with where it was
+measured), or ``check_work(key, seconds, what)`` for any other estimate; ``key`` is the
+argument that sets the amount, so the refusal names it (``--trials: ...``).
 """
 
 from __future__ import annotations
@@ -23,7 +29,7 @@ from typing import Annotated, Any, Literal
 from pydantic import Field, PlainValidator, model_validator
 
 from ..errors import SpecError, brief
-from .base import Flag, Int, Path, Real, Text, between, request, wrong_type
+from .base import Flag, Int, Path, Real, Text, between, request, shown, wrong_type
 
 MAX_DAYS_ENV = "SPINVIZ_MAX_DAYS"
 MAX_DAYS = 30.0                  # default cap on the estimated work of one command, days
@@ -52,11 +58,23 @@ def check_work(key: str, seconds: float, what: str) -> None:
                              f"{MAX_DAYS_ENV}=DAYS")
 
 
+def check_units(key: str, units: float, seconds_each: float, what: str, workers: int = 1) -> float:
+    """``check_work`` for ``units`` alike pieces of work, each measured at ``seconds_each`` on
+    one core, shared by ``workers`` processes; returns the estimate, s."""
+    workers = max(1, int(workers))
+    seconds = float(units) * float(seconds_each) / workers
+    check_work(key, seconds, f"{what} (~{seconds_each:.2g} s each on one core, {workers} worker"
+                             f"{'s' if workers != 1 else ''})")
+    return seconds
+
+
 def _duration(seconds: float) -> str:
     if not math.isfinite(seconds):
         return "forever"
     days = seconds / 86400.0
-    return f"{days / 365.25:.3g} years" if days > 730 else f"{days:.3g} days" if days >= 1 else f"{seconds / 3600:.3g} h"
+    if days >= 1:
+        return f"{days / 365.25:.3g} years" if days > 730 else f"{days:.3g} days"
+    return f"{seconds / 3600:.3g} h" if seconds >= 3600 else f"{seconds / 60:.3g} min" if seconds >= 60 else f"{seconds:.3g} s"
 
 
 def _count(limit: int, why: str):
@@ -204,11 +222,23 @@ class EvidenceRequest:
                 raise SpecError("workers", f"must be at most {cores}, the cores this process may use, got {self.workers}")
         why = f"the classifier's windows and 100 braking times below, {self.tau_why} above"
         if self.tau_end is not None and not TAU_MIN <= self.tau_end <= self.tau_max:
-            raise SpecError("tau_end", f"must lie in [{TAU_MIN:g}, {self.tau_max:g}] ({why}), got {self.tau_end!r}")
+            raise SpecError("tau_end", f"must lie in [{TAU_MIN:g}, {self.tau_max:g}] ({why}), got "
+                                       f"{shown(self.tau_end, TAU_MIN, self.tau_max)}")
         for x in self.horizons or ():
             if not TAU_MIN <= x <= self.tau_max:
-                raise SpecError("horizons", f"each must lie in [{TAU_MIN:g}, {self.tau_max:g}] ({why}), got {x!r}")
+                raise SpecError("horizons", f"each must lie in [{TAU_MIN:g}, {self.tau_max:g}] ({why}), got "
+                                            f"{shown(x, TAU_MIN, self.tau_max)}")
         return self
+
+
+# --- decide ------------------------------------------------------------------------------------
+# One trial (a start, both models as the truth, the decision time of each by bisection over the
+# records), CPU time on one core of this 2-core machine, 2026 (load ~4-7): 0.40-0.46 s with tau0
+# known, 1.14-1.36 s fitted, at 47-89 records (the default receiver over 0.01-30 x the cube's
+# horizon), where every trial is decided; undecided trials cost a tenth of that.  The fits grow
+# with the records a trial holds, so the estimate scales by records / DECIDE_RECORDS beyond them.
+DECIDE_S_PER_TRIAL = {"known": 0.5, "fitted": 1.4}
+DECIDE_RECORDS = 71
 
 
 # --- listen ------------------------------------------------------------------------------------
@@ -216,10 +246,12 @@ SOUND_SECONDS = (0.5, 600.0, "seconds of sound")
 LISTEN_SAMPLES = 100_000         # instants of each model's run (the detector's memory per instant)
 
 
-def _extension(ext: str, what: str):
-    """A path (str or os.PathLike) ending in ``ext``, kept as str."""
+def _extension(ext: str, what: str, required: bool = False):
+    """A path (str or os.PathLike) ending in ``ext``, kept as str (None allowed unless ``required``)."""
 
     def check(v):
+        if v is None and required:
+            raise wrong_type(f"must be a path ending in {ext}, got None")
         if v is None:
             return None
         if not isinstance(v, str | os.PathLike):
@@ -238,7 +270,7 @@ class ListenRequest:
     spectrogram ``png``, default beside it), how long, at which pitch, how sound time and pitch
     follow the run's, how much dynamic range, from how many instants."""
 
-    out: _extension(".wav", "the sound is written as WAV")
+    out: _extension(".wav", "the sound is written as WAV", required=True)
     png: _extension(".png", "the spectrogram is a PNG") = None
 
     duration: Annotated[Real, between(*SOUND_SECONDS)] = 20.0

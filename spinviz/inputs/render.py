@@ -24,7 +24,7 @@ from pydantic import AfterValidator, Field, PlainValidator, model_validator
 
 from ..errors import SpecError, brief
 from ..executors.processes import usable_cores
-from .base import Flag, Int, Line, NonNegative, Path, Positive, Real, one_line, request, wrong_type
+from .base import Flag, Int, Line, NonNegative, Path, Positive, Real, one_line, request, shown, wrong_type
 
 SHOW_ITEMS = ("body", "dipole", "omega", "L", "axes", "trail", "sphere", "hud", "hodograph", "inset", "power")
 DEFAULT_SHOW = ("body", "dipole", "axes", "trail", "sphere", "hud")
@@ -132,8 +132,9 @@ class RenderSpec:
             raise SpecError("duration", f"{self.duration:g} s at {self.fps} fps is {self.frames} frames; "
                                         f"at most {MAX_FRAMES} are allowed")
         if self.spin_turns_per_second > self.fps / 4.0:
-            raise SpecError("spin_turns_per_second", f"must be at most fps / 4 = {self.fps / 4.0:g} (a quarter turn per "
-                                                     f"frame; faster spins alias), got {self.spin_turns_per_second:g}")
+            cap = self.fps / 4.0
+            raise SpecError("spin_turns_per_second", f"must be at most fps / 4 = {cap:g} (a quarter turn per "
+                                                     f"frame; faster spins alias), got {shown(self.spin_turns_per_second, cap)}")
         return self
 
     def with_(self, **overrides) -> RenderSpec:
@@ -172,7 +173,7 @@ class RenderSpec:
             raise SpecError("log_knee", f"must be below t_end = {t_end:g}")
         if self.log_knee is not None and t_end / self.log_knee > MAX_KNEE_RATIO:
             raise SpecError("log_knee", f"must be at least t_end / {MAX_KNEE_RATIO:g} = {t_end / MAX_KNEE_RATIO:.3g}, "
-                                        f"got {self.log_knee:g}")
+                                        f"got {shown(self.log_knee, t_end / MAX_KNEE_RATIO)}")
 
     def check_output(self, path: str, panels: int = 1) -> None:
         """The output format and the layout: .mp4 or .gif; MP4 (H.264, yuv420p) needs even

@@ -24,7 +24,7 @@ from ..physics import bodies as B
 from ..physics import models as M
 from ..physics import presets as P
 from . import receiver as RX
-from .base import Direction, Line, Positive, Real, Text, between, check_vector, one_line, refused, request, wrong_type
+from .base import Direction, Line, Positive, Real, Text, between, check_vector, one_line, refused, request, shown, wrong_type
 from .render import MAX_TITLE
 from .simulation import Atol, Method, ModelName, Quaternion, Rtol, Samples, Vector3
 from .toml import Table
@@ -181,7 +181,8 @@ class BodyTable:
                 if isinstance(d, tuple):
                     raise SpecError("dipole_debye", f"a rod's dipole is one number (D, at chi from the axis), got {brief(d)}")
                 if not DIPOLE_DEBYE[0] <= d <= DIPOLE_DEBYE[1]:
-                    raise SpecError("dipole_debye", f"must lie in [{DIPOLE_DEBYE[0]:g}, {DIPOLE_DEBYE[1]:g}] (D), got {d:g}")
+                    raise SpecError("dipole_debye", f"must lie in [{DIPOLE_DEBYE[0]:g}, {DIPOLE_DEBYE[1]:g}] (D), "
+                                                    f"got {shown(d, *DIPOLE_DEBYE)}")
                 return B.rod(length * U.NM, diameter, density, d * U.DEBYE, self._chi(0.0), name=name)
             a, b, c = self._need("a_nm", "b_nm", "c_nm")
             (d,) = self._need("dipole_debye")
@@ -190,7 +191,7 @@ class BodyTable:
             size = max(abs(x) for x in d)
             if not DIPOLE_DEBYE[0] <= size <= DIPOLE_DEBYE[1]:
                 raise SpecError("dipole_debye", f"the largest component must lie in [{DIPOLE_DEBYE[0]:g}, "
-                                                f"{DIPOLE_DEBYE[1]:g}] D, got {size:g}")
+                                                f"{DIPOLE_DEBYE[1]:g}] D, got {shown(size, *DIPOLE_DEBYE)}")
             return B.box(a * U.NM, b * U.NM, c * U.NM, density, np.array(d) * U.DEBYE, name=name)
         if form == "delta":
             return B.symmetric_top(self.delta, self._chi(), name=self.name or "symmetric top")

@@ -141,6 +141,8 @@ class Scene:
         from ..physics import longitudinal as LG
         from ..physics import models as M
 
+        if not isinstance(command, str) or command not in NEEDS:
+            raise SpecError("command", f"unknown command {brief(command)}; valid: {', '.join(NEEDS)}")
         needs = NEEDS[command]
         if needs.models is not None and len(self.models) != needs.models:
             example = ", ".join(f'"{m}"' for m in M.with_line_law())

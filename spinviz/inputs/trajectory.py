@@ -12,7 +12,7 @@ import numpy as np
 from pydantic import PlainValidator, model_validator
 
 from ..errors import SpecError, brief
-from .base import Direction, Real, request, wrong_type
+from .base import Direction, Real, request, shown, shown_bound, wrong_type
 
 MAX_TIMES = 1_000_000           # instants one call may ask for (memory: 11 numbers an instant)
 
@@ -49,8 +49,9 @@ class SampleRequest:
         slack = 1e-12 * abs(self.end - self.start)
         outside = self.times[(self.times < self.start - slack) | (self.times > self.end + slack)]
         if outside.size:
-            raise SpecError("times", f"must lie in [{self.start:g}, {self.end:g}] (the run's stored span: sampling "
-                                     f"interpolates, it never integrates), got {outside[0]:g}")
+            span = f"[{shown_bound(self.start)}, {shown_bound(self.end)}]"
+            raise SpecError("times", f"must lie in {span} (the run's stored span: sampling interpolates, it never "
+                                     f"integrates), got {shown(outside[0], self.start, self.end)}")
         return self
 
 

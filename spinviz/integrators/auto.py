@@ -52,10 +52,12 @@ def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", ste
     """Refuse, before any work, a run that cannot finish: more than 1e10 fixed steps, or more
     than ``HARD_MAX_TURNS`` turns (estimated with braking) for a method that resolves every
     turn.  ``secular`` follows the slow variables instead and has no such limit; ``auto`` is
-    judged by the method it picks (``picked``, when the caller has already chosen it), and the
-    hand-over ``taylor -> secular`` by its full stage alone: the turns before tau0 |Omega| has
-    braked to ``secular.EPS_MAX``, as the averaged flow predicts them (``handover.plan``).
-    ``SpecError`` names "step" or "t_end"."""
+    judged by the method it picks (``picked``, when the caller has already chosen it).  The
+    hand-over ``taylor -> secular`` is judged through both stages: its full stage by the turns
+    before tau0 |Omega| has braked to ``secular.EPS_MAX``, as the averaged flow predicts them
+    (``handover.plan``; ``choose_method`` picks it only where they can finish), and its slow
+    flow, like ``secular``'s, by its steps and the range of float64 it stays in
+    (``horizon.check_secular``).  ``SpecError`` names "step" or "t_end"."""
     method = str(method).lower()
     auto = method == "auto"
     if not body.is_symmetric and (auto or method == "polhode"):
@@ -63,6 +65,13 @@ def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", ste
         _check_polhode_horizon(body, model, omega0, t_end, spin, "polhode")
     if auto:
         method = picked or choose_method(body, model, omega0, t_end, kinematics, spin=spin)[0]
+    if method in (HANDOVER, "secular"):
+        # both stages: the full stage is picked only where it can finish, the slow flow's steps and
+        # float64 range are forecast (horizon.check_secular)
+        from .horizon import check_secular
+
+        check_secular(body, model, omega0, t_end, spin, handover=method == HANDOVER)
+        return
     if method in HANDOVERS or method == "polhode":
         # the full stage: choose_method picks a hand-over only where it can finish; the averaged stage:
         # refused at once where its horizon is beyond what it can represent
@@ -71,8 +80,6 @@ def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", ste
     if get(method).fixed_step:
         if step is not None and t_end / step > MAX_FIXED_STEPS:
             raise SpecError("step", f"t_end / step = {t_end / step:.3g} steps; at most {MAX_FIXED_STEPS:g} can finish")
-        return
-    if method in AVERAGED:
         return
     turns = estimated_turns(body, model, omega0, t_end, spin)
     if turns > HARD_MAX_TURNS:

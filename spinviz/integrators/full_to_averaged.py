@@ -179,6 +179,9 @@ def solve_handover(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, s
     else:
         sol = SC.solve_secular(sub, rtol, atol)
     if not sol.success:
+        stats.update(handover_at=s)
+        if "failed_at" in sol.stats:
+            stats["failed_at"] = s + sol.stats["failed_at"] / e
         return Solution(t=t, omega=full.omega, q=full.q_out, success=False, stats=stats, status=sol.status or 1,
                         message=f"after the hand-over at t = {s:.4g} (spin units), {target}: {sol.message}", reached=j)
     full.omega[j:] = sol.omega[1:] * e

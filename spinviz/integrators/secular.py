@@ -185,6 +185,7 @@ def solve_secular(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, st
         setup.equivariant, MAX_STEPS, _phi0(setup), *KN.DP853_ARRAYS)
     stats = _stats(setup, cnt, switches, rtol, t)
     if status != ST.OK:
+        stats["failed_at"] = float(cnt[14])            # where it stopped, not the last output it reached
         if status == ST.TOO_MANY_STEPS and cnt[8] >= REGIME5_SIGN_CHANGES:
             return failed(f"from {cnt[13] / t[-1]:.3g} of the horizon on, the body is in the oscillating "
                           f"regime '5' (omega3 changed sign {int(cnt[8])} times), where averaging fails and the full "

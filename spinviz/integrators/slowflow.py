@@ -321,7 +321,7 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
     fixed L, from phi0; p: the unwrapped body-frame phase of omega_perp (psi = pi/2 - p).
     counters: 0 steps FULL, 1 steps AVG, 2 evaluations FULL, 3 evaluations AVG, 4 rejected
     steps, 5 switches, 6 the largest mu_ad met in AVG, 7 precession turns in FULL, 8 sign
-    changes of w3, 13 the time of the first (9, 14, 15 unused), 10 the integral of mu^2 dt over
+    changes of w3, 13 the time of the first, 14 the time reached (9, 15 unused), 10 the integral of mu^2 dt over
     AVG (mu = eps |w|^2 / |delta w3|), 11 the phase Sigma covered in FULL, 12 the largest
     forced-response error met in AVG."""
     # Long on purpose: one compiled loop whose step, hand-over and dense output share ~20 local arrays and counters.
@@ -374,10 +374,13 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
     err_exp = -1.0 / 8.0
     while t < t_end:
         if nsteps >= max_steps:
+            cnt[14] = t
             return out, cnt, sw[:nsw], cross[:ncross], TOO_MANY_STEPS
         if (nsteps + int(cnt[4])) % STOP_POLL == 0 and stop[0] != 0:
+            cnt[14] = t
             return out, cnt, sw[:nsw], cross[:ncross], INTERRUPTED
         if h < 10.0 * abs(np.nextafter(t, np.inf) - t):
+            cnt[14] = t
             return out, cnt, sw[:nsw], cross[:ncross], STEP_UNDERFLOW
         if t + h > t_end:
             h = t_end - t
@@ -394,6 +397,7 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
         # the phase Sigma (index 3) is held to rtol x its increment
         err, finite = KN.error_norm(K, y, y_new, h, n, rtol, atol, E3, E5, 3)
         if not finite:
+            cnt[14] = t
             return out, cnt, sw[:nsw], cross[:ncross], NOT_FINITE
         if not err <= 1.0:
             h = h * max(0.2, 0.9 * err ** err_exp)
@@ -508,6 +512,7 @@ def integrate_hybrid(model, J, g, w0, t_eval, rtol, atol, mu_star, equiv, max_st
                 rhs(mode, sgn, model, J, g, cM, sM, equiv, y, K[0])
                 h = initial_step(mode, sgn, model, J, g, cM, sM, equiv, y, K[0], rtol, atol, n, t_end - t)
                 nf = 2
+    cnt[14] = t
     return out, cnt, sw[:nsw], cross[:ncross], OK
 
 

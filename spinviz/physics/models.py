@@ -99,8 +99,24 @@ class Model:
     type_labels: Mapping[str, str] | None = field(default=None)
 
     def __post_init__(self):
-        if not self.name or self.name != self.name.lower() or not self.name.isidentifier():
-            raise ValueError(f"a model's name is a lower-case identifier, got {self.name!r}")
+        if not isinstance(self.name, str) or not self.name or self.name != self.name.lower() or not self.name.isidentifier():
+            raise ValueError(f"a model's name is a lower-case identifier, got {_brief(self.name)}")
+        for key in ("equations", "summary"):
+            if not isinstance(getattr(self, key), str):
+                raise TypeError(f"model {self.name!r}: {key} is text, got {_brief(getattr(self, key))}")
+        for key, kind in (("terms", None), ("symmetric_rate", None), ("averaged", Averaged), ("line", LineLaw)):
+            value = getattr(self, key)
+            if value is None and key != "terms":
+                continue
+            if not (callable(value) if kind is None else isinstance(value, kind)):
+                want = "a function (w1, w2, w3, J, g[, free])" if kind is None else f"a {kind.__name__}"
+                raise TypeError(f"model {self.name!r}: {key} must be {want}, got {_brief(value)}")
+        if self.kernel_id is not None and (isinstance(self.kernel_id, bool) or not isinstance(self.kernel_id, int)):
+            raise TypeError(f"model {self.name!r}: kernel_id is a whole number or None, got {_brief(self.kernel_id)}")
+        if not isinstance(self.brakes, bool):
+            raise TypeError(f"model {self.name!r}: brakes is True or False, got {_brief(self.brakes)}")
+        if self.type_labels is not None and not isinstance(self.type_labels, Mapping):
+            raise TypeError(f"model {self.name!r}: type_labels maps each class to a label, got {_brief(self.type_labels)}")
         if self.type_labels is not None:
             missing = set(CLASSES) - set(self.type_labels)
             if missing:
@@ -120,8 +136,17 @@ class Model:
 _REGISTRY: dict[str, Model] = {}
 
 
+def _brief(value) -> str:
+    """A short, printable repr of a value a caller handed in (``errors.brief``)."""
+    from ..errors import brief
+
+    return brief(value)
+
+
 def register(model: Model) -> Model:
     """Add ``model`` to the registry (its name must be new); returns it."""
+    if not isinstance(model, Model):
+        raise TypeError(f"register takes a Model, got {_brief(model)}")
     if model.name in _REGISTRY:
         raise ValueError(f"model {model.name!r} is already registered")
     if model.kernel_id is not None and any(m.kernel_id == model.kernel_id for m in _REGISTRY.values()):
@@ -131,8 +156,10 @@ def register(model: Model) -> Model:
 
 
 def unregister(name: str) -> None:
-    """Remove a model (tests that register a model of their own)."""
-    _REGISTRY.pop(name, None)
+    """Remove a model (tests that register a model of their own); a name not registered is
+    nothing to remove."""
+    if isinstance(name, str):
+        _REGISTRY.pop(name, None)
 
 
 def names() -> tuple[str, ...]:
@@ -147,7 +174,7 @@ def get(name) -> Model:
     try:
         return _REGISTRY[name]
     except (KeyError, TypeError):
-        raise ValueError(f"unknown model {name!r}; valid: {', '.join(_REGISTRY)}") from None
+        raise ValueError(f"unknown model {_brief(name)}; valid: {', '.join(_REGISTRY)}") from None
 
 
 def with_line_law() -> tuple[str, ...]:

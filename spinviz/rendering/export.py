@@ -13,6 +13,7 @@ import time
 from dataclasses import dataclass, field
 
 from ..atomic import Outputs
+from ..errors import printable
 from ..inputs.render import MODEL_FORMATS
 from . import blender, gltf, keyframes, webpage
 
@@ -40,14 +41,14 @@ class ExportResult:
     fps: int = 0
 
     def describe(self) -> str:
-        """One line for the command line."""
+        """One line for the command line, the path escaped (``errors.printable``) as every echoed name is."""
         kind = {"glb": "glTF model (binary)", "gltf": "glTF model", "html": "web page"}[self.format]
         worst = max(self.max_error_deg, self.max_error_componentwise_deg)
-        line = (f"{self.path}: {kind}, {self.bytes / 1e3:.0f} kB, {self.keyframes} keyframes of {self.frames} frames "
-                f"(within {self.tolerance_deg:g} deg of every frame; largest {worst:.3g} deg), "
+        line = (f"{printable(self.path, 300)}: {kind}, {self.bytes / 1e3:.0f} kB, {self.keyframes} keyframes of "
+                f"{self.frames} frames (within {self.tolerance_deg:g} deg of every frame; largest {worst:.3g} deg), "
                 f"written in {self.seconds:.1f} s")
         if self.script:
-            line += (f"; {self.script} opens it in Blender at {self.fps} fps, frames 0-{self.frames - 1}, "
+            line += (f"; {printable(self.script, 300)} opens it in Blender at {self.fps} fps, frames 0-{self.frames - 1}, "
                      f"through its camera")
         return line
 

@@ -76,6 +76,8 @@ def _worker_signals(parent: int) -> None:
         raise SystemExit(128 + signum)
 
     signal.signal(signal.SIGTERM, leave)
+    if hasattr(signal, "pthread_sigmask"):              # born with them blocked (WorkerPool): handled from here on
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, (signal.SIGINT, signal.SIGTERM, signal.SIGHUP))
     if os.getppid() != parent:                          # the parent died before we started
         raise SystemExit(1)
 
@@ -141,22 +143,28 @@ class WorkerPool:
     def __init__(self, workers: int):
         import multiprocessing as mp
 
+        from ..executors.processes import deaf_children
+
         ctx = mp.get_context("spawn")                   # fresh interpreters: no GL state shared by fork
         self.workers = workers
-        self.stop = ctx.Event()
-        self.msgs = ctx.Queue()
-        self.tasks = [ctx.Queue() for _ in range(workers)]
-        self.procs = [ctx.Process(target=_pool_worker, daemon=True,
-                                  args=(k, self.tasks[k], self.msgs, self.stop, os.getpid()))
-                      for k in range(workers)]
         self.used = False
         self._closed = False
-        try:
-            for p in self.procs:
-                p.start()
-        except BaseException:
-            self.close()
-            raise
+        self.procs = []
+        # born with the stop signals blocked (they, and the resource tracker the queues start, never
+        # take the terminal's signals; a worker sets its own handling first thing, _worker_signals)
+        with deaf_children(tracker=True):
+            self.stop = ctx.Event()
+            self.msgs = ctx.Queue()
+            self.tasks = [ctx.Queue() for _ in range(workers)]
+            self.procs = [ctx.Process(target=_pool_worker, daemon=True,
+                                      args=(k, self.tasks[k], self.msgs, self.stop, os.getpid()))
+                          for k in range(workers)]
+            try:
+                for p in self.procs:
+                    p.start()
+            except BaseException:
+                self.close()
+                raise
 
     def close(self):
         """Stop the workers (each finishes its frame and closes its encoder) and release the queues."""

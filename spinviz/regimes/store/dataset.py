@@ -49,6 +49,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...atomic import loads_json
 from ...errors import UsageError
 from ...interrupt import deferred
 from ...physics import asymptotics as FM
@@ -255,8 +256,8 @@ def check_identity(spec, path: str) -> None:
 
 def _same_spec(attrs: dict, spec) -> bool:
     try:
-        return json.loads(attrs.get("spec", "")) == json.loads(spec.canonical_json())
-    except ValueError:
+        return loads_json(attrs.get("spec", "")) == json.loads(spec.canonical_json())
+    except (TypeError, ValueError):
         return False
 
 

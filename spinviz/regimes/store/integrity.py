@@ -35,7 +35,7 @@ import re
 import shutil
 from dataclasses import dataclass, field
 
-from ...atomic import open_regular, write_text
+from ...atomic import loads_json, open_regular, read_regular, write_text
 
 DIR = ".checksums"
 SKELETON = "skeleton.json"
@@ -66,11 +66,17 @@ def _hash_or_why(path: str) -> tuple[str | None, str | None]:
         return None, e.strerror or str(e)
 
 
+MAX_RECORD_BYTES = 64_000_000     # the skeleton's record of a large atlas is ~1 MB; a chunk's, ~1 kB
+
+
 def read_json(path: str):
     """A record of the store, parsed (``open_regular``: a FIFO planted in its place is refused
-    at once, ``NotRegularFile``)."""
-    with open_regular(path, "r") as fh:
-        return json.load(fh)
+    at once, ``NotRegularFile``); a record larger than ``MAX_RECORD_BYTES`` or nested deeper
+    than ``atomic.MAX_JSON_DEPTH`` is refused as damaged (``ValueError``)."""
+    raw = read_regular(path, MAX_RECORD_BYTES)
+    if len(raw) > MAX_RECORD_BYTES:
+        raise ValueError(f"{path}: larger than {MAX_RECORD_BYTES} bytes: not a record of this store")
+    return loads_json(raw.decode("utf-8"))
 
 
 def key_name(key) -> str:

@@ -9,13 +9,14 @@ it never waits, never interleaves.
 
 The lock is ``flock(2)`` on a file beside the store, ``.NAME.lock`` in its parent directory
 (beside, not inside: the store does not exist yet while its creation is under way, and a
-lock inside would be left behind with it).  The kernel releases it when the process ends,
-however it ends -- a ``kill -9`` leaves no stale lock.  The file holds the writer's pid (for
-the message) and is removed by the last holder; a process that locked a file another just
-removed sees the path no longer names its file and starts again (the usual check of
-lock-file protocols).  Where the lock file cannot be made (a read-only place) the shared lock
-is skipped -- no one can write there either -- and the exclusive one is refused by the
-writability check before.
+lock inside would be left behind with it), named after the store's real path: a symbolic
+link to the store, or to a folder above it, names the same store and so the same lock.  The
+kernel releases it when the process ends, however it ends -- a ``kill -9`` leaves no stale
+lock.  The file holds the writer's pid (for the message) and is removed by the last holder;
+a process that locked a file another just removed sees the path no longer names its file and
+starts again (the usual check of lock-file protocols).  Where the lock file cannot be made
+(a read-only place) the shared lock is skipped -- no one can write there either -- and the
+exclusive one is refused by the writability check before.
 """
 
 from __future__ import annotations
@@ -30,8 +31,11 @@ from ..faults import StoreBusy
 
 
 def lock_path(store: str) -> str:
-    """``.NAME.lock`` beside the store ``store``."""
-    parent, name = os.path.split(os.path.abspath(store))
+    """``.NAME.lock`` beside the store ``store``, the path resolved first (``os.path.realpath``:
+    every symbolic link in it, the store's own included, followed -- also to a store not made
+    yet): the lock belongs to the store, not to the spelling of its path, so a link to it or
+    to its folder takes the same lock."""
+    parent, name = os.path.split(os.path.realpath(store))
     return os.path.join(parent, f".{name}.lock")
 
 

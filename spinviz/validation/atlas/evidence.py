@@ -14,6 +14,7 @@ Each prints a table (``--json``: the rows as JSON instead) and its progress on s
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import math
@@ -203,9 +204,15 @@ def run(kind: str, members: int | None = None, *, workers: int | None = None, ta
     given = {"members": members, "tau_end": tau_end, "horizons": horizons}
     key = next((o for o in ("members", "tau_end", "horizons") if given[o] is not None), "members")
     check_work(key, k.cost(req), f"evidence {k.name} with {req.members} member(s) per point")
-    if req.out is not None:
-        _check_store(req.out)
-    rows, table, status = _compute(k, req)
+    with contextlib.ExitStack() as held:
+        if req.out is not None:
+            from ...regimes.store.lock import StoreLock
+
+            _check_store(req.out)
+            # the store's lock before the study, not after it: refused at once when another
+            # command writes the store, and no one writes it while the rows are computed
+            held.enter_context(StoreLock(req.out, exclusive=True, what=f"evidence {k.name} --out"))
+        rows, table, status = _compute(k, req)
     print(json.dumps(rows, indent=2, default=float) if as_json else table)
     return status
 
@@ -220,12 +227,11 @@ def _check_store(out: str) -> None:
 
 
 def _compute(k: Kind, req) -> tuple:
-    """(rows, table, exit status) of one kind, its rows kept in the store ``req.out`` names."""
+    """(rows, table, exit status) of one kind, its rows kept in the store ``req.out`` names
+    (``run`` holds the store's lock from before the study)."""
     rows, table, status = k.compute(req, _say)
     if req.out and k.keeps:
-        from ...regimes.store.lock import StoreLock
         from . import convergence as CV
 
-        with StoreLock(req.out, exclusive=True, what=f"evidence {k.name} --out"):
-            CV.record(req.out, rows, key=k.keeps)
+        CV.record(req.out, rows, key=k.keeps)
     return rows, table, status

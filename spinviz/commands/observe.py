@@ -9,7 +9,19 @@ import argparse
 import json
 
 from ..errors import SimulationError
-from .shared import EXIT_OK, add_detector_options, cannot_write, need_matplotlib, out, p, positive, prefix_of, receiver_options
+from .shared import (
+    EXIT_OK,
+    add_detector_options,
+    add_environment_options,
+    cannot_write,
+    environment_options,
+    need_matplotlib,
+    out,
+    p,
+    positive,
+    prefix_of,
+    receiver_options,
+)
 
 
 def _refused_option(text: str):
@@ -28,6 +40,7 @@ def add_parser(sub) -> None:
     o.add_argument("--out", help="prefix of the PNG plots (default renders/<scene>): <prefix>_observe.png, "
                                  "<prefix>_detector.png and, for a physical body, <prefix>_receiver.png")
     add_detector_options(o)
+    add_environment_options(o)
     for gone in ("--power-factor", "--frequency-resolution", "--polarization-deg"):
         # fixed thresholds: the resolutions are the receiver's; say so instead of "unrecognized"
         o.add_argument(gone, type=_refused_option, help=argparse.SUPPRESS)
@@ -49,7 +62,8 @@ def run(args) -> int:
     paths = [f"{prefix}_observe.png", f"{prefix}_detector.png"] + ([f"{prefix}_receiver.png"] if sc.units == "cgs" else [])
     group = Outputs(paths, [args.scene])
     try:
-        obs = experiment.observe(sc, samples=args.samples, line_of_sight=args.line_of_sight, **receiver_options(args))
+        obs = experiment.observe(sc, samples=args.samples, line_of_sight=args.line_of_sight, **receiver_options(args),
+                                 **environment_options(args))
     except SimulationError as e:
         raise SimulationError(f"{args.scene}: {e}") from None
     try:

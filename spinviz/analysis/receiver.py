@@ -79,14 +79,18 @@ def detection_threshold(bins, p_outlier: float = P_OUTLIER):
 
 @functools.lru_cache(maxsize=256)
 def _exact(bins: float, p_outlier: float) -> float:
-    from scipy import integrate, optimize, stats
+    from scipy import integrate, optimize, special
 
     k = max(float(bins), 1.0)
 
     def outshone(rho):
-        # 1 - E[(1 - exp(-Y))^K], Y = X / 2 with X noncentral chi-square (2 dof, noncentrality rho)
+        # 1 - E[(1 - exp(-Y))^K], Y = |sqrt(lam) + z|^2, lam = rho/2: density exp(-(y + lam)) I0(2 sqrt(lam y))
+        lam = 0.5 * rho
+
         def f(y):
-            return (1.0 - math.exp(k * math.log1p(-math.exp(-y)))) * 2.0 * stats.ncx2.pdf(2.0 * y, 2, rho)
+            r = math.sqrt(y)
+            pdf = math.exp(-(r - math.sqrt(lam)) ** 2) * special.i0e(2.0 * math.sqrt(lam) * r)
+            return -math.expm1(k * math.log1p(-math.exp(-y))) * pdf
 
         lo, hi = max(0.0, 0.5 * rho - 20.0 * math.sqrt(rho + 1.0)), 0.5 * rho + 20.0 * math.sqrt(rho + 1.0) + 20.0
         return integrate.quad(f, lo, hi, limit=200, points=[0.5 * rho])[0] - p_outlier

@@ -138,7 +138,7 @@ def flux_integrals(s, kmax: int = 4):
     small flux keeps its relative accuracy (to ~s^2 of round-off in I_1's difference)."""
     s = np.asarray(s, dtype=float)
     e = np.exp(-s * s)
-    i0 = 0.5 * SQRT_PI * _erfc(-s).astype(float)
+    i0 = 0.5 * SQRT_PI * np.asarray(_erfc(-s), dtype=float)
     i1 = np.maximum(0.5 * e + s * i0, 0.0)
     out = [i0, i1]
     for k in range(1, kmax):

@@ -49,6 +49,9 @@ class Truth:
     n_hat: np.ndarray            # the antenna's direction, in L's frame (L along z)
     e_hat: np.ndarray            # the field's direction, in L's frame
     field_rate: float            # d_par |E| / (2 pi I1): Omega_p = field_rate cos(theta_L) / f (rad/s)
+    jump_t: np.ndarray = None    # the located collisions' instants (s) and the line's jumps (Hz)
+    jump_v: np.ndarray = None
+    t_switch: float = 0.0        # after it, the gas's smooth drag and its walk; before it, the located jumps alone
 
     @property
     def gamma(self) -> float:
@@ -77,22 +80,36 @@ def draw_truth(setup: DC.Setup, start: DC.Start, rng) -> Truth:
     I1 = float(nu.inertia[0]) if nu.inertia else 1.0
     kappa = d_par * nu.field * float(e_hat[2]) / (4.0 * math.pi**2 * I1)
     line = None
+    jump_t, jump_v, t_switch = np.zeros(0), np.zeros(0), 0.0
     if nu.gas is not None:
         omega = NU.start_omega(d, setup.epsilon, start.u0, start.b0, rng.uniform(0.0, 2.0 * math.pi))
         line = NU.gas_line(nu, omega, np.random.default_rng(rng.integers(2**63)))
+        jump_t, jump_v, t_switch = NU.located_jumps(line, factor, setup.integration_s, setup.horizon, rng)
     return Truth(tau0=tau0, slope=slope, factor=factor, kappa=kappa, line=line, n_hat=n_hat, e_hat=e_hat,
-                 field_rate=d_par * nu.field / (2.0 * math.pi * I1))
+                 field_rate=d_par * nu.field / (2.0 * math.pi * I1), jump_t=jump_t, jump_v=jump_v, t_switch=t_switch)
 
 
-def _line(model: str, t, w0, share, tau0, gamma):
-    """(f, y, cos theta_L) at times t of ``model``'s line with the drag gamma (a change of time,
-    ``nuisance``): f (Hz), y = ln(Omega_perp^2 omega_L^2); complex parameters allowed."""
+def _line(model: str, t, w0, share, tau0, gamma, t_switch: float = 0.0):
+    """(f, y, cos theta_L) at times t of ``model``'s line with the drag gamma from ``t_switch`` on
+    (a change of time, ``nuisance``; before it the located collisions stand for the gas): f (Hz),
+    y = ln(Omega_perp^2 omega_L^2); complex parameters allowed."""
+    law = M.get(model).line
+    u0, b0 = share * w0, (1.0 - share) * w0
     if np.iscomplexobj(gamma) or gamma != 0.0:
-        s = -np.expm1(-2.0 * gamma * t) / (2.0 * gamma)
-        decay = np.exp(-2.0 * gamma * t)
+        if t_switch > 0.0:
+            u0, b0 = law.state(t_switch, u0, b0, tau0)
+        dt = np.maximum(t - t_switch, 0.0)
+        s = -np.expm1(-2.0 * gamma * dt) / (2.0 * gamma)
+        decay = np.exp(-2.0 * gamma * dt)
+        u, b = law.state(s, u0, b0, tau0)
+        if t_switch > 0.0:                       # before the switch: the radiation alone
+            early = t < t_switch
+            ue, be = law.state(t, share * w0, (1.0 - share) * w0, tau0)
+            u, b = np.where(early, ue, u), np.where(early, be, b)
+            decay = np.where(early, 1.0, decay)
     else:
-        s, decay = t, 1.0
-    u, b = M.get(model).line.state(s, share * w0, (1.0 - share) * w0, tau0)
+        u, b = law.state(t, u0, b0, tau0)
+        decay = 1.0
     u, b = u * decay, b * decay
     w2 = u + b
     return np.sqrt(w2) / (2.0 * math.pi), np.log(u) + np.log(w2), np.sqrt(b / w2)
@@ -113,6 +130,9 @@ class RecordsEnv:
     sy: np.ndarray
     chol: np.ndarray
     lnf: np.ndarray
+    jumps: np.ndarray = None          # (R, K): each record's weight after each located collision
+    jump_t: np.ndarray = None         # their instants (s)
+    t_switch: float = 0.0
 
     def __post_init__(self):
         from scipy.linalg import solve_triangular
@@ -122,9 +142,10 @@ class RecordsEnv:
         self.white = (solve_triangular(self.chol, np.eye(n), lower=True, check_finite=False) if n else self.chol)
         self._fixed: dict = {}
 
-    def fixed_columns(self, n: int, gain: bool) -> np.ndarray:
-        """The whitened columns of the power's constant (and the gain's exponent) on the first n
-        records, (2n, 1 or 2)."""
+    def fixed_columns(self, n: int, gain: bool) -> tuple[np.ndarray, int]:
+        """The whitened columns of the power's constant (and the gain's exponent, and each
+        located collision's jump of the line, 4 / f of it in the power) on the first n records,
+        (2n, m), and how many of them have a prior (the gain's: it comes second)."""
         key = (n, gain)
         if key not in self._fixed:
             one = np.zeros(2 * n)
@@ -134,6 +155,16 @@ class RecordsEnv:
                 g = np.zeros(2 * n)
                 g[1::2] = self.lnf[:n]
                 cols.append(g)
+            if self.jumps is not None and self.jumps.shape[1]:
+                # collisions between the same two nodes are seen as one jump (their sum), one before
+                # the first record is part of the start: each distinct, informative column once
+                part = np.round(self.jumps[:n], 12)
+                keep = np.any(part > 0.0, axis=0) & np.any(part < 1.0, axis=0)
+                for col in np.unique(part[:, keep], axis=1).T:
+                    c = np.zeros(2 * n)
+                    c[0::2] = col
+                    c[1::2] = 4.0 * col / self.f[:n]
+                    cols.append(c)
             self._fixed[key] = self.white[:2 * n, :2 * n] @ np.stack(cols, axis=1)
         return self._fixed[key]
 
@@ -143,12 +174,14 @@ def observe_env(setup: DC.Setup, start: DC.Start, truth_model: str, tr: Truth, r
     nu = setup.nuisance
     edges = setup.edges()
     t, w = DC._nodes(edges)
-    f_det, y_shape, cos = _line(truth_model, t, start.w0, start.share, tr.tau0, tr.gamma)
+    f_det, y_shape, cos = _line(truth_model, t, start.w0, start.share, tr.tau0, tr.gamma, tr.t_switch)
     tn, fn = t.reshape(-1), f_det.reshape(-1)
     f0 = float(fn[0])
     walk = np.zeros_like(fn)
     if tr.line is not None:
-        walk = NU.gas_walk(tn, fn, f0, tr.line, tr.factor, rng)
+        walk = NU.gas_walk(tn, fn, f0, tr.line, tr.factor, rng, tr.t_switch)
+        if tr.jump_t.size:                   # the located collisions: their jumps, uncompensated (the drag is theirs)
+            walk = walk + (tn[:, None] > tr.jump_t[None, :]) @ tr.jump_v
     clock = NU.clock_path(tn, nu.clock, nu.clock_time, rng) if nu.clock > 0 else np.zeros_like(fn)
     walk, clock = walk.reshape(t.shape), clock.reshape(t.shape)
     f_true = f_det + tr.kappa * cos / f_det + walk + f_det * clock
@@ -163,7 +196,7 @@ def observe_env(setup: DC.Setup, start: DC.Start, truth_model: str, tr: Truth, r
     fbar = np.sum(weight * f_true, axis=1)
     ybar = np.sum(weight * (y_true + np.log(share) + tr.slope * np.log(f_det / nu.f_ref)), axis=1)
     tm = np.sum(weight * t, axis=1)
-    fm, _, _ = _line(truth_model, tm, start.w0, start.share, tr.tau0, tr.gamma)
+    fm, _, _ = _line(truth_model, tm, start.w0, start.share, tr.tau0, tr.gamma, tr.t_switch)
     u, b = M.get(truth_model).line.state(tm, start.u0, start.b0, tr.tau0)
     rate, accel = M.get(truth_model).line.drift(u, b, tr.tau0)
     fdot, fddot = (rate - tr.gamma) * fm, accel * fm
@@ -177,8 +210,12 @@ def observe_env(setup: DC.Setup, start: DC.Start, truth_model: str, tr: Truth, r
     fm_obs = fbar + sf * noise[0]
     ym_obs = ybar + sy * noise[1]
     chol = _whitening(setup, t[ok], w[ok], fm_obs[ok], sf[ok], sy[ok], tn, fn, f0, tr)
+    jumps = None
+    if tr.jump_t is not None and tr.jump_t.size:
+        jumps = np.einsum("ja,jak->jk", weight[ok], (t[ok][:, :, None] > tr.jump_t[None, None, :]).astype(float))
     return RecordsEnv(end=edges[1:][ok], t=t[ok], weight=weight[ok], f=fm_obs[ok], y=ym_obs[ok], sf=sf[ok], sy=sy[ok],
-                      chol=chol, lnf=np.log(fm_obs[ok] / nu.f_ref))
+                      chol=chol, lnf=np.log(fm_obs[ok] / nu.f_ref), jumps=jumps,
+                      jump_t=tr.jump_t if jumps is not None else None, t_switch=tr.t_switch)
 
 
 def _share(tr: Truth, tn, fn, cos, start) -> np.ndarray:
@@ -210,7 +247,7 @@ def _whitening(setup, t, w, f_rec, sf, sy, tn_all, fn_all, f0, tr: Truth) -> np.
         # the walk's intensity along the whole run (undetected stretches included), from the
         # measured line where there is one
         f_at = np.interp(tn_all, t.reshape(-1), np.repeat(f_rec, t.shape[1])) if f_rec.size else fn_all
-        Q_all = NU.cumulative_intensity(tn_all, f_at, f0, tr.line.q, tr.line.k_q)
+        Q_all = NU.cumulative_intensity(tn_all, f_at, f0, tr.line.q, tr.line.k_q, tr.t_switch)
         Q = np.interp(t.reshape(-1), tn_all, Q_all)
     share_rate = tr.field_rate / max(float(f_rec[0]), 1e-300) if (tr.field_rate > 0 and f_rec.size) else 0.0
     C = NU.covariance(t, w, f_rec, sf, sy, nu, Q, share_rate)
@@ -218,14 +255,15 @@ def _whitening(setup, t, w, f_rec, sf, sy, tn_all, fn_all, f0, tr: Truth) -> np.
 
 
 # --- the fits --------------------------------------------------------------------------------------
-def _layout(setup: DC.Setup):
-    """Which nonlinear parameters the fits carry: (k, tau0 index or None, gamma index or None)."""
+def _layout(setup: DC.Setup, tr: Truth | None = None):
+    """Which nonlinear parameters the fits carry: (k, tau0 index or None, gamma index or None);
+    the drag only where the gas walks (after the located collisions)."""
     nu = setup.nuisance
     k = 2
     i_tau = i_gam = None
     if setup.tau0_mode == "fitted" or nu.tau0_width > 0:
         i_tau, k = k, k + 1
-    if nu.gas is not None:
+    if nu.gas is not None and (tr is None or tr.t_switch < setup.horizon):
         i_gam, k = k, k + 1
     return k, i_tau, i_gam
 
@@ -246,7 +284,7 @@ def _residuals(setup, model, x, rec: RecordsEnv, n: int, ref: DC.Start, tr: Trut
     tau0 = setup.tau0 * (np.exp(x[i_tau]) if i_tau is not None else 1.0)
     gamma = (tr.line.gamma * np.exp(x[i_gam])) if i_gam is not None else 0.0
     t, wt = rec.t[:n], rec.weight[:n]
-    f, y, cos = _line(model, t, w0, x[1], tau0, gamma)
+    f, y, cos = _line(model, t, w0, x[1], tau0, gamma, rec.t_switch)
     fb, yb = np.sum(wt * f, axis=1), np.sum(wt * y, axis=1)
     r = np.empty(2 * n, dtype=np.result_type(fb, float))
     r[0::2], r[1::2] = rec.f[:n] - fb, rec.y[:n] - yb
@@ -254,7 +292,7 @@ def _residuals(setup, model, x, rec: RecordsEnv, n: int, ref: DC.Start, tr: Trut
     z = _apply(Wn, r)
     gain = nu.gain_slope_db > 0
     A = rec.fixed_columns(n, gain)
-    widths = [math.inf] + ([nu.gain_width] if gain else [])
+    widths = [math.inf] + ([nu.gain_width] if gain else []) + [math.inf] * (A.shape[1] - 1 - int(gain))
     if nu.field > 0 and tr.field_rate > 0:
         kc = np.zeros(2 * n, dtype=np.result_type(cos, float))
         kc[0::2] = np.sum(wt * cos / f, axis=1)
@@ -262,6 +300,7 @@ def _residuals(setup, model, x, rec: RecordsEnv, n: int, ref: DC.Start, tr: Trut
         widths.append(tr.field_rate / (2.0 * math.pi * math.sqrt(3.0)))     # kappa's isotropic RMS
     prior = np.array([0.0 if math.isinf(s) else 1.0 / (s * s) for s in widths])
     G = A.T @ A + np.diag(prior)
+    G += np.diag(1e-12 * np.diag(G))                 # a ridge far below the data: nearly collinear jumps stay solvable
     beta = np.linalg.solve(G, A.T @ z)
     out = [z - A @ beta, np.sqrt(prior) * beta]
     if i_tau is not None and nu.tau0_width > 0 and setup.tau0_mode != "fitted":
@@ -275,7 +314,7 @@ def fit(setup, model, rec: RecordsEnv, n: int, ref: DC.Start, tr: Truth, starts)
     """(chi2, x) of ``model``'s best fit to the first ``n`` records from the starting points."""
     from scipy.optimize import least_squares
 
-    layout = _layout(setup)
+    layout = _layout(setup, tr)
     k = layout[0]
 
     def fun(x):
@@ -311,7 +350,7 @@ def z_at(setup, rec: RecordsEnv, n: int, truth: str, start: DC.Start, tr: Truth,
     """Z of ``truth`` against the other model on the first ``n`` records (step 4)."""
     first, second = setup.models
     other = second if truth == first else first
-    k = _layout(setup)[0]
+    k = _layout(setup, tr)[0]
     x_true = np.zeros(k)
     x_true[1] = start.share
     across = x_true.copy()

@@ -244,7 +244,7 @@ def plot_decide(out, title: str, path: str) -> None:
     nu = s.nuisance
     exact = s.tau0_mode == "known" and (nu is None or nu.tau0_width == 0.0)
     tau = ("τ0 known exactly: the truncated curve rests on it (with τ0 fitted no truncated trial decides)" if exact
-           else f"τ0 {'fitted' if s.tau0_mode == 'fitted' else f'known to {nu.tau0_width:.3g} (relative)'}")
+           else "τ0 fitted with the start" if s.tau0_mode == "fitted" else "τ0 as below")
     trap = ""
     if nu is not None:
         from .nuisance import describe

@@ -17,8 +17,13 @@ The nuisances (``Nuisances``), each with its prior and how it enters:
   and the same for every component (a sphere-like top): with s = (1 - exp(-2 gamma t)) / 2
   gamma, (u, b)(t) = exp(-2 gamma t) (u, b)_radiation(s); the fit profiles ln gamma.  Its
   collisions make the line walk: each changes |L| by L_hat . J, so the line jumps by
-  L_hat . J / (2 pi I1); the compensated sum is a random walk of intensity
-  q = rate E[(L_hat . J)^2] / (2 pi I1)^2 (Hz^2/s, the mean squared included);
+  L_hat . J / (2 pi I1).  Where they come rarely (fewer than ``RESOLVE_RATE`` an integration)
+  each jump -- hundreds of Hz on the DAST cube's 7 GHz line, against a resolution of ~10 mHz --
+  stands out of the 1 s estimates: an analysis locates it there and fits its size, so the
+  first ``N_LOCATED`` are located (told to the fit by their instants) and the smooth drag
+  starts only after them; the rest, and all of them where they come often, make the line's
+  compensated walk, a random walk of intensity q = rate E[(L_hat . J)^2] / (2 pi I1)^2 (Hz^2/s,
+  the mean squared included);
 * a static field of the stated size, its direction unknown (isotropic): L precesses about E at
   Omega_p = d_par cos(theta_L) |E| / |L|, which moves the line by Omega_p (E_hat . L_hat) / 2 pi
   (``kappa cos(theta_L) / f``, kappa = d_par |E| (E_hat . L_hat) / 4 pi^2 I1: the fit profiles
@@ -46,6 +51,8 @@ SHARE_VARIANCE = 0.0372          # mean over isotropic E, antenna and L of the v
 GAIN_PER_DB_OCTAVE = 1.0 / (10.0 * math.log10(2.0))     # the exponent G of (f/f_ref)^G per dB per octave
 POOL = 2048                      # single collisions drawn per trial: the distribution of the line's jumps
 EXACT_PER_STEP = 64              # collisions between two nodes drawn one by one; more: their Gaussian sum
+RESOLVE_RATE = 0.2               # collisions an integration below which each is located in the 1 s estimates
+N_LOCATED = 64                   # the located collisions an analysis profiles one by one; after them, a walk
 
 
 @dataclass(frozen=True)
@@ -144,15 +151,30 @@ def gas_line(nu: Nuisances, omega, rng) -> GasLine:
     return GasLine(gamma=g1, rate=r1, q=q1, k_gamma=k(g1, g2), k_rate=k(r1, r2), k_q=k(q1, q2), jumps=jumps)
 
 
-def gas_walk(t_nodes, f_nodes, f0: float, line: GasLine, factor: float, rng) -> np.ndarray:
+def located_jumps(line: GasLine, factor: float, integration_s: float, horizon: float, rng):
+    """The collisions an analysis locates one by one in the 1 s estimates: where they come rarely
+    (fewer than ``RESOLVE_RATE`` an integration) the first ``N_LOCATED`` of them, their instants
+    (s) and the line's jumps (Hz, drawn from the pool), and the instant after which the rest are
+    a random walk (the horizon when all are located); where they come often, none and 0."""
+    rate = factor * line.rate
+    if not rate * integration_s < RESOLVE_RATE:
+        return np.zeros(0), np.zeros(0), 0.0
+    times = np.cumsum(rng.exponential(1.0 / rate, N_LOCATED)) if rate > 0 else np.full(N_LOCATED, np.inf)
+    times = times[times < horizon]
+    t_switch = float(times[-1]) if times.size == N_LOCATED else float(horizon)
+    return times, rng.choice(line.jumps, times.size), t_switch
+
+
+def gas_walk(t_nodes, f_nodes, f0: float, line: GasLine, factor: float, rng, t_switch: float = 0.0) -> np.ndarray:
     """The gas's compensated walk of the line (Hz) at increasing node times ``t_nodes`` (M,)
-    from 0: between nodes a Poisson number of collisions at the rate ``factor`` x
-    line.rate (f/f0)^k_rate, each a jump drawn from the pool scaled by (f/f0)^((k_q -
-    k_rate)/2), less their mean; past ``EXACT_PER_STEP`` collisions the Gaussian of the
-    same variance."""
+    from ``t_switch`` on (before it the located jumps stand alone): between nodes a Poisson
+    number of collisions at the rate ``factor`` x line.rate (f/f0)^k_rate, each a jump drawn
+    from the pool scaled by (f/f0)^((k_q - k_rate)/2), less their mean; past
+    ``EXACT_PER_STEP`` collisions the Gaussian of the same variance."""
     t = np.asarray(t_nodes, dtype=float)
     f = np.asarray(f_nodes, dtype=float)
-    dt = np.diff(np.concatenate([[0.0], t]))
+    prev = np.concatenate([[0.0], t[:-1]])
+    dt = np.maximum(0.0, t - np.maximum(prev, t_switch))
     ratio = np.maximum(f / f0, 1e-300)
     mu = factor * line.rate * ratio**line.k_rate * dt
     scale = ratio ** (0.5 * (line.k_q - line.k_rate))
@@ -222,11 +244,12 @@ def covariance(t, w, f_rec, sf, sy, nu: Nuisances, walk_Q, share_rate: float) ->
     return out
 
 
-def cumulative_intensity(t_nodes, f_nodes, f0: float, q0: float, k_q: float) -> np.ndarray:
-    """Q(t) = int_0^t q dt' at increasing node times, q = q0 (f/f0)^k_q (trapezoid; Hz^2)."""
+def cumulative_intensity(t_nodes, f_nodes, f0: float, q0: float, k_q: float, t_switch: float = 0.0) -> np.ndarray:
+    """Q(t) = int_t_switch^t q dt' at increasing node times (0 before t_switch), q = q0
+    (f/f0)^k_q (trapezoid; Hz^2)."""
     t = np.asarray(t_nodes, dtype=float)
     q = q0 * np.maximum(np.asarray(f_nodes, dtype=float) / f0, 1e-300) ** k_q
-    tt = np.concatenate([[0.0], t])
+    tt = np.maximum(np.concatenate([[0.0], t]), t_switch)
     qq = np.concatenate([[q[0]], q])
     return np.cumsum(0.5 * (qq[1:] + qq[:-1]) * np.diff(tt))
 

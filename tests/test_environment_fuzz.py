@@ -39,6 +39,7 @@ def tables(draw):
     return out
 
 
+@settings(max_examples=30)
 @given(table=tables())
 def test_a_hostile_environment_is_accepted_or_refused_by_its_key(table):
     try:

@@ -34,7 +34,7 @@ def test_flux_integrals_are_the_integrals():
 
     for s in (-6.0, -2.0, -0.3, 0.0, 0.7, 3.0, 10.0):
         got = G.flux_integrals(np.array([s]))[:, 0]
-        ref = [quad(lambda y, k=k: y**k * math.exp(-(y - s) ** 2), 0, np.inf, epsabs=0, epsrel=1e-13)[0]
+        ref = [quad(lambda y, k=k, s=s: y**k * math.exp(-(y - s) ** 2), 0, np.inf, epsabs=0, epsrel=1e-13)[0]
                for k in range(5)]
         assert got == pytest.approx(ref, rel=1e-9), s
 
@@ -48,7 +48,7 @@ def test_linear_coefficients_are_the_slopes_of_the_exact_forces():
         ct, cn = gas.linear_coefficients()
         h = 1e-6 * gas.mean_speed
 
-        def force(u):
+        def force(u, gas=gas):
             flux, mean, _ = G.element_moments(gas, np.asarray(u, dtype=float), n)
             return gas.mass * flux * mean
 

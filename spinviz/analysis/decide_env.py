@@ -10,14 +10,16 @@ One trial, each model the truth in turn (``decide``'s steps, with):
    priors; the gas's line at the start (``nuisance.gas_line``: quadrature and a pool of single
    collisions);
 2. the records: the line at the 8 nodes of each record is the model's closed form with the drag
-   (a change of time), plus the field's shift, the gas's walk (exact collisions, or their
-   Gaussian sum where many), times (1 + the clock's error); the power toward the antenna gets
-   the share as L precesses about E and the gain slope; merged as ``decide`` merges them;
+   (a change of time), plus the field's shift, the gas's collisions -- the located ones' jumps
+   (``nuisance.located_jumps``), then the walk (exact collisions, or their Gaussian sum where
+   many) -- times (1 + the clock's error); the power toward the antenna gets the share as L
+   precesses about E and the gain slope; merged as ``decide`` merges them;
 3. each model's fit: least squares on the records whitened by the Cholesky factor of their
    covariance (``nuisance.covariance``: measurement noise, the walk at the stated pressure, the
    clock, the share), over the start, ln tau0 (with its prior) and ln gamma (with the pressure's
    prior), the linear nuisances -- the power's constant, the gain's exponent, the field's
-   shift kappa -- profiled in closed form with their priors at every step;
+   shift kappa, each located collision's jump -- profiled in closed form with their priors
+   (none for the jumps) at every step;
 4. Z = sqrt(chi2_other - chi2_true), priors' penalties included; the decision time by bisection
    over the records as in ``decide`` (the records' covariance is Markov in time, so the first n
    records' whitening is the leading block of the whole: one factorisation a trial).

@@ -15,7 +15,8 @@ The nuisances (``Nuisances``), each with its prior and how it enters:
   Its mean drag brakes |L| at gamma (``gas_line``: the gas's quadrature along L at the start),
   which enters the line's closed forms exactly as a change of time for a drag linear in Omega
   and the same for every component (a sphere-like top): with s = (1 - exp(-2 gamma t)) / 2
-  gamma, (u, b)(t) = exp(-2 gamma t) (u, b)_radiation(s); the fit profiles ln gamma.  Its
+  gamma, (u, b)(t) = exp(-2 gamma t) (u, b)_radiation(s) (from the last located collision on,
+  below); the fit profiles ln gamma.  Its
   collisions make the line walk: each changes |L| by L_hat . J, so the line jumps by
   L_hat . J / (2 pi I1).  Where they come rarely (fewer than ``RESOLVE_RATE`` an integration)
   each jump -- hundreds of Hz on the DAST cube's 7 GHz line, against a resolution of ~10 mHz --

@@ -179,6 +179,8 @@ class Scene:
             raise SpecError("model", f"{brief(model)} is not one of the scene's models ({', '.join(self.models)})")
         times = {"t_end": self.t_end, "samples": self.samples} if t_eval is None else {"t_eval": t_eval}
         env = self.environment if self.environment.active else None
+        if env is not None and kinematics == "none":
+            kinematics = "quaternion"            # a trap's run carries the orientation whatever is drawn of it
         return SimulationRequest(body=self.body, model=model, omega0=self.omega0, q0=self.q0, method=self.method,
                                  rtol=self.rtol, atol=self.atol, step=self.step, kinematics=kinematics,
                                  environment=env, **times)

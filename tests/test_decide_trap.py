@@ -167,3 +167,32 @@ def test_a_stop_signal_ends_a_requirements_run_clean(tmp_path):
     assert lines == ["spinviz: interrupted by SIGTERM; nothing was written"], err
     assert list(tmp_path.iterdir()) == []
     assert gone(proc.pid) == []
+
+
+def _requirements(probed: bool):
+    """A Requirements answer drawn by hand: every key probed at three values, or none probed."""
+    results = {}
+    for key in RQ.KEYS:
+        probes = [(1e-13, 1.0, {"reduced": 30.0, "truncated": 40.0}), (1e-12, 0.97, {"reduced": 60.0, "truncated": 90.0}),
+                  (1e-11, 0.4, {"reduced": math.inf, "truncated": 300.0})] if probed else []
+        results[key] = RQ.Requirement(key, 1e-12 if probed else None, False, probes,
+                                      "" if probed else "not decided within the horizon even in a perfect vacuum")
+    return RQ.Requirements(title="a crystal", stated={k: 0.0 for k in RQ.KEYS}, trials=10, seed=1, horizon=3600.0,
+                           vacuum_t95={"reduced": 25.0, "truncated": 35.0}, results=results,
+                           models=("reduced", "truncated"))
+
+
+@pytest.mark.parametrize("probed", [True, False])
+def test_the_requirements_figure_says_what_was_probed(tmp_path, probed):
+    """The figure: six panels when the keys were probed; one panel saying why when even the
+    vacuum does not decide (no empty axes); written whole (a PNG of the stated size)."""
+    pytest.importorskip("matplotlib")
+    from PIL import Image
+
+    from spinviz.analysis.requirement_plots import plot_requirements
+
+    path = tmp_path / "r.png"
+    plot_requirements(_requirements(probed), str(path))
+    with Image.open(path) as im:
+        w, h = im.size
+    assert (w / h < 2.0) == probed                   # the six-panel grid is 17 x 10, the message 9 x 3.6

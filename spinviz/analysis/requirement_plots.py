@@ -6,6 +6,7 @@ each requirement the share of trials decided against its value.  matplotlib, dra
 from __future__ import annotations
 
 import math
+import textwrap
 
 import numpy as np
 
@@ -51,14 +52,15 @@ def _pressure_panel(ax, req) -> None:
     ax.set_ylabel(tl.replace("time t", f"time by which {100 * SHARE:g} % decide") + ", log scale")
     ax.set_title(f"how long to watch against the trap's pressure (Z ≥ {DECISION_Z:g})")
     ax.grid(True, which="major", color="0.9", lw=0.6)
-    ax.legend(fontsize=7, loc="upper left")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7, loc="upper left")
 
 
 def _share_panel(ax, req, key: str) -> None:
     r = req.results[key]
     name, what, unit = LABELS[key]
     if not r.probes:
-        ax.annotate("not probed:\n" + (r.note or ""), (0.5, 0.5), xycoords="axes fraction", ha="center", va="center",
+        ax.annotate("not probed:\n" + textwrap.fill(r.note or "", 34), (0.5, 0.5), xycoords="axes fraction", ha="center", va="center",
                     fontsize=8, color="0.3")
         ax.set_axis_off()
         ax.set_title(what, fontsize=9)
@@ -89,6 +91,19 @@ def plot_requirements(req, path: str) -> None:
     pressure that still decides; beside and below it, the share of trials decided against each
     requirement's value, the 95 % line and the answer (PNG, atomic)."""
     plt = pyplot()
+    if not any(r.probes for r in req.results.values()):
+        fig, ax = plt.subplots(figsize=(9, 3.6))
+        note = next((r.note for r in req.results.values() if r.note), "nothing probed")
+        ax.text(0.5, 0.55, textwrap.fill(f"No requirement can be met: {note}.", 64), ha="center", va="center",
+                fontsize=11, transform=ax.transAxes)
+        ax.text(0.5, 0.15, f"horizon {U.human_time(req.horizon)}; {req.trials} trials (seed {req.seed}); "
+                f"decided: {100 * SHARE:g} % of the trials of each truth at Z ≥ {DECISION_Z:g}", ha="center",
+                va="center", fontsize=9, color="0.35", transform=ax.transAxes)
+        ax.set_axis_off()
+        fig.suptitle(f"{req.title}\nwhat the trap must achieve", fontsize=11)
+        fig.tight_layout()
+        save(fig, path)
+        return
     fig = plt.figure(figsize=(17, 10))
     grid = fig.add_gridspec(2, 4, height_ratios=(1.25, 1.0))
     _pressure_panel(fig.add_subplot(grid[0, :3]), req)

@@ -196,3 +196,19 @@ def test_the_requirements_figure_says_what_was_probed(tmp_path, probed):
     with Image.open(path) as im:
         w, h = im.size
     assert (w / h < 2.0) == probed                   # the six-panel grid is 17 x 10, the message 9 x 3.6
+
+
+def test_decide_in_a_gas_is_estimated_at_a_trial_in_gas(monkeypatch, cube):
+    """The work cap prices a trial in a gas (collisions located and fitted) at its own measured
+    cost, not the vacuum's: a cap that lets the vacuum's 8 trials through refuses the same 8 in
+    a gas, before any trial."""
+    from spinviz.analysis import decide as DC
+
+    spec = DecideArguments(trials=8, workers=1)
+    vacuum = experiment._decide_setup(cube, cube.observe.receiver, spec)
+    gas = experiment._decide_setup(cube.with_environment(pressure_mbar=1e-13), cube.observe.receiver, spec)
+    monkeypatch.setenv("SPINVIZ_MAX_DAYS", str(2.0 * DC.work_seconds(vacuum, 8) / 86400.0))
+    DC.check_work(vacuum, 8, 1)
+    with pytest.raises(SpecError, match="SPINVIZ_MAX_DAYS") as e:
+        DC.check_work(gas, 8, 1)
+    assert e.value.key == "trials"

@@ -416,12 +416,17 @@ def summarize(out: Outcome) -> Outcome:
 
 def work_seconds(setup: Setup, trials: int, workers: int = 1) -> float:
     """The estimated wall time of ``trials`` trials of ``setup`` on ``workers`` processes, s:
-    the measured cost of a trial (``inputs.options.DECIDE_S_PER_TRIAL``, by tau0 mode, for a
+    the measured cost of a trial (``inputs.options.DECIDE_S_PER_TRIAL``, by tau0 mode and
+    nuisances, for a
     trial that is decided: the dearest) times the share of records beyond the measured ones."""
     from ..inputs.options import DECIDE_RECORDS, DECIDE_S_PER_TRIAL
 
     records = setup.edges().size - 1
-    each = DECIDE_S_PER_TRIAL[setup.tau0_mode] * max(1.0, records / DECIDE_RECORDS)
+    nu = setup.nuisance
+    kind = setup.tau0_mode
+    if nu is not None and nu.active:
+        kind = "gas" if nu.gas is not None else "nuisances"
+    each = max(DECIDE_S_PER_TRIAL[kind], DECIDE_S_PER_TRIAL[setup.tau0_mode]) * max(1.0, records / DECIDE_RECORDS)
     return trials * each / max(1, int(workers))
 
 

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import units as U
+from ..inputs.options import DECIDE_S_PER_TRIAL
 from . import decide as DC
 from . import nuisance as NU
 
@@ -39,9 +40,10 @@ LABELS = {"pressure_mbar": ("max_pressure_mbar", "pressure", "mbar"),
           "gain_slope": ("max_gain_slope_db_per_octave", "antenna gain slope", "dB/octave"),
           "clock_stability": ("max_clock_stability", "clock stability (fractional)", "")}
 REFINE = 4
-# measured costs of one trial (both truths), one core, the DAST cube (docs/experiment.md): the
-# vacuum's full decision, a full decision in gas, and the horizon's fits alone with a nuisance
-S_PER_TRIAL = {"vacuum": 1.5, "full": 3.0, "horizon": 0.4}
+# measured costs of one trial (both truths), one core, the DAST cube (inputs.options): the
+# vacuum's full decision, a full decision in gas (the dearest pressure's), and the horizon's fits
+# alone with a nuisance
+S_PER_TRIAL = {"vacuum": DECIDE_S_PER_TRIAL["known"], "full": DECIDE_S_PER_TRIAL["gas"], "horizon": 0.4}
 
 
 @dataclass

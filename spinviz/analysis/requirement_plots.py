@@ -33,11 +33,9 @@ def _pressure_panel(ax, req) -> None:
             ax.plot(v[never], np.full(int(never.sum()), top), "v", ms=7, color=model_color(m),
                     label=f"truth: {m}, fewer than {100 * SHARE:g} % decided (drawn at the horizon)")
         t_vac = req.vacuum_t95.get(m, math.inf)
-        if math.isfinite(t_vac):
-            ax.axhline(t_vac / scale, color=model_color(m), lw=0.9, ls=":")
-            ax.annotate(f"vacuum, everything known: {U.human_time(t_vac)} ({m})", (0.01, t_vac / scale),
-                        xycoords=("axes fraction", "data"), xytext=(0, 3 if m == req.models[0] else -10),
-                        textcoords="offset points", fontsize=8, color=model_color(m))
+        if math.isfinite(t_vac):                    # in the legend: two labels on one level overlap
+            ax.axhline(t_vac / scale, color=model_color(m), lw=0.9, ls=":",
+                       label=f"truth: {m}, vacuum with everything known: {U.human_time(t_vac)}")
     ax.axhline(top, color="0.5", lw=0.8, ls="--")
     ax.annotate(f"horizon {U.human_time(req.horizon)}", (0.99, top), xycoords=("axes fraction", "data"), ha="right",
                 va="bottom", fontsize=8, color="0.35")

@@ -91,7 +91,7 @@ def test_the_command_writes_the_atlas_and_its_picture(tmp_path, capsys):
     import xarray as xr
 
     nc, png = tmp_path / "b.nc", tmp_path / "b.png"
-    assert main(["boxes", "--grid", "3", "--starts", "40", "--models", "truncated", "--out", str(nc), "--plot", str(png),
+    assert main(["atlas", "boxes", "--grid", "3", "--starts", "40", "--models", "truncated", "--out", str(nc), "--plot", str(png),
                  "--quiet"]) == 0
     ds = xr.open_dataset(nc)
     tot = ds["axis_share"].sum("axis") + ds["polhode_share"] + ds["separatrix_share"]

@@ -58,8 +58,8 @@ def _share_panel(ax, req, key: str) -> None:
     r = req.results[key]
     name, what, unit = LABELS[key]
     if not r.probes:
-        ax.annotate("not probed:\n" + textwrap.fill(r.note or "", 34), (0.5, 0.5), xycoords="axes fraction", ha="center", va="center",
-                    fontsize=8, color="0.3")
+        ax.annotate("not probed:\n" + textwrap.fill(r.note or "", 34), (0.5, 0.5), xycoords="axes fraction",
+                    ha="center", va="center", fontsize=8, color="0.3")
         ax.set_axis_off()
         ax.set_title(what, fontsize=9)
         return

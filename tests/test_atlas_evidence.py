@@ -40,7 +40,7 @@ tau_end = 1e6
     ("physical", {"tau_end": float("nan")}, SpecError, "tau_end: must be finite"),
     ("convergence", {"out": "/nonexistent/a.zarr"}, UsageError, "--out /nonexistent/a.zarr: not an atlas store"),
     ("nonsense", {}, UsageError, "evidence: nonsense is not one of validate, crosscheck, physical, convergence, "
-                                 "tolerance, handover, basins, flows"),
+                                 "tolerance, handover, basins, bound, flows"),
 ])
 def test_options_a_kind_does_not_take_are_refused_before_work(kind, options, error, message, monkeypatch):
     """Each refused before any work: the computation itself raises if reached."""

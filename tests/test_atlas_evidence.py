@@ -50,6 +50,19 @@ def test_options_a_kind_does_not_take_are_refused_before_work(kind, options, err
     assert message in str(e.value)
 
 
+def test_the_evidence_listing_names_every_kind(capsys):
+    """``spinviz atlas evidence --help`` prints each kind with its description (argparse
+    expands '%' in help texts: a description must survive that)."""
+    from spinviz.commands import main
+
+    with pytest.raises(SystemExit) as e:
+        main(["atlas", "evidence", "--help"])
+    assert e.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    for kind in evidence.KINDS.values():
+        assert f"{kind.name} {' '.join(kind.summary.split()[:4])}" in text, kind.name
+
+
 @pytest.mark.parametrize("kind", sorted(evidence.KINDS))
 def test_each_kind_is_a_sub_command_with_exactly_its_options(kind, capsys):
     """``spinviz atlas evidence KIND --help`` lists --members, the options the registry says the

@@ -189,7 +189,7 @@ KINDS = {k.name: k for k in (
          options=("horizons", "out"), tau_why="where brute force integrates in full", horizons=(1e12, 1e14),
          keeps="handover_validation"),
     Kind("basins", "the 4|5 band at delta = 0.5 and 0.4: the shares of the starts ending in 4 and in 5 against "
-                   "beta of (4.18), with their 95 % Clopper-Pearson intervals", 256,
+                   "beta of (4.18), with their Clopper-Pearson intervals at 95 percent", 256,
          cost=lambda r: _band_points() * r.members * BASIN_S_PER_RUN * (_full(r.tau_end) / _full(1e16)) / _cores(r),
          compute=_basins, options=("tau_end",), tau_max=1e20, tau_why="where the hand-over engine was measured to hold",
          tau_end=1e16),

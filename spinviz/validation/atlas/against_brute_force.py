@@ -189,16 +189,26 @@ def format_table(rows: list[dict]) -> str:
 MARGIN_TOL = 1e-15             # the references' tolerance (scalar Taylor on the scaled variable)
 
 
+SCAN_DELTA = (0.3, 0.5, 0.7, 0.9)
+SCAN_BETA = (-0.55, -0.6, -0.65, -0.7)
+
+
 def bound_points() -> list[tuple]:
-    """(name, model, delta, chi_deg, |omega0|): the validation and disputed points, and three
-    cells where the smaller amplitude stays large against the bound's |(a, b)| term for decades
-    (the reduced transverse state at beta = -0.60 and, where mu falls slowest, -0.69; the
-    balanced one just inside (4.17))."""
+    """(name, model, delta, chi_deg, |omega0|): the validation and disputed points; the
+    audit's (0.7, 29 deg) and two cells beside it (the balanced state just inside (4.17), the
+    transverse one where mu falls slowest); and a scan of the reduced transverse state between
+    the 3|4 boundary beta(4.18) = -1/2 and the 4|5 band (``SCAN_BETA`` at each of ``SCAN_DELTA``),
+    where omega3 dies as tau^(beta + 1/2), slowest by the boundary, so the smaller amplitude b
+    stays large against the bound's |(a, b)| term for decades."""
+    from ...physics import asymptotics as FM
     from .convergence import points as conv
 
-    return conv() + [("4 by 3|4: b slow (beta = -0.60)", "reduced", 0.7, 29.0, 0.1),
-                     ("4 by 4|5: mu slow (beta = -0.69)", "reduced", 0.7, 31.0, 0.1),
-                     ("3 by 3|4", "reduced", 0.7, 25.0, 0.1)]
+    scan = [(f"scan beta = {b:g}", "reduced", d, round(math.degrees(chi_at_beta(d, b)), 2), 0.1)
+            for d in SCAN_DELTA for b in SCAN_BETA]
+    near = [("4 by 3|4: b slow", "reduced", 0.7, 29.0, 0.1), ("4 by 4|5: mu slow", "reduced", 0.7, 31.0, 0.1),
+            ("3 by 3|4", "reduced", 0.7, 25.0, 0.1)]
+    near = [(f"{n} (beta = {FM.type4_eq4_18(d, math.radians(c))['beta']:.2f})", m, d, c, w) for n, m, d, c, w in near]
+    return conv() + near + scan
 
 
 def margins(members: int = 8, tau_end: float = 1e12, points=None, seed: int = 1, progress=None) -> list[dict]:
@@ -217,7 +227,9 @@ def margins(members: int = 8, tau_end: float = 1e12, points=None, seed: int = 1,
         t0 = time.perf_counter()
         en = HO.cell_records(model, d, chi, starts, Settings(tau_end=tau_end, rtol=1e-8))
         flow = AV.Flow(model, d, chi) if d != 0.0 and 0.0 < chi < 0.5 * math.pi else None
-        over, small = [], []
+        over, first, small = [], [], []
+        state = flow.stable_state() if flow is not None else None
+        axial = state is None or (model == "reduced" and state.name == "axial")
         for k, e in enumerate(en):
             lim = e.limit or {}
             if flow is None or not math.isfinite(lim.get("tau_handover", math.nan)):
@@ -226,6 +238,10 @@ def margins(members: int = 8, tau_end: float = 1e12, points=None, seed: int = 1,
             a, b = (float(x) for x in AV.scaled_amplitudes(flow, wr[0] + 1j * wr[1], wr[2], tau_end))
             ea, eb = lim["abar_end"] - a, abs(lim["bbar_end"]) - b
             over.append(max(abs(ea), abs(eb)) / lim["bound"])
+            if not axial:               # the first term alone (+ the floor): the bound without the smaller one's share
+                floor = lim.get("noise_floor", math.nan)
+                alone = HO.BOUND_C * lim["mu_handover"] ** 2 * math.hypot(lim["abar_end"], lim["bbar_end"])
+                first.append(max(abs(ea), abs(eb)) / (alone + (floor if math.isfinite(floor) else 0.0)))
             if not lim.get("spiral_unresolved", 0):         # a free spiral below the noise: no share of its own
                 small.append((eb / b if b < a else ea / a) / lim["mu_handover"] ** 2)
         rows.append({"point": name, "model": model, "delta": d, "chi_deg": cdeg, "omega0": w, "members": members,
@@ -233,6 +249,7 @@ def margins(members: int = 8, tau_end: float = 1e12, points=None, seed: int = 1,
                      "max_over_bound": float(max(over)) if over else math.nan,
                      "median_over_bound": float(np.median(over)) if over else math.nan,
                      "beyond_bound": int(sum(x > 1.0 for x in over)),
+                     "max_over_first_term": float(max(first)) if first else math.nan,
                      "small_share_mu2": float(max(small, key=abs)) if small else math.nan,
                      "small_positive": int(sum(x > 0.0 for x in small)), "seconds": time.perf_counter() - t0})
     return rows
@@ -240,14 +257,16 @@ def margins(members: int = 8, tau_end: float = 1e12, points=None, seed: int = 1,
 
 def format_margins(rows: list[dict]) -> str:
     """The bound rows as a Markdown table."""
-    out = ["| point | model | δ | χ | handed over | error / bound: largest, median | beyond | smaller amplitude's "
-           "error / (itself × μ_h²): largest, positive |", "|---|---|---|---|---|---|---|---|"]
+    out = ["| point | model | δ | χ | handed over | error / bound: largest, median | beyond | error / first term "
+           "alone: largest | smaller amplitude's error / (itself × μ_h²): largest, positive |",
+           "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         n = r["handed_over"]
         err = f"{r['max_over_bound']:.2f}, {r['median_over_bound']:.2f}" if n else "-"
-        sm = f"{r['small_share_mu2']:+.2f}, {r['small_positive']}/{n}" if n else "-"
-        out.append(f"| {r['point']} | {r['model']} | {r['delta']:g} | {r['chi_deg']:.1f}° | {n}/{r['members']} | {err} | "
-                   f"{r['beyond_bound'] if n else '-'} | {sm} |")
+        sm = f"{r['small_share_mu2']:+.2f}, {r['small_positive']}/{n}" if n and math.isfinite(r["small_share_mu2"]) else "-"
+        ft = f"{r['max_over_first_term']:.2f}" if n and math.isfinite(r["max_over_first_term"]) else "-"
+        out.append(f"| {r['point']} | {r['model']} | {r['delta']:g} | {r['chi_deg']:.2f}° | {n}/{r['members']} | {err} | "
+                   f"{r['beyond_bound'] if n else '-'} | {ft} | {sm} |")
     return "\n".join(out)
 
 

@@ -1,5 +1,6 @@
 """The hand-over engine: each run integrated in full until the averaged flow holds, then carried
-by the averaged flow to tau_end, and labelled by the attractor it is in.
+by the averaged flow to tau_end; its type as tau -> oo is the attractor it is in, its label at
+tau_end what its state shows there.
 
 Same contract as ``runs.run_batch`` (``run_batch(batch) -> dict``), chosen by the spec's
 ``[run] engine = "handover"`` (the default).  Per run of a symmetric top

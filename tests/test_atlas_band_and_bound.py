@@ -62,11 +62,14 @@ def test_band_points_pair_equal_betas_on_two_deltas():
     beta = {p: FM.type4_eq4_18(p[0], math.radians(p[1]))["beta"] for p in pts}
     at5 = [p for p in pts if p[0] == HV.BAND_DELTA]
     at4 = [p for p in pts if p[0] == HV.OTHER_DELTA]
-    assert len(at5) == len(at4) == len(HV.BAND_CHI_DEG) + 1
+    assert len(at5) == len(at4) == len(HV.BAND_CHI_DEG) + 1 and len(pts) == len(at5) + len(at4) + len(HV.SPREAD_DELTA)
     for b5, b4 in zip(sorted(beta[p] for p in at5), sorted(beta[p] for p in at4)):
         assert abs(b5 - b4) < 2e-4                              # chi rounded to 0.01 deg
     assert (HV.OTHER_DELTA, HV.AUDIT_CHI_DEG) in pts and beta[(HV.OTHER_DELTA, HV.AUDIT_CHI_DEG)] == pytest.approx(
         -0.730, abs=5e-4)
+    for d in HV.SPREAD_DELTA:                                   # the audit's beta at deltas farther apart
+        (p,) = [p for p in pts if p[0] == d]
+        assert beta[p] == pytest.approx(-0.730, abs=5e-4)
 
 
 def test_stated_bound_closed_form():

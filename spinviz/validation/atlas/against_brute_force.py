@@ -275,6 +275,7 @@ BAND_DELTA = 0.5
 BAND_CHI_DEG = (39.0, 40.0, 41.0, 42.0, 43.0, 44.0)  # delta = 0.5: beta(4.18) = -0.617 ... -0.795
 OTHER_DELTA = 0.4                                   # the same betas at another delta
 AUDIT_CHI_DEG = 47.0                                # (0.4, 47 deg), beta = -0.730: the independent audit's point
+SPREAD_DELTA = (0.2, 0.8)                           # the audit's beta at deltas farther apart
 CONFIDENCE = 0.95
 
 
@@ -287,14 +288,16 @@ def chi_at_beta(delta: float, beta: float) -> float:
 def band_points() -> list[tuple]:
     """(delta, chi_deg) across the 4|5 band: ``BAND_CHI_DEG`` at ``BAND_DELTA``, then the same
     betas of (4.18) at ``OTHER_DELTA`` (whether the shares follow beta alone), then the
-    audit's point (``OTHER_DELTA``, ``AUDIT_CHI_DEG``) and its beta at ``BAND_DELTA``."""
+    audit's point (``OTHER_DELTA``, ``AUDIT_CHI_DEG``) and its beta at ``BAND_DELTA`` and at
+    ``SPREAD_DELTA``."""
     from ...physics import asymptotics as FM
 
     pts = [(BAND_DELTA, c) for c in BAND_CHI_DEG]
     betas = [FM.type4_eq4_18(BAND_DELTA, math.radians(c))["beta"] for c in BAND_CHI_DEG]
     pts += [(OTHER_DELTA, round(math.degrees(chi_at_beta(OTHER_DELTA, b)), 2)) for b in betas]
     audit = FM.type4_eq4_18(OTHER_DELTA, math.radians(AUDIT_CHI_DEG))["beta"]
-    return pts + [(OTHER_DELTA, AUDIT_CHI_DEG), (BAND_DELTA, round(math.degrees(chi_at_beta(BAND_DELTA, audit)), 2))]
+    return pts + [(OTHER_DELTA, AUDIT_CHI_DEG)] + [(d, round(math.degrees(chi_at_beta(d, audit)), 2))
+                                                   for d in (BAND_DELTA,) + SPREAD_DELTA]
 
 
 def share_interval(k: int, n: int, confidence: float = CONFIDENCE) -> tuple[float, float]:

@@ -121,3 +121,22 @@ def test_band_shares_lie_in_their_intervals_and_two_types_share_the_band(band):
     mixed = by[(0.5, 42.0)]
     assert mixed["ci_4"][0] > 0.1 and mixed["ci_5"][0] > 0.1
     assert "% [" in HV.format_basins(band) and "95 % Clopper–Pearson" in HV.format_basins(band)
+
+
+def test_equal_betas_are_compared_by_fishers_exact_test():
+    """Rows off delta = 0.5 are paired with the delta = 0.5 row of the same beta: equal counts
+    give p = 1; 95 against 127 of 256 (the band's counts at beta = -0.730, delta = 0.8 and 0.5)
+    p = 0.0056, the hypergeometric tail summed by hand below."""
+    from scipy.stats import hypergeom
+
+    rows = [{"delta": 0.5, "beta": -0.730, "members": 256, "limit": {"4": 127, "5": 125}},
+            {"delta": 0.8, "beta": -0.7301, "members": 256, "limit": {"4": 95, "5": 158}},
+            {"delta": 0.4, "beta": -0.7302, "members": 256, "limit": {"4": 127}},
+            {"delta": 0.4, "beta": -0.70, "members": 256, "limit": {"4": 1}}]         # no partner: left out
+    pairs = HV.equal_beta(rows)
+    assert [(q["delta"], q["share"]) for q in pairs] == [(0.8, 95 / 256), (0.4, 127 / 256)]     # by beta, falling
+    assert pairs[1]["p"] == pytest.approx(1.0)
+    dist = hypergeom(512, 222, 256)                  # 222 type-4 starts among 512, 256 drawn at delta 0.8
+    pmf = dist.pmf(np.arange(223))
+    by_hand = pmf[pmf <= dist.pmf(95) * (1 + 1e-7)].sum()
+    assert pairs[0]["p"] == pytest.approx(by_hand, rel=1e-6) and 0.004 < pairs[0]["p"] < 0.007

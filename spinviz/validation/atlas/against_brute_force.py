@@ -375,8 +375,34 @@ def format_basins(rows: list[dict]) -> str:
         out.append(f"| {r['delta']:g} | {r['chi_deg']:.2f}° | {r['beta']:.3f} | {pc(r['share_4'], r['ci_4'])} | "
                    f"{pc(r['share_5'], r['ci_5'])} | {r['other']} | {at} | {lock} |")
     n = rows[0]["members"] if rows else 0
-    return "\n".join(out + ["", f"{n} starts per point (|ω0| = {rows[0]['omega0'] if rows else 0:g}, τ_end = "
-                                f"{rows[0]['tau_end'] if rows else 0:.0e}); brackets: 95 % Clopper–Pearson intervals."])
+    out += ["", f"{n} starts per point (|ω0| = {rows[0]['omega0'] if rows else 0:g}, τ_end = "
+                f"{rows[0]['tau_end'] if rows else 0:.0e}); brackets: 95 % Clopper–Pearson intervals."]
+    pairs = equal_beta(rows)
+    if pairs:
+        out += ["", "At equal β, type 4's share against δ = "
+                f"{BAND_DELTA:g}'s (Fisher's exact test: p, the chance of counts as far apart from one share):", ""]
+        out += [f"* β = {q['beta']:.3f}: δ = {q['delta']:g} {100 * q['share']:.0f} % against {100 * q['share_band']:.0f} %, "
+                f"p = {q['p']:.2g}" for q in pairs]
+    return "\n".join(out)
+
+
+def equal_beta(rows: list[dict]) -> list[dict]:
+    """Each row off ``BAND_DELTA`` against the ``BAND_DELTA`` row of the same beta (within 1e-3):
+    type 4's two shares and Fisher's exact test of their counts -- whether the share is a
+    function of beta alone."""
+    from scipy.stats import fisher_exact
+
+    band = [r for r in rows if r["delta"] == BAND_DELTA]
+    out = []
+    for r in sorted((r for r in rows if r["delta"] != BAND_DELTA), key=lambda r: (-r["beta"], r["delta"])):
+        same = [b for b in band if abs(b["beta"] - r["beta"]) < 1e-3]
+        if not same:
+            continue
+        b = same[0]
+        k, kb = r["limit"].get("4", 0), b["limit"].get("4", 0)
+        p = float(fisher_exact([[k, r["members"] - k], [kb, b["members"] - kb]]).pvalue)
+        out.append({"beta": r["beta"], "delta": r["delta"], "share": k / r["members"], "share_band": kb / b["members"], "p": p})
+    return out
 
 
 # --- the averaged flows against full integration -------------------------------------------------

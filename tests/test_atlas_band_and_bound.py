@@ -73,8 +73,8 @@ def test_band_points_pair_equal_betas_on_two_deltas():
 
 
 def test_stated_bound_closed_form():
-    """BOUND_C mu_h^2 |(a, b)| + SMALL_C min(a, b) (mu_h^2 + int mu^2 d ln tau) + floor (+ type
-    1's drift): the smaller amplitude's share is what the first term alone misses."""
+    """BOUND_C mu_h^2 |(a, b)| + SMALL_C min(a, b) (mu_h^2 + int mu^2 d ln tau) / min(1, 1 - delta)
+    + floor (+ type 1's drift): the smaller amplitude's share is what the first term alone misses."""
     mu, a, b, i2 = 1e-2, 0.8, 0.06, 3e-4
     want = HO.BOUND_C * mu**2 * math.hypot(a, b) + HO.SMALL_C * b * (mu**2 + i2)
     assert HO.stated_bound(mu, a, b, i2) == pytest.approx(want, rel=1e-15)
@@ -83,6 +83,10 @@ def test_stated_bound_closed_form():
     assert HO.stated_bound(mu, a, b, i2, drift=(2e-3, 10.0)) == pytest.approx(
         want + HO.TYPE1_DRIFT_C * 4e-6 * b * 10.0, rel=1e-15)
     assert HO.stated_bound(mu, b, a, i2) == pytest.approx(want, rel=1e-15)       # symmetric in (a, b)
+    # J3 = 1 - delta divides the smaller amplitude's share where it is below 1, never shrinks it
+    assert HO.stated_bound(mu, a, b, i2, delta=0.9) == pytest.approx(
+        want + 9.0 * HO.SMALL_C * b * (mu**2 + i2), rel=1e-12)
+    assert HO.stated_bound(mu, a, b, i2, delta=-0.6) == pytest.approx(want, rel=1e-15)
 
 
 def test_eq_4_42_read_as_peak_and_as_rms():

@@ -32,15 +32,17 @@ J = (1, 1, 1 - delta), d = (sin chi, 0, cos chi) (dimensionless (4.1)):
    their hand-over and comparing the averaged amplitudes.  The stated bound of a run is
    ``stated_bound``: ``BOUND_C`` mu_h^2 |(a, b)|_end (the averaged flow's error with the
    transform: O(mu_h^2), measured, docs/atlas.md) + ``SMALL_C`` min(a, b)_end (mu_h^2 + int mu^2
-   d ln tau) (the smaller amplitude's own share, below) + that floor (+ on the axial state of
+   d ln tau) / min(1, 1 - delta) (the smaller amplitude's own share, below) + that floor (+ on the axial state of
    the reduced model the ln tau drift of type 1, ``TYPE1_DRIFT_C`` mu_end^2 |b| ln(tau_end/tau_h)).
    The second term: (LV) carries ln A and ln B, so the hand-over's O(mu_h^2) reading error and
    the second-order drift first-order averaging omits (O(mu^2) per unit ln tau, integrated
    along the averaged run) are shares of each amplitude, and the smaller one -- dying or slow
    along the attractor, omega3 on the transverse state, where b ~ tau^(beta + 1/2) stays ~0.1 a
-   for decades -- keeps its share undamped.  On the reduced transverse state that share is
-   0.2 ... 2.2 mu_h^2 b, b high (the drift: omega3's ln-rate is slower than (4.12)'s by O(mu^2)),
-   beyond the first term wherever b > 0.1 a.  Where the free
+   for decades -- keeps its share undamped.  On the reduced transverse state by the 3|4
+   boundary that share is b high by up to 0.4 mu_h^2 b at delta = 0.3, 0.9 at 0.5, 1.7 at 0.7,
+   6.7 at 0.9 (``validation.atlas.against_brute_force.margins``): ~0.3-0.7 mu_h^2 b / (1 - delta),
+   the torque's change of omega3 being divided by J3 = 1 - delta, so the term carries that
+   factor (measured, not derived: docs/atlas.md).  Where the free
    spiral -- the component that decides 1 versus 2 -- is below ``NOISE_FACTOR`` x the floor
    (or x the transform's own residual, 5 mu_h^2 |z_f|), the run says "spiral unresolved" and
    is not evidence for that decision.
@@ -78,7 +80,7 @@ HOLD_DECADES = 0.25         # ... held at every sample of this last stretch
 MIN_BRAKING_TIMES = 10.0    # never before tau = 10 T: the braking has to have begun
 MU_BACK = 3.0               # the averaged flow is trusted to MU_BACK x MU_STAR (hysteresis); beyond: back to full
 BOUND_C = 0.2               # error of the averaged amplitudes <= BOUND_C mu_h^2 |(a, b)| ...
-SMALL_C = 1.0               # ... + SMALL_C min(a, b) (mu_h^2 + int mu^2 d ln tau) (measured up to 0.75 of it)
+SMALL_C = 1.0               # ... + SMALL_C min(a, b) (mu_h^2 + int mu^2 d ln tau) / min(1, 1 - delta)
 TYPE1_DRIFT_C = 1.3         # type 1's (k1 + k2 ln tau)/tau drift of b, missed by first-order averaging (measured)
 NOISE_PROBES = 4            # handed-over runs per cell rerun at rtol/100 for the noise floor
 NOISE_FACTOR = 10.0         # a component below this x the floor is not resolved
@@ -448,13 +450,14 @@ def _records(batch, cells: list, starts: list) -> tuple[list, float]:
 
 
 def stated_bound(mu_h: float, a: float, b: float, mu2_int: float = 0.0, floor: float = math.nan,
-                 drift: tuple | None = None) -> float:
+                 drift: tuple | None = None, delta: float = 0.0) -> float:
     """The stated bound on the error of a handed-over run's averaged end amplitudes (a, b) =
     (abar, |bbar|) (module docstring): ``BOUND_C`` mu_h^2 |(a, b)| + ``SMALL_C`` min(a, b) (mu_h^2 +
-    ``mu2_int``) (``mu2_int``: int mu^2 d ln tau along the averaged run, ``averaged_stage``) + the
-    noise ``floor`` (NaN: not measured, 0) + type 1's drift ``TYPE1_DRIFT_C`` mu_end^2 b ln(tau_end
+    ``mu2_int``) / min(1, 1 - ``delta``) (``mu2_int``: int mu^2 d ln tau along the averaged run,
+    ``averaged_stage``; 1 - delta = J3, which divides the torque's change of omega3) + the noise
+    ``floor`` (NaN: not measured, 0) + type 1's drift ``TYPE1_DRIFT_C`` mu_end^2 b ln(tau_end
     / tau_h) when ``drift`` = (mu_end, ln(tau_end / tau_h)) is given (the reduced axial state)."""
-    bound = BOUND_C * mu_h**2 * math.hypot(a, b) + SMALL_C * min(a, b) * (mu_h**2 + mu2_int)
+    bound = BOUND_C * mu_h**2 * math.hypot(a, b) + SMALL_C * min(a, b) * (mu_h**2 + mu2_int) / min(1.0, 1.0 - delta)
     bound += floor if math.isfinite(floor) else 0.0
     if drift is not None:
         bound += TYPE1_DRIFT_C * drift[0] ** 2 * b * drift[1]
@@ -499,7 +502,7 @@ def handed_record(job: _Job, r: dict, state, floor: float, st, series: bool = Tr
     A, B = math.exp(lnA), math.exp(lnB)
     mu_end = float(flow.small_parameter_scaled(A, B, s[end]))
     drift = (mu_end, math.log(tau_end / t[0])) if state.name == "axial" and flow.model == "reduced" else None
-    bound = stated_bound(job.mu_h, math.sqrt(A), math.sqrt(B), r["mu2_int"], floor, drift)
+    bound = stated_bound(job.mu_h, math.sqrt(A), math.sqrt(B), r["mu2_int"], floor, drift, flow.delta)
     limit = {"tau_handover": float(t[0]), "mu_handover": job.mu_h, "bound": bound, "abar_end": math.sqrt(A),
              "bbar_end": r["sign_b"] * math.sqrt(B), "free_forced_ratio": lim["ratio"], "tau_1_2": crossing(flow, r, tau),
              "limit_settled": int(lim["settled"] and lim["label_inf"] != "other"), "decades_to_settle": lim["decades"],

@@ -83,7 +83,7 @@ LIMIT = {
     "mu_handover": "the averaged flow's small parameter mu = |omega|^2/|delta omega3| (x max(1, |omega|/|omega3|), "
                    "reduced) at the hand-over",
     "bound": "stated bound on the error of abar_end, bbar_end: 0.2 mu_handover^2 |(a, b)| + min(a, b) (mu_handover^2 + "
-             "int mu^2 d ln tau) + noise_floor (+ type 1's ln tau drift on the reduced axial state)",
+             "int mu^2 d ln tau) / min(1, 1 - delta) + noise_floor (+ type 1's ln tau drift on the reduced axial state)",
     "abar_end": "averaged omega_perp sqrt(tau) at tau_end (through the near-identity transform; NaN where it does not hold)",
     "bbar_end": "averaged omega3 sqrt(tau) at tau_end, signed",
     "free_forced_ratio": "free spiral / forced response of omega_perp at tau_end (reduced axial state: type 2's part "

@@ -189,8 +189,8 @@ def format_table(rows: list[dict]) -> str:
 MARGIN_TOL = 1e-15             # the references' tolerance (scalar Taylor on the scaled variable)
 
 
-SCAN_DELTA = (0.3, 0.5, 0.7, 0.9)
-SCAN_BETA = (-0.55, -0.6, -0.65, -0.7)
+SCAN_DELTA = (0.3, 0.5, 0.7, 0.9, 0.95, 0.98)
+SCAN_BETA = (-0.52, -0.55, -0.6, -0.65, -0.7)
 
 
 def bound_points() -> list[tuple]:
@@ -440,7 +440,7 @@ def flows(cells=FLOW_CELLS, mus=FLOW_MU, tau_f: float = 1e10, tol: float = 1e-15
             a, b = math.exp(0.5 * r["lnA"][-1]), math.exp(0.5 * r["lnB"][-1])
             err = max(abs(a - a_ref), abs(b - b_ref))
             pts.append({"mu_h": float(mu[i]), "tau_h": float(tau[i]), "error": err,
-                        "bound": HO.stated_bound(float(mu[i]), a, b, r["mu2_int"]), "error_over_mu2": err / mu[i] ** 2})
+                        "bound": HO.stated_bound(float(mu[i]), a, b, r["mu2_int"], delta=d), "error_over_mu2": err / mu[i] ** 2})
         order = float(np.polyfit(np.log([p["mu_h"] for p in pts]), np.log([p["error"] for p in pts]), 1)[0])
         rows.append({"model": model, "delta": d, "chi_deg": math.degrees(chi), "type": what, "tau_f": tau_f,
                      "order": order, "points": pts, "seconds": time.perf_counter() - t0,

@@ -123,29 +123,37 @@ def test_label_at_tau_end_is_the_states_and_the_limit_the_attractors():
 
 
 @pytest.mark.slow
-def test_stated_bound_holds_by_the_3_4_boundary():
-    """At (0.7, 29 deg), beta(4.18) = -0.60, the transverse state's omega3 dies as tau^-0.1, so
-    b stays ~0.05-0.1 a for decades, and the averaged flow's error of b is a share of b itself
-    (up to ~2 mu_h^2 b, of one sign: b high) -- beyond 0.2 mu_h^2 |(a, b)|, which it reached 0.7
-    times for these starts.  Against tol-1e-15 references at 1e10 every handed-over run is
-    within the stated bound, with the margin docs/atlas.md states (<= 0.5 of it)."""
-    from spinviz.validation.atlas.against_brute_force import full_run
+@pytest.mark.parametrize("delta, beta, margin", [(0.7, -0.6, 0.3), (0.95, -0.52, 0.35)])   # measured 0.13, 0.18
+def test_stated_bound_holds_by_the_3_4_boundary(delta, beta, margin):
+    """By the 3|4 boundary the transverse state's omega3 dies as tau^(beta + 1/2), so b stays
+    ~0.05-0.2 a for decades, and the averaged flow's error of b is a share of b itself, of one
+    sign (b high), growing as ~1/(1 - delta): at (0.7, 29 deg) beyond 0.2 mu_h^2 |(a, b)|'s
+    reach for b, at delta = 0.95 beyond the bound without the 1/J3 factor.  Against tol-1e-15
+    references at 1e10, every handed-over run is within the stated bound, with the margin
+    docs/atlas.md states; at delta = 0.95 the bound without the factor is exceeded."""
+    from spinviz.validation.atlas.against_brute_force import chi_at_beta, full_run
 
-    d, chi, tau_end = 0.7, math.radians(29.0), 1e10
+    chi, tau_end = chi_at_beta(delta, beta), 1e10
     starts = directions(8, 2) * 0.1
-    recs = HO.cell_records("reduced", d, chi, starts, Settings(tau_end=tau_end, rtol=1e-8))
-    f = AV.Flow("reduced", d, chi)
-    over, high = [], []
+    recs = HO.cell_records("reduced", delta, chi, starts, Settings(tau_end=tau_end, rtol=1e-8))
+    f = AV.Flow("reduced", delta, chi)
+    over, high, flat = [], [], []
     for k, r in enumerate(recs):
         lim = r.limit or {}
         if not math.isfinite(lim.get("tau_handover", math.nan)):
             continue
-        w = full_run("reduced", d, chi, starts[k], [tau_end])[-1]
+        w = full_run("reduced", delta, chi, starts[k], [tau_end])[-1]
         a, b = AV.scaled_amplitudes(f, w[0] + 1j * w[1], w[2], tau_end)
-        over.append(max(abs(lim["abar_end"] - a), abs(abs(lim["bbar_end"]) - b)) / lim["bound"])
+        err = max(abs(lim["abar_end"] - a), abs(abs(lim["bbar_end"]) - b))
+        over.append(err / lim["bound"])
         high.append(abs(lim["bbar_end"]) > b)
+        floor = lim["noise_floor"] if math.isfinite(lim["noise_floor"]) else 0.0
+        first = HO.BOUND_C * lim["mu_handover"] ** 2 * math.hypot(lim["abar_end"], lim["bbar_end"]) + floor
+        flat.append(err / (first + (lim["bound"] - first) * (1.0 - delta)))    # the same bound with J3 taken as 1
     assert len(over) >= 6 and all(high)
-    assert max(over) <= 0.5, over
+    assert max(over) <= margin, over
+    if delta > 0.9:
+        assert max(flat) > 1.0, flat
 
 
 def test_cells_where_averaging_cannot_last_stay_in_full():

@@ -8,6 +8,7 @@ import pytest
 import xarray as xr
 
 from spinviz.physics import asymptotics as FM
+from spinviz.regimes import TYPE_CODES
 from spinviz.regimes.figures import hodographs as HG
 from spinviz.validation.atlas.validate import spinviz_domain
 
@@ -57,3 +58,27 @@ def test_every_type_is_shown_from_deep_inside_its_domain(diagram):
     _, _, d, c, *_ = next(r for r in reps if r[1] == "3")
     alpha, beta = FM.type2_eq4_14(d, c)["alpha"], FM.type4_eq4_18(d, c)["beta"]
     assert alpha + 0.5 > 0.1 and beta + 0.5 > 0.1, (d, math.degrees(c), alpha, beta)
+
+
+def test_the_figure_atlas_hodographs_show_type_3_away_from_its_boundaries():
+    """The committed extract of the figure atlas (what the docs' hodographs are drawn from):
+    its type-3 panel comes from a cell more than 0.1 in the exponents from alpha(4.14) = -1/2
+    and beta(4.18) = -1/2, at least MARGIN_CELLS inside its domain, and the extract keeps that
+    run's series (the picture is drawn from it, not integrated again)."""
+    from pathlib import Path
+
+    saved = np.load(Path(__file__).resolve().parents[1] / "examples" / "data" / "atlas_figure_labels.npz")
+    names = {code: name for name, code in TYPE_CODES.items()}
+    dims = ("model", "delta", "chi", "member")
+    decode = np.vectorize(names.get, otypes=[str])
+    ds = xr.Dataset({"label": (dims, decode(saved["regime_0"])), "limit_label": (dims, decode(saved["label_inf_0"])),
+                     "candidate": (dims, saved["candidate_0"]), "confidence": (dims, saved["confidence"]),
+                     "series": (("model", "delta", "chi", "start", "sample", "axis"), saved["series"])},
+                    coords={"model": saved["models"], "delta": saved["delta_0"], "chi": saved["chi_0"],
+                            "member": np.arange(saved["regime_0"].shape[-1]), "start": np.arange(saved["series"].shape[3])})
+    reps = {(r[0], r[1]): r for r in HG.representatives(ds)}
+    model, _, d, c, k, _, deep = reps[("reduced", "3")]
+    alpha, beta = FM.type2_eq4_14(d, c)["alpha"], FM.type4_eq4_18(d, c)["beta"]
+    assert alpha + 0.5 > 0.1 and beta + 0.5 > 0.1 and deep >= HG.MARGIN_CELLS, (d, math.degrees(c), alpha, beta, deep)
+    i, j = list(ds["delta"].values).index(d), list(ds["chi"].values).index(c)
+    assert np.isfinite(saved["series"][list(saved["models"]).index(model), i, j, k]).all()

@@ -148,8 +148,8 @@ def hodographs(ds, path: str):
         ax.tick_params(labelsize=6, pad=-3)
         ax.locator_params(nbins=4)
         unit = "  (\u03c9/|\u03c9\u2080|)" if name == "R" else ""
-        after = f"; averaged flow from \u03c4 = {t_h:.0e} (ring)" if handed else ""
-        inside = f"; {deep:.1f} cells inside" if deep > 0 else ""
+        after = f"\naveraged flow from \u03c4 = {t_h:.0e} (ring)" if handed else ""
+        inside = f", {deep:.1f} cells inside" if deep > 0 else ""
         ax.set_title(f"{model} \"{name}\"  \u03b4={d:+.2f} \u03c7={math.degrees(c):.1f}\u00b0{unit}\n"
                      f"confidence {conf:.2f}{inside}{after}", fontsize=8)
     note = ("\nafter a hand-over (black ring) the samples are the averaged flow's: the amplitudes are the run's "

@@ -413,7 +413,7 @@ def verify(path: str) -> IN.Report:
 
 
 # The first classifier version whose ``regime`` of a handed-over run is what its state shows at
-# tau_end; before it, a hand-over store recorded the attractor there (``label_inf``'s value)
+# tau_end; a hand-over store of an earlier version holds the attractor there (``label_inf``'s value)
 STATE_LABELS_SINCE = 4
 
 

@@ -310,3 +310,34 @@ def test_lanes_idle_and_busy_to_tau_1e20():
     assert [r.label for r in recs] == ["T4"] * 8
     tau_h = np.array([r.limit.get("tau_handover", np.nan) for r in recs])
     assert np.isnan(tau_h).sum() >= 1 and np.nanmax(tau_h) > 1e17 and np.nanmin(tau_h) < 1e8
+
+
+def test_a_store_whose_label_at_tau_end_is_the_attractor_is_refused(monkeypatch):
+    """A hand-over store of a classifier before ``STATE_LABELS_SINCE`` holds the attractor in
+    ``regime``: ``open_atlas`` refuses it in one line naming the store and the version, rather
+    than read it as the state at tau_end; one without handed-over runs, or of this version, opens."""
+    import xarray as xr
+
+    from spinviz.errors import UsageError
+    from spinviz.regimes.store import dataset as DS
+
+    def store(version, handed):
+        method = np.full((1, 1, 1, 2), RN.METHOD_CODE[RN.HANDED_OVER] if handed else 0, dtype=np.int8)
+        dims = ("model", "delta", "chi", "member")
+        return xr.Dataset({"method": (dims, method), "tau_handover": (dims, np.ones(method.shape)),
+                           "regime": (dims, np.full(method.shape, C.CODE["3"], dtype=np.int8))},
+                          attrs={"classifier_version": version})
+
+    for version, handed, refused in [(3, True, True), (3, False, False), (C.VERSION, True, False)]:
+        monkeypatch.setattr(xr, "open_zarr", lambda path, v=version, h=handed: store(v, h))
+        if refused:
+            with pytest.raises(UsageError, match=r"old\.zarr: an atlas of classifier version 3, whose label at tau_end "
+                                                 r"of a handed-over run is its attractor's"):
+                DS.open_atlas("old.zarr")
+        else:
+            try:
+                DS.open_atlas("new.zarr")
+            except UsageError as e:                              # the refusal is the only thing tested here
+                pytest.fail(str(e))
+            except Exception:                                    # noqa: BLE001 -- a partial fake store past that check
+                pass

@@ -53,6 +53,8 @@ _API = {
     "compare": ("experiment", "compare"),
     "observe": ("experiment", "observe"),
     "decide": ("experiment", "decide"),
+    "requirements": ("experiment", "requirements"),
+    "Environment": ("inputs.environment", "EnvironmentSpec"),
     "listen": ("experiment", "listen"),
 }
 _SUBMODULES = {

@@ -54,6 +54,7 @@ def simulate(
     atol: float | None = None,
     step: float | None = None,
     kinematics: str = "quaternion",
+    environment=None,
 ) -> Trajectory:
     """Integrate the Euler equation of ``model`` with orientation; return a ``Trajectory``.
 
@@ -89,6 +90,11 @@ def simulate(
     kinematics : {"quaternion", "euler_zxz", "none"}
         "quaternion" (default); "euler_zxz", the Poisson equations (6.4), for comparison
         (singular at theta = 0); "none", no orientation (the Euler equation only).
+    environment : spinviz.Environment or dict, optional
+        The trap (``inputs.environment``): a residual gas (``pressure_mbar``, ``gas``, ...)
+        whose collisions act at their random instants (reproduced by its ``seed``) and a
+        static field ``field_v_per_m`` (world frame).  A CGS body with a surface; None (the
+        default) or all zero is the perfect vacuum, bit for bit.
 
     Returns
     -------
@@ -108,7 +114,8 @@ def simulate(
     """
     return simulate_request(SimulationRequest(
         body=body, model=model, omega0=omega0, t_end=t_end, samples=samples, t_eval=t_eval, q0=q0,
-        euler_zxz0=euler_zxz0, method=method, rtol=rtol, atol=atol, step=step, kinematics=kinematics))
+        euler_zxz0=euler_zxz0, method=method, rtol=rtol, atol=atol, step=step, kinematics=kinematics,
+        environment=environment))
 
 
 def simulate_request(request: SimulationRequest) -> Trajectory:
@@ -138,9 +145,15 @@ def simulate_request(request: SimulationRequest) -> Trajectory:
     if method not in HANDOVERS:
         _check_method(method, body, kinematics)
     start = time.perf_counter()
+    env = request.environment if request.environment is not None and request.environment.active else None
     try:
-        sol, name, reason = solve(problem, method, rtol=rtol, atol=atol, step=None if step is None else step * time_scale,
-                                  auto=auto, reason=reason, resolvable=resolvable)
+        if env is not None:
+            sol, name, reason = _solve_in_environment(problem, method, env, body, eps, rtol, atol,
+                                                      None if step is None else step * time_scale, reason)
+        else:
+            sol, name, reason = solve(problem, method, rtol=rtol, atol=atol,
+                                      step=None if step is None else step * time_scale, auto=auto, reason=reason,
+                                      resolvable=resolvable)
     except SpinvizError:
         raise
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as e:
@@ -159,8 +172,31 @@ def simulate_request(request: SimulationRequest) -> Trajectory:
         stats["accuracy_notes"] = notes
     if step is not None:
         stats["step"] = step
+    if env is not None:
+        stats["environment"] = env.record()
     return Trajectory(t=t_eval, omega=U.omega_from_dimensionless(sol.omega * eps, body.tau0), q=sol.q,
                       euler=sol.euler, body=body, model=model, stats=stats, slow=sol.slow)
+
+
+def _solve_in_environment(problem, method: str, env, body: Body, eps: float, rtol: float, atol: float, step, reason):
+    """``solve`` for a run in a trap (``integrators.environment``): the environment in the
+    integrators' terms -- CGS, the spin unit |Omega0| = eps / tau0 -- and its random stream
+    from the environment's seed."""
+    from .integrators.environment import solve_in_environment
+    from .integrators.taylor_env import EnvRun
+
+    gas = env.gas_model()
+    surface = None
+    if gas is not None:
+        from .physics.surface import surface_of
+
+        surface = surface_of(body)
+    run = EnvRun(gas, surface, tuple(body.inertia), tuple(body.dipole), env.field_cgs(), eps / body.tau0,
+                 np.random.default_rng(env.seed))
+    sol, name, reason = solve_in_environment(problem, method, run, rtol=rtol, atol=atol, step=step, reason=reason)
+    if sol.success:
+        _check_finite(sol)
+    return sol, name, reason
 
 
 def accuracy_notes(method: str, rtol: float, atol: float) -> list[str]:

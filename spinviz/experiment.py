@@ -9,7 +9,9 @@ argument is a ``SpecError`` naming it, a scene that lacks what the command needs
 ``SceneError`` naming its file and key.  The command line calls these very functions.
 
 Receiver keywords (``distance_cm=``, ``integration_s=``, any key of
-``inputs.receiver.DETECTOR_KEYS``) override the scene's ``[observe]`` keys of the same name.
+``inputs.receiver.DETECTOR_KEYS``) override the scene's ``[observe]`` keys of the same name;
+environment keywords (``pressure_mbar=``, ``field_v_per_m=``, any key of ``ENVIRONMENT_KEYS``)
+its ``[environment]``'s.
 """
 
 from __future__ import annotations
@@ -19,9 +21,23 @@ import os
 
 from .errors import SpecError
 
-__all__ = ["compare", "observe", "decide", "listen", "test_measurements", "receiver_of"]
+__all__ = ["compare", "observe", "decide", "requirements", "listen", "test_measurements", "receiver_of"]
 
 DASK_TRIALS = 2000            # from this many trials (or with a scheduler) decide runs on Dask
+# the [environment] keys observe and decide take as keywords (the command line's options)
+ENVIRONMENT_KEYS = ("pressure_mbar", "gas", "gas_temperature_k", "accommodation", "body_temperature_k",
+                    "field_v_per_m")
+
+
+def _split(options: dict) -> tuple[dict, dict]:
+    """(receiver keywords, environment keywords) of a front door's keywords."""
+    env = {k: options.pop(k) for k in list(options) if k in ENVIRONMENT_KEYS}
+    return options, env
+
+
+def _with_environment(sc, env: dict):
+    """The scene with the environment keywords given (``Scene.with_environment``)."""
+    return sc.with_environment(**env) if any(v is not None for v in env.values()) else sc
 
 
 def _scene(source):
@@ -94,12 +110,20 @@ def observe(scene, *, samples: int = 800, line_of_sight=None, plots: str | None 
     from .inputs.experiment import ObserveRequest
 
     req = ObserveRequest(samples=samples, line_of_sight=line_of_sight)
+    receiver, env = _split(receiver)
     sc = _scene(scene)
     rx = receiver_of(sc, **receiver)
-    sc.require("observe")
+    sc = _with_environment(sc, env)
+    try:
+        sc.require("observe")
+    except SpecError as e:
+        raise _environment_error(e, sc, env) from None
     names = ["observe", "detector"] + (["receiver"] if sc.units == "cgs" else [])
     group = _plots(sc, [f"{plots}_{n}.png" for n in names]) if plots is not None else None
-    obs, _ = OB.run_scene(sc, req.samples, req.line_of_sight, rx)
+    try:
+        obs, _ = OB.run_scene(sc, req.samples, req.line_of_sight, rx)
+    except SpecError as e:
+        raise _environment_error(e, sc, env) from None
     if group is not None:
         from .analysis import experiment_plots as EP
         from .analysis import observe_plots as OP
@@ -110,6 +134,23 @@ def observe(scene, *, samples: int = 800, line_of_sight=None, plots: str | None 
             if len(tmps) > 2:
                 EP.plot_receiver(obs, tmps[2])
     return obs
+
+
+def _environment_error(e: SpecError, sc, env: dict) -> SpecError:
+    """A run's refusal in a trap, blamed on the environment key that made it (the option given,
+    or the scene's): a horizon the gas makes unaffordable is the pressure's."""
+    if not sc.environment.active:
+        return e
+    key = e.key.split(".", 1)[1] if e.key.startswith("environment.") else None
+    if key is None and e.key in ("t_eval", "t_end", "samples") and "gas" in e.reason:
+        key = "pressure_mbar"
+    if key is None:
+        return e
+    if env.get(key) is not None:
+        return SpecError(key, e.reason)
+    from .errors import SceneError
+
+    return SceneError(sc.path, f"[environment].{key}", e.reason)
 
 
 def listen(scene, out: str, *, png: str | None = None, duration: float = 20.0, f0: float = 440.0,
@@ -133,23 +174,28 @@ def listen(scene, out: str, *, png: str | None = None, duration: float = 20.0, f
 
 
 def decide(scene, *, trials: int = 200, seed: int = 1, spin_range=(0.5, 2.0), tau0: str = "known",
-           workers: int | None = None, scheduler: str | None = None, plot: str | None = None, say=None, **receiver):
+           workers: int | None = None, scheduler: str | None = None, plot: str | None = None, say=None,
+           tau0_prior: float = 0.0, gain_slope: float = 0.0, clock_stability: float = 0.0,
+           pressure_prior: float = 1.0, **options):
     """How long to watch: a Monte Carlo over noise and unknown starts of the time a
     likelihood-ratio test needs to tell the scene's two models apart at 5 sigma in 95 % of
     trials (``analysis.decide.Outcome``; ``.table()`` for people, ``.record()`` for JSON).
+
+    What must be known (``analysis.nuisance``): ``tau0_prior`` (tau0's relative width; 0:
+    known), ``gain_slope`` (the antenna's, dB per octave, 1 sigma), ``clock_stability`` (the
+    reference's fractional stability), ``pressure_prior`` (the pressure's relative width), and
+    the trap: the scene's ``[environment]`` with the environment keywords in place of its keys.
+    All zero (and no gas or field): the perfect experiment, exactly as without them.
 
     Runs on worker processes of this machine (``workers``, default one per core), or on Dask
     from ``DASK_TRIALS`` trials or with ``scheduler`` (an existing cluster's address);
     ``say(text)``, if given, hears where it runs.  plot : a PNG path for the share of trials
     decided against observation time, written atomically."""
     from .analysis import decide as DC
-    from .inputs.decide import DecideArguments
 
-    spec = DecideArguments(trials=trials, seed=seed, spin_range=spin_range, tau0=tau0, workers=workers,
-                           scheduler=scheduler)
-    sc = _scene(scene)
-    rx = receiver_of(sc, **receiver)
-    setup = DC.setup_from_scene(sc.require("decide"), rx, sc.observe.t_end or sc.t_end, spec.spin_range, spec.tau0)
+    spec, sc, rx = _decide_request(scene, trials, seed, spin_range, tau0, workers, scheduler, tau0_prior, gain_slope,
+                                   clock_stability, pressure_prior, False, options)
+    setup = _decide_setup(sc, rx, spec)
     DC.check_work(setup, spec.trials, _workers(spec))          # SPINVIZ_MAX_DAYS, before any trial
     group = _plots(sc, [plot]) if plot is not None else None
     with contextlib.ExitStack() as stack:
@@ -162,6 +208,71 @@ def decide(scene, *, trials: int = 200, seed: int = 1, spin_range=(0.5, 2.0), ta
         with group as (tmp,):
             plot_decide(outcome, sc.title, tmp)
     return outcome
+
+
+def requirements(scene, *, trials: int = 100, seed: int = 1, spin_range=(0.5, 2.0), workers: int | None = None,
+                 scheduler: str | None = None, plot: str | None = None, say=None, tau0_prior: float = 0.0,
+                 gain_slope: float = 0.0, clock_stability: float = 0.0, pressure_prior: float = 1.0, **options):
+    """What the trap must achieve (``analysis.requirements.Requirements``): the largest pressure,
+    field, tau0 prior, gain slope and clock instability at which 95 % of ``decide``'s trials
+    still decide within the horizon, each with the others at their stated values (the
+    keywords, and the scene's ``[environment]``).  Its work is estimated first and refused
+    above ``SPINVIZ_MAX_DAYS`` (``inputs.options.check_work``).  plot : a PNG path for the
+    decision time against pressure, written atomically; ``.table()`` for people,
+    ``.record()`` for JSON."""
+    from .analysis import requirements as RQ
+    from .inputs.options import check_work
+
+    spec, sc, rx = _decide_request(scene, trials, seed, spin_range, "known", workers, scheduler, tau0_prior,
+                                   gain_slope, clock_stability, pressure_prior, True, options)
+    from .executors.processes import usable_cores
+
+    seconds = RQ.work_seconds(spec.trials, spec.workers or usable_cores())
+    check_work("trials", seconds, f"the requirements' Monte Carlo of {spec.trials} trials at every value probed")
+    if say is not None:
+        say(f"requirements: at most ~{seconds / 3600:.2g} h of work estimated")
+    stated = {"pressure_mbar": sc.environment.pressure_mbar, "field_v_per_m": sc.environment.field_magnitude_v_per_m,
+              "tau0_prior": spec.tau0_prior, "gain_slope": spec.gain_slope, "clock_stability": spec.clock_stability,
+              "pressure_prior": spec.pressure_prior}
+    group = _plots(sc, [plot]) if plot is not None else None
+    with contextlib.ExitStack() as stack:
+        mapper = _mapper(stack, spec, say)
+        req = RQ.run(sc.require("decide"), rx, stated, spec.trials, spec.seed, spec.spin_range, mapper, say)
+    if group is not None:
+        from .analysis.requirement_plots import plot_requirements
+
+        with group as (tmp,):
+            plot_requirements(req, tmp)
+    return req
+
+
+def _decide_request(scene, trials, seed, spin_range, tau0, workers, scheduler, tau0_prior, gain_slope, clock_stability,
+                    pressure_prior, requirements, options):
+    """decide's and requirements' arguments checked once: (DecideArguments, scene in its
+    environment, receiver)."""
+    from .inputs.decide import DecideArguments
+
+    spec = DecideArguments(trials=trials, seed=seed, spin_range=spin_range, tau0=tau0, workers=workers,
+                           scheduler=scheduler, tau0_prior=tau0_prior, gain_slope=gain_slope,
+                           clock_stability=clock_stability, pressure_prior=pressure_prior, requirements=requirements)
+    receiver, env = _split(dict(options))
+    sc = _scene(scene)
+    rx = receiver_of(sc, **receiver)
+    sc = _with_environment(sc, env)
+    return spec, sc, rx
+
+
+def _decide_setup(sc, rx, spec):
+    """decide's ``Setup``, with its nuisances when there are any."""
+    import dataclasses
+
+    from .analysis import decide as DC
+    from .analysis import nuisance as NU
+
+    setup = DC.setup_from_scene(sc.require("decide"), rx, sc.observe.t_end or sc.t_end, spec.spin_range, spec.tau0)
+    nu = NU.from_scene(sc, tau0_width=spec.tau0_prior, gain_slope_db=spec.gain_slope, clock=spec.clock_stability,
+                       pressure_width=spec.pressure_prior)
+    return dataclasses.replace(setup, nuisance=nu) if nu.active else setup
 
 
 def _mapper(stack: contextlib.ExitStack, spec, say):

@@ -58,8 +58,9 @@ class Trajectory:
         ``secular``.
     slow : dict or None
         For ``secular`` runs, the slow geometry: q_L (4,) taking world z to the fixed
-        L_world, and (N,) arrays theta_L (nutation of e3 from L), phi_L (precession phase) and
-        psi_L (spin phase), rad.
+        L_world -- or (N, 4), one per instant, where a trap's gas or field moves L -- and (N,)
+        arrays theta_L (nutation of e3 from L), phi_L (precession phase) and psi_L (spin
+        phase), rad.
 
     Notes
     -----
@@ -259,6 +260,9 @@ class Trajectory:
         slow = None
         if self.slow is not None:
             slow = {k: (np.interp(times, t, v) if k in SLOW_SERIES else v) for k, v in self.slow.items()}
+            q_L = np.asarray(self.slow.get("q_L", ()), dtype=float)
+            if q_L.ndim == 2:                   # L moves over the run (a trap's gas or field): one per instant
+                slow["q_L"] = R.slerp_series(t, q_L, times)
         return replace(self, t=times, omega=omega, q=q, euler=euler, slow=slow)
 
     # -- people and notebooks ------------------------------------------------------------

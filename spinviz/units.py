@@ -184,3 +184,17 @@ def erg_per_s_from_w(x_w):
 def wavelength_cm(f_hz):
     """The free-space wavelength c / f of a line at f Hz, cm."""
     return C_LIGHT / np.asarray(f_hz, dtype=float)
+
+
+# --- a trap's environment ---------------------------------------------------------------------
+DYN_PER_CM2_IN_MBAR = 1.0e3      # 1 mbar = 100 Pa = 1000 dyn/cm^2
+
+
+def pressure_from_mbar(p_mbar):
+    """A pressure in mbar as dyn/cm^2 (erg/cm^3): 1 mbar = 1000 dyn/cm^2."""
+    return np.asarray(p_mbar, dtype=float) * DYN_PER_CM2_IN_MBAR
+
+
+def field_from_v_per_m(e_v_per_m):
+    """An electric field in V/m as statV/cm (Gaussian): 1 statV/cm = 29979.2458 V/m."""
+    return np.asarray(e_v_per_m, dtype=float) / STATV_PER_CM_IN_V_PER_M

@@ -91,13 +91,23 @@ def refined_atlas(tmp_path_factory):
     return Refined(spec=spec, store=store, made={})
 
 
-# Hypothesis: deterministic and bounded in CI; HYPOTHESIS_PROFILE=fuzz for a long random hunt.
+# Hypothesis, deterministic and bounded: a few examples each in the README's test command
+# ("quick"), 60 in .ci/run's second pass (HYPOTHESIS_PROFILE=ci, over the tests marked slow or
+# fuzz); HYPOTHESIS_PROFILE=fuzz for a long random hunt.  Every test that draws its examples
+# from Hypothesis is marked fuzz here, so that pass finds them all.
 from hypothesis import HealthCheck, settings  # noqa: E402
 
 _quiet = [HealthCheck.function_scoped_fixture, HealthCheck.too_slow]
+settings.register_profile("quick", max_examples=8, derandomize=True, deadline=None, suppress_health_check=_quiet)
 settings.register_profile("ci", max_examples=60, derandomize=True, deadline=None, suppress_health_check=_quiet)
 settings.register_profile("fuzz", max_examples=3000, deadline=None, suppress_health_check=_quiet)
-settings.load_profile(__import__("os").environ.get("HYPOTHESIS_PROFILE", "ci"))
+settings.load_profile(__import__("os").environ.get("HYPOTHESIS_PROFILE", "quick"))
+
+
+def pytest_collection_modifyitems(items):
+    for item in items:
+        if getattr(getattr(item, "obj", None), "is_hypothesis_test", False):
+            item.add_marker(pytest.mark.fuzz)
 
 
 @pytest.fixture(scope="session")

@@ -157,6 +157,7 @@ def _median(recs, key):
     return float(np.median([r.evidence[C.EVIDENCE.index(key)] for r in recs]))
 
 
+@pytest.mark.slow
 def test_domain_2_spiral_alpha_above_minus_one():
     """(0.5, 22 deg): in (4.15), alpha = -0.60 > -1: type 2 for every member; alpha within
     0.03 and B^2 within 3 % of (4.14) (at 1e10 the runs are still converging: -0.608, 1.763)."""

@@ -48,6 +48,7 @@ def same_numbers(a, b):
     assert da.attrs == db.attrs
 
 
+@pytest.mark.slow
 def test_store_opens_with_plain_xarray(reference):
     """Plain ``xarray.open_zarr``: dims, every run done, the spec and version recorded, the
     labels readable through their flag meanings."""
@@ -94,6 +95,7 @@ def test_interrupted_then_resumed_store_is_identical(spec_path, reference, tmp_p
     assert again.computed == 0 and again.reused == 36 and again.cluster == "nothing to compute"
 
 
+@pytest.mark.slow
 def test_store_of_another_spec_is_refused(spec_path, reference, tmp_path):
     other = tmp_path / "other.toml"
     other.write_text(SPEC.replace("seed = 5", "seed = 6"))

@@ -83,6 +83,7 @@ def test_each_kind_is_a_sub_command_with_exactly_its_options(kind, capsys):
         assert e.value.code == 2 and f"unrecognized arguments: {missing[0]}" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_tolerance_rows_against_the_tightest_rtol():
     """The tightest rtol is its own reference (all labels the same, end states identical);
     a looser one moves the end states more than a tighter one does."""

@@ -36,6 +36,9 @@ from spinviz.regimes.faults import AtlasIncomplete, StoreDamaged
 from spinviz.regimes.store import dataset as DS
 from spinviz.regimes.store import integrity, levels
 
+# every test here reads or breaks the small atlas computed once (~1 s) or starts a cluster: .ci/run's second pass
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""), "PYTHONUNBUFFERED": "1"}
 DASK = str(Path(sys.executable).parent / "dask")

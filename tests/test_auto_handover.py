@@ -73,6 +73,7 @@ def test_long_run_of_a_slow_top_is_handed_over_and_says_so():
     assert np.all(np.diff(slow_variables(tr)[:, 3]) < 0.0)
 
 
+@pytest.mark.slow
 def test_handover_agrees_with_a_full_taylor_run(monkeypatch):
     """~3e4 turns (affordable in full): the composite, made auto's pick below 1e6 turns for the
     test, against Taylor's method at rtol 1e-12 at instants spread over five decades, each slow

@@ -93,6 +93,7 @@ def test_results_do_not_depend_on_batching_or_processes(cube_setup):
     json.dumps(a.record(), allow_nan=False)                # strict JSON: None for never
 
 
+@pytest.mark.slow
 def test_z_stays_above_five_after_the_decision(cube_setup):
     """The bisection takes Z to grow with the observation: at twice each trial's decision time Z is
     still at least 5 (two trials, both truths)."""
@@ -138,6 +139,7 @@ def test_the_five_sigma_time_is_stable_against_the_monte_carlo_size(cube_setup):
         assert math.log(ib[1] / ib[0]) < math.log(ia[1] / ia[0])
 
 
+@pytest.mark.slow
 def test_quantile_interval_covers_the_quantile():
     """The order-statistic interval holds the true 95 % quantile of a known distribution in at
     least its level of repeated samples, and not much more once the trials are many (1000 samples

@@ -87,7 +87,7 @@ def receiver_value(key):
 
 
 # --- the model registry ---------------------------------------------------------------------------
-@settings(max_examples=max(20, settings.default.max_examples // 3))
+@settings(max_examples=max(2, settings.default.max_examples // 3))
 @given(name=hostile)
 def test_any_name_gets_a_model_or_one_line(name):
     try:
@@ -200,7 +200,7 @@ def arguments(fn) -> list[str]:
 
 
 @pytest.mark.parametrize("door", sorted(DOORS))
-@settings(max_examples=max(20, settings.default.max_examples // 3))          # each example reads a scene
+@settings(max_examples=max(2, settings.default.max_examples // 3))          # each example reads a scene
 @given(data=st.data())
 def test_any_arguments_to_a_front_door_get_the_work_or_one_line(world, door, data):
     fn = DOORS[door]

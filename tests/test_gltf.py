@@ -134,6 +134,7 @@ def test_componentwise_interpolation_is_held_to_the_tolerance_too():
 
 
 # --- the glTF file --------------------------------------------------------------------------
+@pytest.mark.slow
 def test_glb_reread_holds_the_videos_poses(model, plan):
     """Reread with pygltflib: the body's rotation keyframes (x, y, z, w) are the video's poses
     at the keyframe frames to 1e-6 rad; slerp and component-wise interpolation between them
@@ -167,6 +168,7 @@ def test_glb_reread_holds_the_videos_poses(model, plan):
         np.testing.assert_allclose(R.world_from_body(wxyz(world.rotation), [0.0, 0.0, 1.0]), [0.0, 1.0, 0.0], atol=1e-12)
 
 
+@pytest.mark.slow
 def test_extras_clock_is_the_keyframes_own(model, plan):
     """The extras' clock is the one the keyframes keep: every keyframe's time is float32(f /
     fps) exactly, f its video frame; the stated map gives its physical time, and the last
@@ -187,6 +189,7 @@ def test_extras_clock_is_the_keyframes_own(model, plan):
     assert (blender_ex["fps"], blender_ex["frame_start"], blender_ex["frame_end"]) == (fps, 0, F - 1)
 
 
+@pytest.mark.slow
 def test_names_are_unique_and_carry_their_model(model):
     """Nodes, meshes and materials: every name unique, each model's named after it; the camera
     and its lights are the only other nodes; the two bodies' meshes share their geometry."""
@@ -204,6 +207,7 @@ def test_names_are_unique_and_carry_their_model(model):
     assert [p.material for p in bodies[0].primitives] != [p.material for p in bodies[1].primitives]
 
 
+@pytest.mark.slow
 def test_cage_and_axes_are_thin_geometry_that_renders(model):
     """No line primitive: every primitive is triangles; the cage's and the axes' are unlit
     (KHR_materials_unlit, double-sided) tubes within ``LINE_RADIUS`` of the unit sphere's
@@ -227,6 +231,7 @@ def test_cage_and_axes_are_thin_geometry_that_renders(model):
             assert np.all(np.linalg.norm(off, axis=1) <= 1.01 * gltf.LINE_RADIUS)
 
 
+@pytest.mark.slow
 def test_camera_sees_each_model_from_the_videos_direction_side_by_side(model, plan):
     """The scene's one camera, composed from the file's own transforms: each model's origin
     seen from the video's view direction (azimuth_deg, elevation_deg) in that model's spinviz
@@ -260,6 +265,7 @@ def test_camera_sees_each_model_from_the_videos_direction_side_by_side(model, pl
     assert 0.8 < max(np.max(np.abs(np.r_[lo0, hi0, lo1, hi1])), 0.0) < 1.0   # and filling the picture
 
 
+@pytest.mark.slow
 def test_lights_are_the_videos_riding_on_the_camera(model):
     """KHR_lights_punctual: the video's key, fill and head lights, directional, children of the
     camera; each shines from the video's direction in the camera's frame (key from the upper
@@ -281,6 +287,7 @@ def test_lights_are_the_videos_riding_on_the_camera(model):
     assert key[0] < 0 < key[1]                                                # upper left
 
 
+@pytest.mark.slow
 def test_cli_writes_what_the_api_writes(scene, glb, tmp_path, capsys):
     """`spinviz render SCENE --out X.glb` and spinviz.render(..., out=X.glb) write the same
     bytes, and the same Blender script beside them; the command says what it wrote."""
@@ -293,6 +300,7 @@ def test_cli_writes_what_the_api_writes(scene, glb, tmp_path, capsys):
     assert "askew_blender.py opens it in Blender at 30 fps, frames 0-179, through its camera" in said
 
 
+@pytest.mark.slow
 def test_blender_script_holds_numbers_and_the_models_name_only(plan):
     """The script is Python whose settings are literals: the model's file name (any name, even
     one with quotes and a newline, stays one string literal), the rate, the range, the
@@ -321,6 +329,7 @@ def write_scene_plan_title_free(plan):
     return replace(plan, spec=plan.spec.with_(title="print('hi')", subtitles=("x\"y", "z")))
 
 
+@pytest.mark.slow
 def test_an_output_that_cannot_be_written_leaves_neither_file(scene, tmp_path, capsys):
     """The model and its script land together: where the script's path is a directory, the
     command refuses with one line naming it, before any work, and writes no model."""
@@ -331,6 +340,7 @@ def test_an_output_that_cannot_be_written_leaves_neither_file(scene, tmp_path, c
     assert not (tmp_path / "m.glb").exists()
 
 
+@pytest.mark.slow
 def test_outputs_refused_with_one_line(scene, tmp_path, capsys):
     """An unknown extension, and a model of a scene that shows no body and no arrow: exit 2,
     one line naming the option or the key."""

@@ -30,7 +30,7 @@ def test_import_spinviz_is_light():
 
 @pytest.mark.parametrize("argv", [
     ["info", "dast_cube"],
-    ["simulate", "scenes/check_6_10_cube_truncated.toml", "--out", "{tmp}/t.npz"],
+    pytest.param(["simulate", "scenes/check_6_10_cube_truncated.toml", "--out", "{tmp}/t.npz"], marks=pytest.mark.slow),
 ])
 def test_cli_commands_never_import_rendering(argv, tmp_path):
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]

@@ -387,6 +387,7 @@ def test_a_damaged_trajectory_file_is_one_typed_error(tmp_path, damage, reason):
     assert isinstance(e.value, ValueError) and str(e.value) == f"{p}: {reason}"
 
 
+@pytest.mark.slow
 def test_render_frame_is_the_videos_frame_that_shows_t():
     """``render_frame(scene, t)`` is the frame of the scene's own video that shows t: the first
     at t = 0, the last at the run's end, frame f at its time, and between two frames the one

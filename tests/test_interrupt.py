@@ -56,6 +56,7 @@ def test_library_frames_are_judged_by_module_name(tmp_path):
     assert ns["result"] is True
 
 
+@pytest.mark.slow
 def test_a_signal_inside_a_weakref_callback_or_finalizer_is_recorded_not_raised(monkeypatch):
     """Python swallows what a weak reference's callback or a ``__del__`` raises (it goes to
     ``sys.unraisablehook``, which prints "Exception ignored in ..." on stderr): a signal

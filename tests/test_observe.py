@@ -212,7 +212,7 @@ def test_antenna_inside_a_wavelength_gets_no_snr():
     SNR is not, and so no parting for this receiver."""
     obs = spinviz.observe(SCENES / "dast_cube.toml", samples=50, distance_cm=1.0)
     rec = json.loads(json.dumps(obs.record(), allow_nan=False))          # strict JSON: no NaN, no Infinity
-    start = rec["budget"]["reduced"]["start"]
+    start = rec["budget"]["reduced"]["first"]
     assert start["zone"] == "intermediate" and start["snr_integration"] is None and start["received_w"] is None
     assert start["field_full_rms_v_per_m"] / start["field_radiation_term_rms_v_per_m"] == pytest.approx(1.84, abs=0.01)
     assert all(rec["parting"][k]["setup_time"] is None for k in ("power", "frequency", "polarization"))

@@ -62,6 +62,7 @@ def fake_plan(models=("reduced", "truncated"), captions="outreach", F=5, units="
 
 
 # --- the markup ----------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_page_is_self_contained_under_its_csp(page, askew):
     """One file under 2 MB under a hash-only CSP (``check_csp``: no style attribute, no remote
     element either); the title is text (escaped), the data block cannot close its element; the
@@ -75,6 +76,7 @@ def test_page_is_self_contained_under_its_csp(page, askew):
     assert page_glb(text) == askew.glb.read_bytes()
 
 
+@pytest.mark.slow
 def test_page_carries_the_mit_notice_itself(page):
     """The three.js MIT licence, its copyright line and permission notice whole, is in the page
     (a downloaded page must carry it), not a pointer to a file."""
@@ -84,6 +86,7 @@ def test_page_carries_the_mit_notice_itself(page):
     assert "Copyright © 2010-2026 three.js authors" in text and "LICENSE-three.txt" not in text
 
 
+@pytest.mark.slow
 def test_each_view_has_its_poster_and_the_text_alternative(page, plan):
     """Each view holds its poster in the markup (an inline SVG of the opening frame, labelled by
     the text alternative), so it is drawn before any script has run; the text alternative
@@ -271,6 +274,7 @@ def test_committed_page_carries_the_committed_model():
     assert page_glb(text) == (ROOT / "renders" / "dast_cube.glb").read_bytes()
 
 
+@pytest.mark.slow
 def test_title_is_text(plan):
     """A scene's title goes into the page's heading as text, and so do its subtitles."""
     from dataclasses import replace

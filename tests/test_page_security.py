@@ -21,6 +21,10 @@ import pytest
 from spinviz.regimes.figures import draw
 from spinviz.regimes.figures import page as PG
 
+# every test here reads the refined atlas (~4 s of CPU to compute once): .ci/run's second pass
+pytestmark = pytest.mark.slow
+
+
 PAYLOAD = "document.title='PWNED'"
 HOSTILE = [
     f"<img src=x onerror={PAYLOAD}>",                                        # runs if put into innerHTML

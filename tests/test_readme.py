@@ -5,6 +5,8 @@ import re
 import shutil
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -13,6 +15,7 @@ def python_blocks() -> list[str]:
     return re.findall(r"```python\n(.*?)```", text, flags=re.S)
 
 
+@pytest.mark.slow
 def test_readme_python_snippets_run(tmp_path, monkeypatch, capsys):
     blocks = python_blocks()
     assert len(blocks) >= 1                     # the "Python" section: simulate, save, plot, compare, a frame

@@ -303,7 +303,11 @@ def scene_frames(path, frames=("first", "middle", "last"), size=(640, 360), **ov
     return plan, dict(zip(frames, imgs)), session
 
 
-@pytest.mark.parametrize("path", [pytest.param(p, marks=pytest.mark.slow) if p.stem == "dast_box" else p for p in SCENES],
+# three scenes in the default run (a symmetric top, the rod, the cube comparison); every scene in .ci/run's second pass
+FAST_SCENES = ("askew_example", "cellulose_rod", "default")
+
+
+@pytest.mark.parametrize("path", [p if p.stem in FAST_SCENES else pytest.param(p, marks=pytest.mark.slow) for p in SCENES],
                          ids=[p.stem for p in SCENES])
 def test_every_scene_keeps_its_frame_edges_clear_and_labels_its_arrows(path):
     """At 640x360, the first, middle and last frames of every shipped scene leave the outermost
@@ -476,6 +480,7 @@ def test_captions_key_is_validated():
         RenderSpec(subtitles=("a", "b", "c"))
 
 
+@pytest.mark.slow
 def test_render_workers_import_no_simulation_stack():
     """A render worker imports the drawing stack and unpickles a picture without loading numba,
     scipy or numpy-quaternion (about 1.5 s), nor pyvista's plotting module and matplotlib

@@ -18,6 +18,7 @@ def horizon(eps, n_T, w_dir=W_DIR):
     return n_T / (eps**2 * (w_dir[0] ** 2 + w_dir[1] ** 2))
 
 
+@pytest.mark.slow
 def test_auto_matches_full_integration_in_the_domain_of_4_20():
     """delta = 0.8, chi = 1.2 (the '?' domain), tau0 |Omega0| = 1e-4, 30 T: the first-order
     averaged flow is 14 % off in |Omega| here (it sends omega3 monotonically to 0 while it

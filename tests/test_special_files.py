@@ -124,6 +124,7 @@ def store(small_atlas_reference):
     (".checksums/chunks/0.0.0.0.json", "checksums: 1 chunk with runs marked done and no usable record "
                                        "(.checksums/chunks/0.0.0.0.json (record unreadable))"),
 ])
+@pytest.mark.slow
 def test_verify_names_a_special_file_planted_in_the_store(store, tmp_path, capsys, kind, rel, line):
     """--verify read every chunk file with open(): a FIFO in place of one held it forever."""
     s = tmp_path / "s.zarr"
@@ -144,6 +145,7 @@ def test_verify_names_a_special_file_planted_in_the_store(store, tmp_path, capsy
     assert line.format(what=WORDS[kind]) in out, out
 
 
+@pytest.mark.slow
 def test_resume_recomputes_a_chunk_a_fifo_replaced(store, small_atlas_spec, tmp_path, capsys):
     """The resume treats the FIFO as damage: removed, its runs computed again, the same numbers."""
     from spinviz.regimes import api

@@ -71,6 +71,7 @@ class Reached(Exception):
     """The study started."""
 
 
+@pytest.mark.slow
 def test_evidence_is_refused_at_once_on_a_held_lock(refined_atlas, tmp_path, monkeypatch, capsys):
     """Another command writes the store: ``atlas evidence convergence --out STORE`` is refused before
     its study starts (refused after it, minutes of work would be thrown away), by the store's

@@ -22,6 +22,9 @@ from spinviz.regimes.store import dataset as DS
 from spinviz.regimes.store import levels as LV
 from spinviz.regimes.store.lock import StoreLock, lock_path
 
+# every test here reads the refined atlas (~4 s of CPU to compute once): .ci/run's second pass
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parents[1]
 SKIP = {"run_seconds"}                 # a measurement: differs between two computations of the same atlas
 

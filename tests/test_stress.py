@@ -37,6 +37,7 @@ def test_stress_case_meets_its_measured_error(case, method, bound):
     assert r.error < bound, r.record()
 
 
+@pytest.mark.slow
 def test_driver_says_why_it_picked_a_stiff_method():
     """The thin rod spun fast (decay/spin 1.6e6): radau, saying why, within 1e-8 of BDF at rtol
     1e-12 (measured 1.4e-9, the run at rtol 1e-8)."""

@@ -80,6 +80,7 @@ class Setup:
     spin_range: tuple = (0.5, 2.0)
     tau0_mode: str = "known"
     models: tuple = ("reduced", "truncated")
+    nuisance: object = None              # analysis.nuisance.Nuisances: what must be known, and the trap
 
     def edges(self) -> np.ndarray:
         """Record edges (s): 0, t_int, then ``RECORDS_PER_DECADE`` a decade to the horizon, each
@@ -314,7 +315,12 @@ def decision_time(rec: Records, truth: str, start: Start, setup: Setup) -> tuple
 
 def run_trials(setup: Setup, seed: int, indices) -> list[dict]:
     """Trials ``indices`` of the Monte Carlo seeded by ``seed``: per trial its start and, per
-    truth, the decision time and the final Z (a top-level function: any map can run it)."""
+    truth, the decision time and the final Z (a top-level function: any map can run it).
+    With nuisances (``Setup.nuisance``), ``decide_env.run_trials``."""
+    if setup.nuisance is not None and setup.nuisance.active:
+        from . import decide_env
+
+        return decide_env.run_trials(setup, seed, indices)
     seqs = np.random.SeedSequence(seed).spawn(max(indices) + 1)
     out = []
     for i in indices:
@@ -366,7 +372,8 @@ class Outcome:
                 "t95_s": {k: _num(v) for k, v in self.t95.items()},
                 "t95_interval_s": {k: [_num(x) for x in v] for k, v in self.interval.items()},
                 "decided_at_horizon": {m: float(np.mean(np.isfinite(self.times(m)))) for m in s.models},
-                "decision_times_s": {m: [_num(x) for x in self.times(m)] for m in s.models}}
+                "decision_times_s": {m: [_num(x) for x in self.times(m)] for m in s.models},
+                **({"nuisances": s.nuisance.record()} if s.nuisance is not None else {})}
 
 
 def _num(x):
@@ -409,12 +416,17 @@ def summarize(out: Outcome) -> Outcome:
 
 def work_seconds(setup: Setup, trials: int, workers: int = 1) -> float:
     """The estimated wall time of ``trials`` trials of ``setup`` on ``workers`` processes, s:
-    the measured cost of a trial (``inputs.options.DECIDE_S_PER_TRIAL``, by tau0 mode, for a
+    the measured cost of a trial (``inputs.options.DECIDE_S_PER_TRIAL``, by tau0 mode and
+    nuisances, for a
     trial that is decided: the dearest) times the share of records beyond the measured ones."""
     from ..inputs.options import DECIDE_RECORDS, DECIDE_S_PER_TRIAL
 
     records = setup.edges().size - 1
-    each = DECIDE_S_PER_TRIAL[setup.tau0_mode] * max(1.0, records / DECIDE_RECORDS)
+    nu = setup.nuisance
+    kind = setup.tau0_mode
+    if nu is not None and nu.active:
+        kind = "gas" if nu.gas is not None else "nuisances"
+    each = max(DECIDE_S_PER_TRIAL[kind], DECIDE_S_PER_TRIAL[setup.tau0_mode]) * max(1.0, records / DECIDE_RECORDS)
     return trials * each / max(1, int(workers))
 
 
@@ -446,7 +458,12 @@ def format_outcome(out: Outcome, title: str, receiver) -> str:
     lines = [title, "", f"receiver: {receiver.describe()}",
              f"start: {START}; spin_range {s.spin_range[0]:g}..{s.spin_range[1]:g}",
              f"tau0: {'the body' + chr(39) + 's (known)' if s.tau0_mode == 'known' else 'fitted with the start'}; "
-             f"{out.trials} trials (seed {out.seed}); watched for at most {U.human_time(s.horizon)}", ""]
+             f"{out.trials} trials (seed {out.seed}); watched for at most {U.human_time(s.horizon)}"]
+    if s.nuisance is not None:
+        from .nuisance import describe
+
+        lines.append(f"what must be known, and the trap: {describe(s.nuisance)}")
+    lines.append("")
     lines.append(f"how long to watch: the time by which {100 * SHARE:g} % of the trials reach Z = {DECISION_Z:g}")
     for m in s.models:
         t = out.times(m)

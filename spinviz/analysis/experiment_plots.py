@@ -106,12 +106,11 @@ def _field_panel(ax, obs, pos, scale) -> None:
         lam = U.wavelength_cm(bg.freq[rows, bg.dominant[pos]])
         tw.plot(bg.t[pos] / scale, obs.receiver.distance_cm / lam, color=model_color(bg.model), lw=0.8, ls="-.")
     tw.axhline(1.0, color="tab:red", lw=0.8, ls="--")
-    tw.annotate("R = λ: radiation zone above", (0.99, 1.0), xycoords=("axes fraction", "data"), ha="right",
-                va="bottom", fontsize=7, color="tab:red")
+    tw.annotate("R/λ = 1 on the right axis: radiation zone above", (0.99, 1.0), xycoords=("axes fraction", "data"),
+                ha="right", va="bottom", fontsize=7, color="tab:red")
     tw.set_yscale("log")
     tw.tick_params(axis="y", labelsize=8, colors="0.35")
-    tw.annotate("dash-dot: R/λ (right axis)", (0.99, 0.97), xycoords="axes fraction", ha="right", va="top",
-                fontsize=7, color="0.35")
+    tw.set_ylabel("R/λ (dash-dot and the red line: right axis)", fontsize=8, color="0.35")
 
 
 def _pf_panel(ax, obs) -> None:
@@ -162,6 +161,16 @@ def _wrap(text: str, width: int) -> list[str]:
     return out + [line]
 
 
+def _environment_box(fig, rep: dict) -> None:
+    """The trap's numbers at the start (``environment_report``), boxed under the panels."""
+    from .environment_report import lines
+
+    text = "\n".join(line.strip() if i == 0 else "    " + line.strip() for i, line in enumerate(lines(rep))
+                     if line.strip())
+    fig.text(0.01, 0.01, text, ha="left", va="bottom", fontsize=8, color="0.1", family="monospace",
+             bbox={"boxstyle": "round", "fc": "lightyellow", "ec": "0.6"})
+
+
 def plot_receiver(obs, path: str) -> None:
     """Four panels of ``spinviz observe`` for a CGS scene: the SNR of each line over time, the
     resolutions the receiver reaches, the field at the antenna (all terms and the radiation term,
@@ -177,6 +186,10 @@ def plot_receiver(obs, path: str) -> None:
     _pf_panel(axes[1, 1], obs)
     fig.suptitle(f"{obs.title}\nthe receiver: {obs.receiver.describe()}", fontsize=11)
     fig.tight_layout(w_pad=2.5)
+    if obs.environment is not None:
+        fig.set_size_inches(15, 12)
+        fig.tight_layout(w_pad=2.5, rect=(0.0, 0.1, 1.0, 1.0))
+        _environment_box(fig, obs.environment)
     save(fig, path)
 
 
@@ -228,7 +241,16 @@ def plot_decide(out, title: str, path: str) -> None:
     ax.set_title("each trial's decision time against its start")
     ax.grid(True, which="major", color="0.9", lw=0.6)
     ax.legend(fontsize=8, loc="upper center")
-    fig.suptitle(f"{title}\nhow long to watch: tau0 {s.tau0_mode}, |Ω0| log-uniform over "
-                 f"{s.spin_range[0]:g}–{s.spin_range[1]:g} × the scene's, directions isotropic", fontsize=11)
+    nu = s.nuisance
+    exact = s.tau0_mode == "known" and (nu is None or nu.tau0_width == 0.0)
+    tau = ("τ0 known exactly: the truncated curve rests on it (with τ0 fitted no truncated trial decides)" if exact
+           else "τ0 fitted with the start" if s.tau0_mode == "fitted" else "τ0 as below")
+    trap = ""
+    if nu is not None:
+        from .nuisance import describe
+
+        trap = "\n" + describe(nu).split(" -- ")[0]
+    fig.suptitle(f"{title}\nhow long to watch: {tau}; |Ω0| log-uniform over "
+                 f"{s.spin_range[0]:g}–{s.spin_range[1]:g} × the scene's, directions isotropic{trap}", fontsize=11)
     fig.tight_layout()
     save(fig, path)

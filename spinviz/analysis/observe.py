@@ -54,6 +54,7 @@ class Observation:
     pf_law: str | None = None
     pf_reason: str = ""
     notes: list = field(default_factory=list)
+    environment: dict | None = None                  # the trap's numbers at the start (environment_report)
 
     def table(self) -> str:
         """The observation for people (``format_table``): the receiver, the observables, when the
@@ -62,8 +63,9 @@ class Observation:
 
     def record(self) -> dict:
         """The observation as a JSON-ready dict (``spinviz observe --json``): the receiver, per
-        model its observables and budget at the first and last samples, the parting curves, the
-        P-f tests, the scales."""
+        model its observables at the start and the end and its budget at the first output instant
+        after the start ("first", its time in it) and the end, the parting curves, the P-f tests,
+        the scales, and the trap's numbers where there is one."""
         a, b = self.detections
         out = {
             "title": self.title, "units": self.units, "horizon": self.horizon,
@@ -75,10 +77,12 @@ class Observation:
         }
         if self.receiver is not None:
             out["receiver"] = self.receiver.record()
-            out["budget"] = {bg.model: {"start": bg.record(_first(bg)), "end": bg.record(-1),
+            out["budget"] = {bg.model: {"first": bg.record(_first(bg)), "end": bg.record(-1),
                                         "series": _thinned(bg)} for bg in self.budgets}
         out["pf_test"] = {"law": self.pf_law, "reason": self.pf_reason or None,
                           "fits": {m: (r.record() if r is not None else None) for m, r in self.pf.items()}}
+        if self.environment is not None:
+            out["environment"] = self.environment
         return out
 
 
@@ -221,12 +225,22 @@ def format_table(obs: Observation) -> str:
     for label, i in (("at the start", 0), (f"at the end, t = {U.format_time(obs.horizon, obs.units)}", -1)):
         lines += [label, head]
         cells = [_cells(d, i, cgs) for d in obs.detections]
-        if budgets:
-            for c, d in zip(cells, obs.detections):
-                c.update(_budget_cells(budgets[d.model], _first(budgets[d.model]) if i == 0 else -1))
         for name in cells[0]:
             lines.append(f"  {name:<38} {cells[0][name]:>22} {cells[1][name]:>22}")
+        if budgets:
+            if i == 0:
+                # the receiver's drift rates need an instant after t = 0: its columns are named by that instant
+                first = _first(budgets[obs.detections[0].model])
+                lines.append(f"  the receiver at t = {U.format_time(float(budgets[obs.detections[0].model].t[first]), obs.units)}"
+                             f" (the first output instant):")
+            bc = [_budget_cells(budgets[d.model], _first(budgets[d.model]) if i == 0 else -1) for d in obs.detections]
+            for name in bc[0]:
+                lines.append(f"  {name:<38} {bc[0][name]:>22} {bc[1][name]:>22}")
         lines.append("")
+    if obs.environment is not None:
+        from .environment_report import lines as env_lines
+
+        lines += env_lines(obs.environment)
     lines += _parting_lines(obs)
     lines += _pf_lines(obs)
     for k, v in obs.scales.items():
@@ -304,8 +318,9 @@ def _budget_cells(bg, i: int) -> dict[str, str]:
                                                      f"({r['field_radiation_term_rms_v_per_m'] * 1e6:.3g}) µV/m",
             "received power": g(r["received_w"], "{:.3g} W", "(near zone)"),
             "SNR of one integration": g(r["snr_integration"], "{:.3g}", "(near zone)"),
-            "coherent interval (SNR, threshold)": f"{g(r['coherent_interval_s'], '{:.3g} s')} "
-                                                  f"({g(r['snr_coherent'])}, {g(r['threshold'])})",
+            "coherent interval (SNR, threshold; exact)": f"{g(r['coherent_interval_s'], '{:.3g} s')} "
+                                                         f"({g(r['snr_coherent'])}, {g(r['threshold'])}; "
+                                                         f"{g(r['threshold_exact'])})",
             "resolution: frequency (relative)": g(r["sigma_f_relative"], "{:.2g}", "not detected"),
             "resolution: power (relative)": g(r["sigma_power_relative"], "{:.2g}", "not detected"),
             "resolution: polarization angle": g(r["sigma_polarization_deg"], "{:.2g}°", "not detected")}
@@ -339,4 +354,8 @@ def run_scene(sc, samples: int = 800, line_of_sight=None, receiver=None, receive
     los = line_of_sight if line_of_sight is not None else sc.observe.line_of_sight
     receiver = sc.observe.receiver if receiver is None else receiver
     obs = observe(trajs, sc.title, los, receiver, omega0=sc.omega0, rtol=sc.rtol, receive=receive)
+    if sc.environment.active and sc.units == "cgs":
+        from .environment_report import report
+
+        obs.environment = report(sc, obs)
     return obs, trajs

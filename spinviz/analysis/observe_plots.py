@@ -121,7 +121,8 @@ def plot(obs: Observation, path: str) -> None:
     f_all = np.concatenate([d.f_dom[pos] for d in obs.detections])
     f_log = float(np.max(f_all)) > 5.0 * max(float(np.min(f_all)), 1e-300)
     panels = (("power", lambda d: d.power_sr * (U.ERG_PER_S_IN_W if cgs else 1.0),
-               "power toward the detector (W/sr)" if cgs else f"dP/dΩ ({a.power_sr_unit})", "log", "power received"),
+               "power toward the detector (W/sr)" if cgs else f"dP/dΩ ({a.power_sr_unit})", "log",
+               "power per steradian toward the antenna"),
               ("frequency", lambda d: d.f_dom / fs, "dominant frequency (GHz)" if cgs else f"dominant frequency "
                f"({a.freq_unit})", "log" if f_log else "linear", "strongest spectral line"),
               ("polarization", lambda d: np.degrees(d.pol_angle), "polarization angle from u1 (°)", "linear",

@@ -9,7 +9,19 @@ import argparse
 import json
 
 from ..errors import SimulationError
-from .shared import EXIT_OK, add_detector_options, cannot_write, need_matplotlib, out, p, positive, prefix_of, receiver_options
+from .shared import (
+    EXIT_OK,
+    add_detector_options,
+    add_environment_options,
+    cannot_write,
+    environment_options,
+    need_matplotlib,
+    out,
+    p,
+    positive,
+    prefix_of,
+    receiver_options,
+)
 
 
 def _refused_option(text: str):
@@ -28,6 +40,7 @@ def add_parser(sub) -> None:
     o.add_argument("--out", help="prefix of the PNG plots (default renders/<scene>): <prefix>_observe.png, "
                                  "<prefix>_detector.png and, for a physical body, <prefix>_receiver.png")
     add_detector_options(o)
+    add_environment_options(o)
     for gone in ("--power-factor", "--frequency-resolution", "--polarization-deg"):
         # fixed thresholds: the resolutions are the receiver's; say so instead of "unrecognized"
         o.add_argument(gone, type=_refused_option, help=argparse.SUPPRESS)
@@ -43,7 +56,7 @@ def run(args) -> int:
     prefix = prefix_of(args)
     try:
         obs = experiment.observe(args.scene, samples=args.samples, line_of_sight=args.line_of_sight, plots=prefix,
-                                 **receiver_options(args))
+                                 **receiver_options(args), **environment_options(args))
     except SimulationError as e:
         raise SimulationError(f"{args.scene}: {e}") from None
     except OSError as e:

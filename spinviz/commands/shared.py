@@ -150,6 +150,30 @@ def receiver_options(args) -> dict:
     return {k: getattr(args, k, None) for k in RECEIVER_OPTIONS}
 
 
+# The [environment] keys (``inputs.environment.EnvironmentSpec``) that observe and decide take as
+# options, each in place of the scene's key of its name, checked by the environment's schema.
+ENVIRONMENT_OPTIONS = {
+    "pressure_mbar": (real, "PRESSURE", "the residual gas's pressure, mbar (default: the scene's [environment], else 0: "
+                                        "no gas)"),
+    "gas": (str, "NAME", "the gas: H2, He, Ne, N2, O2, Ar, CO2 or Xe (default: the scene's, else N2)"),
+    "gas_temperature_k": (real, "K", "the gas's temperature (default: the scene's, else 300)"),
+    "accommodation": (real, "SHARE", "the share of molecules re-emitted diffusely (default: the scene's, else 1)"),
+    "body_temperature_k": (real, "K", "the crystal's surface temperature (default: the scene's, else the gas's)"),
+    "field_v_per_m": (vector, "X,Y,Z", "a static field, V/m, world frame (default: the scene's, else none)"),
+}
+
+
+def add_environment_options(parser) -> None:
+    """One option per ``ENVIRONMENT_OPTIONS`` key, --key-with-dashes."""
+    for key, (kind, metavar, text) in ENVIRONMENT_OPTIONS.items():
+        parser.add_argument("--" + key.replace("_", "-"), dest=key, type=kind, metavar=metavar, help=text)
+
+
+def environment_options(args) -> dict:
+    """The environment options given on the command line (None: not given)."""
+    return {k: getattr(args, k, None) for k in ENVIRONMENT_OPTIONS}
+
+
 # --- reports ------------------------------------------------------------------------------
 def say(prefix: str, message) -> None:
     """One line on stderr, control characters escaped and cut: nothing from a file or a key

@@ -237,7 +237,11 @@ class EvidenceRequest:
 # known, 1.14-1.36 s fitted, at 47-89 records (the default receiver over 0.01-30 x the cube's
 # horizon), where every trial is decided; undecided trials cost a tenth of that.  The fits grow
 # with the records a trial holds, so the estimate scales by records / DECIDE_RECORDS beyond them.
-DECIDE_S_PER_TRIAL = {"known": 0.5, "fitted": 1.4}
+# With what must be known (analysis.nuisance; 2026-11-28, the same machine, load ~5): 2.8 s with
+# tau0, gain and clock priors; in a residual gas 1.6 s (1e-10 mbar: the walk alone), 4.0 s (1e-14
+# and 1e-12 mbar) and 11.0 s at 1e-13 mbar, where up to 64 collisions are located and fitted: the
+# dearest, taken for every pressure.
+DECIDE_S_PER_TRIAL = {"known": 0.5, "fitted": 1.4, "nuisances": 3.0, "gas": 12.0}
 DECIDE_RECORDS = 71
 
 

@@ -1,5 +1,6 @@
 """The tables of a scene file: ``[body]``, ``[initial]``, ``[simulation]``, ``[observe]`` and
-the top level (``[render]`` is ``inputs.render.RenderSpec``).
+the top level (``[render]`` is ``inputs.render.RenderSpec``, ``[environment]``
+``inputs.environment.EnvironmentSpec``).
 
 Each table is a request class whose fields are its TOML keys; ``spinviz.scene.parse_scene``
 validates each table with it (``toml.table``: errors name the file, table and key) and then
@@ -339,3 +340,4 @@ class SceneFile:
     description: Text | None = None
     render: Table | None = None
     observe: Table | None = None
+    environment: Table | None = None

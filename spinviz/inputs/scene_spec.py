@@ -40,6 +40,7 @@ import numpy as np
 from ..errors import SceneError, SpecError, SpecTypeError, brief, printable
 from ..physics import bodies as B
 from . import scene as IS
+from .environment import EnvironmentSpec
 from .receiver import ReceiverSpec
 from .render import MAX_TITLE, RenderSpec
 from .simulation import SimulationRequest
@@ -102,7 +103,8 @@ class Scene:
 
     omega0 : (3,) body frame; q0 : (w, x, y, z); t_end : horizon; samples : output instants;
     method, rtol, atol, step : the integrator settings (``SimulationRequest``'s);
-    render : ``RenderSpec``; observe : ``ObserveSpec``.
+    render : ``RenderSpec``; observe : ``ObserveSpec``; environment : ``EnvironmentSpec``
+    (``[environment]``: the trap's gas and field; the perfect vacuum when absent).
     """
 
     path: str
@@ -119,6 +121,7 @@ class Scene:
     step: float | None = None
     render: RenderSpec = field(default_factory=RenderSpec)
     observe: ObserveSpec = field(default_factory=ObserveSpec)
+    environment: EnvironmentSpec = field(default_factory=EnvironmentSpec)
 
     def __post_init__(self):
         object.__setattr__(self, "omega0", _readonly(self.omega0))
@@ -177,20 +180,36 @@ class Scene:
         if model not in self.models:
             raise SpecError("model", f"{brief(model)} is not one of the scene's models ({', '.join(self.models)})")
         times = {"t_end": self.t_end, "samples": self.samples} if t_eval is None else {"t_eval": t_eval}
+        env = self.environment if self.environment.active else None
+        if env is not None and kinematics == "none":
+            kinematics = "quaternion"            # a trap's run carries the orientation whatever is drawn of it
         return SimulationRequest(body=self.body, model=model, omega0=self.omega0, q0=self.q0, method=self.method,
-                                 rtol=self.rtol, atol=self.atol, step=self.step, kinematics=kinematics, **times)
+                                 rtol=self.rtol, atol=self.atol, step=self.step, kinematics=kinematics,
+                                 environment=env, **times)
+
+    def with_environment(self, **given) -> Scene:
+        """This scene with the environment keys given (None: the scene's) in place of its
+        ``[environment]``'s, checked by the schema and against the body (``SpecError`` naming
+        the key: the option's or the argument's, as the receiver's options are)."""
+        from .environment import check_body
+
+        env = self.environment.with_options(**given)
+        if env == self.environment:
+            return self
+        check_body(env, self.body)
+        return replace(self, environment=env)
 
 
 # --- the whole file -----------------------------------------------------------------------
 def parse_scene(data: dict, path: str = "<scene>") -> Scene:
     """Validate a parsed TOML document; raise SceneError (file, key, reason) on the first problem."""
     path = os.fspath(path)
-    return _scene(*document(IS.SceneFile, data, path, _TABLES, ("render",)), path)
+    return _scene(*document(IS.SceneFile, data, path, _TABLES, ("render", "environment")), path)
 
 
 # every table of a scene, validated in one place (inputs.toml.document) before anything is computed
 _TABLES = {"body": IS.BodyTable, "initial": IS.InitialTable, "simulation": IS.SimulationTable, "render": RenderSpec,
-           "observe": IS.ObserveTable}
+           "observe": IS.ObserveTable, "environment": EnvironmentSpec}
 
 
 def _scene(top, tables: dict, path: str) -> Scene:
@@ -208,8 +227,10 @@ def _scene(top, tables: dict, path: str) -> Scene:
     omega0, q0 = np.array(it.omega), it.q0()
     keys = _scene_keys(st, it)
     t_end = _horizon(path, "simulation", st, st.horizon_key, body, omega0, keys)
+    env = _environment(tables["environment"], body, path)
     requests = [_checked(path, keys, body=body, model=m, omega0=omega0, q0=q0, t_end=t_end, samples=st.samples,
-                         method=st.method, rtol=st.rtol, atol=st.atol, step=st.step) for m in st.model_names]
+                         method=st.method, rtol=st.rtol, atol=st.atol, step=st.step,
+                         environment=env if env.active else None) for m in st.model_names]
     title = top.title
     if title is None:   # from the file name, escaped and cut: a name may hold anything a file system allows
         title = printable(os.path.splitext(os.path.basename(path))[0], MAX_TITLE)
@@ -217,7 +238,18 @@ def _scene(top, tables: dict, path: str) -> Scene:
     observe = _observe(tables["observe"], path, body, omega0, requests)
     return Scene(path=path, title=title, body=body, models=st.model_names, omega0=omega0, q0=q0, t_end=t_end,
                  samples=st.samples, method=requests[0].method, rtol=st.rtol, atol=st.atol, step=st.step, render=render,
-                 observe=observe)
+                 observe=observe, environment=env)
+
+
+def _environment(env: EnvironmentSpec, body: B.Body, path: str) -> EnvironmentSpec:
+    """[environment] (validated; its defaults when absent), checked against the body."""
+    from .environment import check_body
+
+    try:
+        check_body(env, body)
+    except SpecError as e:
+        raise SceneError(path, f"[environment].{e.key}", e.reason) from None
+    return env
 
 
 def _scene_keys(st, it) -> dict:
@@ -234,7 +266,10 @@ def _checked(path, keys: dict, **kw) -> SimulationRequest:
     try:
         return SimulationRequest(**kw)
     except SpecError as e:
-        raise SceneError(path, keys.get(e.key, e.key), e.reason) from None
+        key = keys.get(e.key, e.key)
+        if e.key.startswith("environment."):
+            key = f"[environment].{e.key.split('.', 1)[1]}"
+        raise SceneError(path, key, e.reason) from None
 
 
 def _horizon(path, name: str, t, key: str, body: B.Body, omega0, keys: dict) -> float:
@@ -297,7 +332,8 @@ def _observe(ot, path: str, body: B.Body, omega0, requests: list) -> ObserveSpec
         t_end = _horizon(path, "observe", ot, key, body, omega0, keys)
         for r in requests:
             _checked(path, {**keys, "step": "[simulation].step", "method": "[simulation].method"},
-                     **{f: getattr(r, f) for f in ("body", "model", "omega0", "q0", "method", "rtol", "atol", "step")},
+                     **{f: getattr(r, f) for f in ("body", "model", "omega0", "q0", "method", "rtol", "atol", "step",
+                                                   "environment")},
                      t_end=t_end, samples=2)
     return ObserveSpec(t_end=t_end, line_of_sight=ot.line_of_sight, receiver=ot.receiver())
 
@@ -307,4 +343,4 @@ def load_scene(path) -> Scene:
     if not isinstance(path, (str, bytes, os.PathLike)):
         raise SpecTypeError("path", f"must be the path of a scene file (str or os.PathLike), got {type(path).__name__}")
     path = os.fsdecode(path)
-    return _scene(*read_document(path, IS.SceneFile, _TABLES, ("render",)), path)
+    return _scene(*read_document(path, IS.SceneFile, _TABLES, ("render", "environment")), path)

@@ -11,7 +11,7 @@ name the argument (``SpecError("rtol", ...)``); a scene renames them to its keys
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, PlainValidator, model_validator
@@ -78,6 +78,12 @@ Atol = Annotated[Real, between(*ATOL_RANGE)]
 Times = Annotated[np.ndarray, PlainValidator(_times)]
 
 
+def _environment(v):
+    from .environment import environment
+
+    return environment(v)
+
+
 @request(eq=False)
 class SimulationRequest:
     """Everything one run needs, validated (the arguments of ``spinviz.simulate``).
@@ -92,6 +98,8 @@ class SimulationRequest:
     rtol, atol : tolerances in spin units (|omega(0)| = 1); atol defaults to rtol / 100.
     step : fixed-step methods' step, in the time unit.
     kinematics : "quaternion", "euler_zxz" (6.4) or "none".
+    environment : the trap (``inputs.environment.EnvironmentSpec``, or a dict of its keys): a
+    residual gas, a static field; None or inactive, the perfect vacuum.
     """
 
     body: Annotated[Body, PlainValidator(_body)]
@@ -107,6 +115,7 @@ class SimulationRequest:
     atol: Atol | None = None
     step: Positive | None = None
     kinematics: Kinematics = "quaternion"
+    environment: Annotated[Any, PlainValidator(_environment)] = None
 
     @model_validator(mode="after")
     def _together(self):
@@ -151,7 +160,55 @@ class SimulationRequest:
                        kinematics=self.kinematics)
         except SpecError as e:
             raise SpecError(self.time_key if e.key == "t_end" else e.key, e.reason) from None
+        if self.environment is not None and self.environment.active:
+            self._check_environment()
         return self
+
+    def _check_environment(self):
+        """A run in a trap: the body it needs (units, a surface, free-molecular flow), a method
+        that carries it (``integrators.environment``) and a cost that can finish."""
+        from ..integrators import environment as IE
+        from ..integrators.auto import choose_method
+        from .environment import check_body
+
+        env = self.environment
+        try:
+            check_body(env, self.body)
+        except SpecError as e:
+            raise SpecError(f"environment.{e.key}", e.reason) from None
+        key = "environment.pressure_mbar" if env.has_gas else "environment.field_v_per_m"
+        if self.kinematics != "quaternion":
+            raise SpecError("kinematics", "a run in a trap needs the orientation (kinematics \"quaternion\"): the field "
+                                          "acts in the world frame, and the collisions turn L in it")
+        method = self.method
+        if method == "auto":
+            method = choose_method(self.body, self.model, np.asarray(self.omega0), self.horizon, self.kinematics,
+                                   rtol=self.rtol)[0]
+        why = IE.refusal(method)
+        if why is not None:
+            raise SpecError("method" if self.method != "auto" else key,
+                            why if self.method != "auto" else f"auto picks {method!r} for this run, and {why}")
+        gas = env.gas_model()
+        if gas is None:
+            return
+        from ..physics.gas import GasModel
+        from ..physics.surface import surface_of
+
+        model = GasModel(gas, surface_of(self.body), tuple(self.body.inertia))
+        if method in ("taylor", "taylor-long"):
+            n = IE.estimated_collisions(model, self.omega0, self.horizon)
+            if n > IE.MAX_COLLISIONS:
+                raise SpecError(self.time_key, f"the gas hits the body ~{n:.3g} times over the run, and {method} applies "
+                                               f"each collision (at most {IE.MAX_COLLISIONS:g} can finish): shorten it, "
+                                               f"lower [environment].pressure_mbar, or let secular carry it")
+        elif method == "secular":
+            from ..integrators.secular_env import MAX_CHUNKS
+
+            n = IE.estimated_chunks(model, self.body, self.model, self.omega0, self.horizon, len(self.times()))
+            if n > MAX_CHUNKS:
+                raise SpecError(self.time_key, f"the gas brakes the body so fast against the run's length that secular "
+                                               f"would take ~{n:.3g} chunks (at most {MAX_CHUNKS:g} can finish): "
+                                               f"shorten it or lower [environment].pressure_mbar")
 
     # -- derived ------------------------------------------------------------------------------
     @property

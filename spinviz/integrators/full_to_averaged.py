@@ -149,15 +149,18 @@ def _stage(problem: Problem, omega, q, t0: float, times):
 
 
 def solve_handover(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, step: float | None = None,
-                   target: str = "secular") -> Solution:
+                   target: str = "secular", taylor=None, secular=None) -> Solution:
     """Taylor's method in full until ``target`` ("secular": a symmetric top; "polhode": any
     body) applies, then ``target`` to t_end (module docstring).  ``problem`` in spin units,
     kinematics "quaternion" or "none"; ``step`` caps Taylor's steps.  A stage that fails fails
-    the run, with its reason and the samples so far."""
+    the run, with its reason and the samples so far.  ``taylor(sub, e, rtol, atol, step,
+    max_steps, stop_on_stiffness)`` and ``secular(sub, e, rtol, atol)`` run a stage's problem
+    ``sub`` (spin units ``e`` times the run's): by default ``taylor.solve_taylor`` and the
+    target's solver (a trap's run passes its own, ``integrators.environment``)."""
     from . import secular as SC
 
     t = np.asarray(problem.t_eval, dtype=float)
-    full = _FullStage(problem, rtol, atol, step, target)
+    full = _FullStage(problem, rtol, atol, step, target, taylor)
     failure = full.run()
     stats = {"full_stage": {"method": "taylor", "nsteps": full.steps, "chunks": full.chunks, "until": full.s},
              "nsteps": full.steps}
@@ -172,7 +175,9 @@ def solve_handover(problem: Problem, rtol: float = 1e-10, atol: float = 1e-12, s
         return Solution(t=t, omega=full.omega, q=full.q_out, stats=stats)
     sub, e = full.handover
     j, s = full.j, full.s
-    if target == "polhode":
+    if secular is not None:
+        sol = secular(sub, e, rtol, atol)
+    elif target == "polhode":
         from .polhode import solve_polhode
 
         sol = solve_polhode(sub, rtol, atol)
@@ -213,9 +218,10 @@ class _FullStage:
     applies (``handover``: its problem and scale) or t_end.  j: the next output index; s, w, q:
     the time (spin units of ``problem``) and state reached."""
 
-    def __init__(self, problem: Problem, rtol: float, atol: float, step: float | None, target: str = "secular"):
+    def __init__(self, problem: Problem, rtol: float, atol: float, step: float | None, target: str = "secular",
+                 taylor=None):
         self.problem, self.rtol, self.atol, self.step = problem, rtol, atol, step
-        self.target = target
+        self.target, self.taylor = target, taylor
         self.t = t = np.asarray(problem.t_eval, dtype=float)
         self.omega = np.full((t.size, 3), np.nan)
         self.w = self.omega[0] = np.asarray(problem.omega0, dtype=float)
@@ -261,8 +267,12 @@ class _FullStage:
         k = int(np.searchsorted(t, end, side="right"))
         times = t[j:k] if k > j and t[k - 1] == end else np.concatenate([t[j:k], [end]])
         sub, e = _stage(self.problem, self.w, self.q, s, times)
-        sol = solve_taylor(sub, self.rtol, self.atol, None if self.step is None else self.step * e,
-                           max_steps=max(1, MAX_STEPS - self.steps), stop_on_stiffness=True)
+        step = None if self.step is None else self.step * e
+        if self.taylor is None:
+            sol = solve_taylor(sub, self.rtol, self.atol, step, max_steps=max(1, MAX_STEPS - self.steps),
+                               stop_on_stiffness=True)
+        else:
+            sol = self.taylor(sub, e, self.rtol, self.atol, step, max(1, MAX_STEPS - self.steps), True)
         self.steps += int(sol.stats.get("nsteps", 0))
         self.chunks += 1
         got = min(k - j, len(times) if sol.success else max(sol.reached - 1, 0))
@@ -287,10 +297,13 @@ def _slow_series(slow: dict, q_full, q_h, omega_full, problem: Problem) -> dict:
     the resolved q about the hand-over's fixed L, unwrapped and put on the same branch as
     ``secular``'s at the hand-over state q_h (where there is no q: theta from Omega, the
     phases NaN)."""
+    q_L = np.asarray(slow["q_L"], dtype=float)
+    per_sample = q_L.ndim == 2                  # L moves (a trap's run): the hand-over's L is its first row
+    q_ref = q_L[0] if per_sample else q_L
     out = {"q_L": slow["q_L"], "q_frame": slow["q_frame"]}
     series = {name: np.asarray(slow[name], dtype=float) for name in ("phi_L", "theta_L", "psi_L")}
     if q_full is not None:
-        conj = R.conjugate(np.asarray(slow["q_L"], dtype=float))[None, :]
+        conj = R.conjugate(q_ref)[None, :]
         ang = R.euler_zxz_from_quat(R.multiply(conj, np.concatenate([q_full, np.asarray(q_h)[None, :]])))
         for k, name in ((0, "phi_L"), (2, "psi_L")):
             a = np.unwrap(ang[:, k])
@@ -303,4 +316,6 @@ def _slow_series(slow: dict, q_full, q_h, omega_full, problem: Problem) -> dict:
         ang = np.stack([nan, np.arctan2(np.hypot(w[:, 0], w[:, 1]), J3 * w[:, 2]), nan], axis=-1)
     for k, name in enumerate(("phi_L", "theta_L", "psi_L")):
         out[name] = np.concatenate([ang[:, k], series[name][1:]])
+    if per_sample:
+        out["q_L"] = np.concatenate([np.repeat(q_ref[None, :], ang.shape[0], axis=0), q_L[1:]])
     return out

@@ -6,7 +6,7 @@ Which asymptotic type of the paper's section 4 does a symmetric top end in, for 
 elongation δ = 1 − I3/I1 and dipole tilt χ, under each equation of motion?  The figure
 atlas (``scenes/atlas_figure.toml``) answers as τ → ∞ at 32 × 32 cells × 32 random starts,
 both models: each run integrated in full until the flow averaged over the precession holds,
-then carried by it to τ = 1e16 and labelled by the attractor it is in; every cell along a
+then carried by it to τ = 1e16, its type as τ → ∞ the attractor it is in; every cell along a
 change of type cut in four, twice (128 × 128 there): 206 464 runs, 13 min 43 s on
 2026-11-26 on this project's two cores -- too long for a documentation build::
 

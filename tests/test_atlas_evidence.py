@@ -40,7 +40,7 @@ tau_end = 1e6
     ("physical", {"tau_end": float("nan")}, SpecError, "tau_end: must be finite"),
     ("convergence", {"out": "/nonexistent/a.zarr"}, UsageError, "--out /nonexistent/a.zarr: not an atlas store"),
     ("nonsense", {}, UsageError, "evidence: nonsense is not one of validate, crosscheck, physical, convergence, "
-                                 "tolerance, handover, basins, flows"),
+                                 "tolerance, handover, basins, bound, flows"),
 ])
 def test_options_a_kind_does_not_take_are_refused_before_work(kind, options, error, message, monkeypatch):
     """Each refused before any work: the computation itself raises if reached."""
@@ -48,6 +48,19 @@ def test_options_a_kind_does_not_take_are_refused_before_work(kind, options, err
     with pytest.raises(error) as e:
         evidence.run(kind, 1, **options)
     assert message in str(e.value)
+
+
+def test_the_evidence_listing_names_every_kind(capsys):
+    """``spinviz atlas evidence --help`` prints each kind with its description (argparse
+    expands '%' in help texts: a description must survive that)."""
+    from spinviz.commands import main
+
+    with pytest.raises(SystemExit) as e:
+        main(["atlas", "evidence", "--help"])
+    assert e.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    for kind in evidence.KINDS.values():
+        assert f"{kind.name} {' '.join(kind.summary.split()[:4])}" in text, kind.name
 
 
 @pytest.mark.parametrize("kind", sorted(evidence.KINDS))

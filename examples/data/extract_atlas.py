@@ -54,7 +54,7 @@ def extract(store: str) -> dict[str, np.ndarray]:
     # the series of the runs the hodographs show; the rest of the array is NaN (compresses to nothing)
     series = np.full(top["series"].shape, np.nan, dtype=np.float32)
     models, deltas, chis = list(top["model"].values), list(top["delta"].values), list(top["chi"].values)
-    for model, _, d, c, k, _ in representatives(top):
+    for model, _, d, c, k, *_ in representatives(top):
         if k < top.sizes["start"]:
             m, i, j = models.index(model), deltas.index(d), chis.index(c)
             series[m, i, j, k] = top["series"].values[m, i, j, k]

@@ -1,5 +1,6 @@
 """The hand-over engine: each run integrated in full until the averaged flow holds, then carried
-by the averaged flow to tau_end, and labelled by the attractor it is in.
+by the averaged flow to tau_end; its type as tau -> oo is the attractor it is in, its label at
+tau_end what its state shows there.
 
 Same contract as ``runs.run_batch`` (``run_batch(batch) -> dict``), chosen by the spec's
 ``[run] engine = "handover"`` (the default).  Per run of a symmetric top
@@ -29,18 +30,30 @@ J = (1, 1, 1 - delta), d = (sin chi, 0, cos chi) (dimensionless (4.1)):
 4. **Noise floor.**  Taylor's error control is local; the global error of the full stage is
    measured per cell by rerunning its first ``NOISE_PROBES`` handed-over runs at rtol/100 to
    their hand-over and comparing the averaged amplitudes.  The stated bound of a run is
-   ``BOUND_C`` mu_h^2 |(a, b)|_end (the averaged flow's error with the transform: O(mu_h^2),
-   measured, docs/atlas.md) + that floor (+ on the axial state of the reduced model the
-   ln tau drift of type 1, ``TYPE1_DRIFT_C`` mu_end^2 |b| ln(tau_end/tau_h)).  Where the free
+   ``stated_bound``: ``BOUND_C`` mu_h^2 |(a, b)|_end (the averaged flow's error with the
+   transform: O(mu_h^2), measured, docs/atlas.md) + ``SMALL_C`` min(a, b)_end (mu_h^2 + int mu^2
+   d ln tau) / min(1, 1 - delta) (the smaller amplitude's own share, below) + that floor (+ on the axial state of
+   the reduced model the ln tau drift of type 1, ``TYPE1_DRIFT_C`` mu_end^2 |b| ln(tau_end/tau_h)).
+   The second term: (LV) carries ln A and ln B, so the hand-over's O(mu_h^2) reading error and
+   the second-order drift first-order averaging omits (O(mu^2) per unit ln tau, integrated
+   along the averaged run) are shares of each amplitude, and the smaller one -- dying or slow
+   along the attractor, omega3 on the transverse state, where b ~ tau^(beta + 1/2) stays ~0.1 a
+   for decades -- keeps its share undamped.  On the reduced transverse state by the 3|4
+   boundary that share is b high by up to 0.4 mu_h^2 b at delta = 0.3, 0.9 at 0.5, 1.7 at 0.7,
+   6.7 at 0.9 (``validation.atlas.against_brute_force.margins``): ~0.3-0.7 mu_h^2 b / (1 - delta),
+   the torque's change of omega3 being divided by J3 = 1 - delta, so the term carries that
+   factor (measured, not derived: docs/atlas.md).  Where the free
    spiral -- the component that decides 1 versus 2 -- is below ``NOISE_FACTOR`` x the floor
    (or x the transform's own residual, 5 mu_h^2 |z_f|), the run says "spiral unresolved" and
    is not evidence for that decision.
 
-Labels: a handed-over run's ``regime`` is its attractor -- the stable state of (LV), unique in
-every cell where the engine hands over -- read at tau_end: "3", "4", "T2", "T4", and on the
-reduced axial state "1" (free/forced ratio below ``limit.R_ONE``), "2" (above ``limit.R_TWO``) or the
-mixture "1|2" between; ``label_inf`` is the label as tau -> oo ("1" iff alpha(4.14) < -1);
-``limit_settled`` and ``decades_to_settle`` say how near the attractor it is.  Runs that stay
+Labels, two of them: ``label_inf`` (the store's ``limit_label``) is the type as tau -> oo, the
+attractor -- the stable state of (LV), unique in every cell where the engine hands over: "3",
+"4", "T2", "T4", and on the reduced axial state "1" iff alpha(4.14) < -1, else "2";
+``limit_settled`` and ``decades_to_settle`` say how near it the run is.  ``regime`` (``label``)
+is what the run's state shows at tau_end: the classifier's label on its samples, the averaged
+flow's after the hand-over (a slow run still on its way -- a truncated cone drifting to T2, a
+type-3 run creeping as tau^-0.04 -- says so there, "Tcone" or "approaching 3").  Runs that stay
 in full keep the classifier's label; in cells with beta < -3/4 a type-4 run's limit is "5"
 (the spiral is captured into the libration, ``lock_to_5_at_tau``).
 """
@@ -60,13 +73,14 @@ from ...physics import averaged as AV
 from ...physics.equations import truncated_singularity
 from . import classify as C
 from . import runs as RN
-from .limit import crossing, evidence, limit_of, reconstruct
+from .limit import crossing, limit_of, reconstruct
 
 MU_STAR = 1e-2              # hand over below this mu: the averaged flow's error 0.2 mu^2 ~ 2e-5 of the amplitudes
 HOLD_DECADES = 0.25         # ... held at every sample of this last stretch
 MIN_BRAKING_TIMES = 10.0    # never before tau = 10 T: the braking has to have begun
 MU_BACK = 3.0               # the averaged flow is trusted to MU_BACK x MU_STAR (hysteresis); beyond: back to full
-BOUND_C = 0.2               # error of the averaged amplitudes <= BOUND_C mu_h^2 |(a, b)| (measured <= 0.11)
+BOUND_C = 0.2               # error of the averaged amplitudes <= BOUND_C mu_h^2 |(a, b)| ...
+SMALL_C = 1.0               # ... + SMALL_C min(a, b) (mu_h^2 + int mu^2 d ln tau) / min(1, 1 - delta)
 TYPE1_DRIFT_C = 1.3         # type 1's (k1 + k2 ln tau)/tau drift of b, missed by first-order averaging (measured)
 NOISE_PROBES = 4            # handed-over runs per cell rerun at rtol/100 for the noise floor
 NOISE_FACTOR = 10.0         # a component below this x the floor is not resolved
@@ -269,7 +283,8 @@ def averaged_stage(flows: list, tau: np.ndarray, handed: list, omega_h, mu_limit
     (an index into the output grid ``tau``) to the grid's end, one run per lane of heyoka's
     batch integrator (a run's numbers never depend on the others').  Per run a dict: ``idx``
     (grid indices from the hand-over on), ``lnA``, ``lnB`` there, ``sign_b``, ``phase_h``,
-    ``mu_max`` along it and ``tau_back`` (where mu first exceeds ``mu_limit``; inf if never)."""
+    ``mu_max`` along it, ``mu2_int`` (int mu^2 d ln tau along it, trapezoid rule on the samples)
+    and ``tau_back`` (where mu first exceeds ``mu_limit``; inf if never)."""
     from ...integrators.taylor import width
 
     out = []
@@ -289,6 +304,7 @@ def averaged_stage(flows: list, tau: np.ndarray, handed: list, omega_h, mu_limit
         mu = f.small_parameter_scaled(np.exp(r["lnA"]), np.exp(r["lnB"]), np.log(tau[r["idx"]]))
         over = np.flatnonzero(mu > mu_limit)
         r["mu_max"] = float(np.max(mu))
+        r["mu2_int"] = float(np.sum(0.5 * (mu[1:] ** 2 + mu[:-1] ** 2) * np.diff(np.log(tau[r["idx"]]))))
         r["tau_back"] = float(tau[r["idx"][over[0]]]) if over.size else math.inf
     return out
 
@@ -433,54 +449,72 @@ def _records(batch, cells: list, starts: list) -> tuple[list, float]:
     return records, t_cls + time.perf_counter() - t0
 
 
+def stated_bound(mu_h: float, a: float, b: float, mu2_int: float = 0.0, floor: float = math.nan,
+                 drift: tuple | None = None, delta: float = 0.0) -> float:
+    """The stated bound on the error of a handed-over run's averaged end amplitudes (a, b) =
+    (abar, |bbar|) (module docstring): ``BOUND_C`` mu_h^2 |(a, b)| + ``SMALL_C`` min(a, b) (mu_h^2 +
+    ``mu2_int``) / min(1, 1 - ``delta``) (``mu2_int``: int mu^2 d ln tau along the averaged run,
+    ``averaged_stage``; 1 - delta = J3, which divides the torque's change of omega3) + the noise
+    ``floor`` (NaN: not measured, 0) + type 1's drift ``TYPE1_DRIFT_C`` mu_end^2 b ln(tau_end
+    / tau_h) when ``drift`` = (mu_end, ln(tau_end / tau_h)) is given (the reduced axial state)."""
+    bound = BOUND_C * mu_h**2 * math.hypot(a, b) + SMALL_C * min(a, b) * (mu_h**2 + mu2_int) / min(1.0, 1.0 - delta)
+    bound += floor if math.isfinite(floor) else 0.0
+    if drift is not None:
+        bound += TYPE1_DRIFT_C * drift[0] ** 2 * b * drift[1]
+    return bound
+
+
 def handed_record(job: _Job, r: dict, state, floor: float, st, series: bool = True) -> RN.Record:
-    """The record of a handed-over run: its label from the attractor (module docstring), the
-    classifier's evidence read from the averaged flow, the limit records; ``series``: also its
-    omega series on the output grid (the full stage's samples, then ``reconstruct``'s)."""
+    """The record of a handed-over run.  Its limit (``label_inf``: the attractor, module
+    docstring) and the limit records from the averaged flow; its label at tau_end -- what its
+    state shows there, not where it goes -- by the classifier, on its samples: the full stage's,
+    then ``reconstruct``'s (the averaged amplitudes, to the stated bound, with the free spiral's
+    unresolved phase spread round the circle: ``reconstruct(spread=True)``), as a run
+    integrated in full is labelled, with the classifier's evidence; ``series``: also its omega
+    series on the output grid (after the hand-over with the averaged phase)."""
     flow, tau = job.flow, job.tau
     t = tau[r["idx"]]
     s = np.log(t)
     end, tau_end = len(t) - 1, float(t[-1])
-    ke = min(int(np.searchsorted(t, tau_end / 10.0**st.window)), end)
     lnA, lnB = float(r["lnA"][end]), float(r["lnB"][end])
     lim = limit_of(flow, state, lnA, lnB, float(s[end]))
-    early = limit_of(flow, state, float(r["lnA"][ke]), float(r["lnB"][ke]), float(s[ke]))
     a_h = math.exp(0.5 * r["lnA"][0])
     zf_h = abs(complex(flow.forced_response(job.omega[job.handed][2]))) * math.sqrt(t[0])
     thr = NOISE_FACTOR * max(floor if math.isfinite(floor) else 0.0, RESIDUAL_C * job.mu_h**2 * zf_h)
     unresolved = state.name == "axial" and flow.model == "reduced" and flow.F != 0.0 and a_h < thr
-    confidence, reason = 1.0, f"averaged flow from tau {t[0]:.2g} (mu {job.mu_h:.1g})"
+    seen = job.omega.copy()
+    seen[r["idx"]] = reconstruct(flow, r, tau, spread=True)
+    v = C.classify(tau, seen, flow.delta, flow.chi, flow.model, st.window)
+    cut = tau <= tau_end / 10.0**st.window * (1.0 + 1e-9)
+    label, candidate, confidence = v.label, v.candidate, v.confidence
+    early = C.classify(tau[cut], seen[cut], flow.delta, flow.chi, flow.model, st.window).label
+    reason = f"averaged from tau {t[0]:.2g} (mu {job.mu_h:.1g}); basin of {state.label}"
     if unresolved:
-        factor = thr / max(a_h, 1e-300)
-        lim = limit_of(flow, state, lnA, lnB, float(s[end]), factor)
-        early = limit_of(flow, state, float(r["lnA"][ke]), float(r["lnB"][ke]), float(s[ke]), factor)
-        for d in (lim, early):
-            d["label"] = "1" if d["label"] == "1" else "other"
+        # the free spiral -- what tells 1 from 2 -- is noise: only type 1 is decided, where the
+        # noise's upper bound on the spiral decides it
+        lim = limit_of(flow, state, lnA, lnB, float(s[end]), thr / max(a_h, 1e-300))
         lim["label_inf"] = "1" if flow.ratio_exponent < 0.0 else "other"
-        confidence, reason = (1.0 if lim["label"] == "1" else 0.3), reason + "; spiral unresolved (noise floor)"
-    reason += f"; basin of {state.label}" + ("" if lim["settled"] else f", {lim['decades']:.2g} decades to settle")
+        if lim["label"] != "1" or label != "1":            # 1 and 2 not told apart: the mixture
+            candidate, label, confidence = "1|2", "other", min(confidence, 0.3)
+        early = early if early == "1" else "other"
+        reason += ", spiral unresolved (noise floor)"
+    reason += ("" if lim["settled"] else f", {lim['decades']:.2g} decades to settle") + f"; at tau_end {v.reason}"
     A, B = math.exp(lnA), math.exp(lnB)
     mu_end = float(flow.small_parameter_scaled(A, B, s[end]))
-    bound = BOUND_C * job.mu_h**2 * math.hypot(math.sqrt(A), math.sqrt(B)) + (floor if math.isfinite(floor) else 0.0)
-    if state.name == "axial" and flow.model == "reduced":
-        bound += TYPE1_DRIFT_C * mu_end**2 * math.sqrt(B) * math.log(tau_end / t[0])
-    win = s >= s[end] - st.window * math.log(10.0)
-    f3 = np.exp(0.5 * r["lnB"][win] + 0.5 * s[win])
-    turns = abs(flow.delta) * float(np.sum(0.5 * (f3[1:] + f3[:-1]) * np.diff(s[win]))) / (2.0 * math.pi)
-    ev = evidence(flow, lim["label"], lnA, lnB, float(s[end]), (float(r["lnA"][ke]), float(r["lnB"][ke]), float(s[ke])),
-                  r["sign_b"], turns)
+    drift = (mu_end, math.log(tau_end / t[0])) if state.name == "axial" and flow.model == "reduced" else None
+    bound = stated_bound(job.mu_h, math.sqrt(A), math.sqrt(B), r["mu2_int"], floor, drift, flow.delta)
+    limit = {"tau_handover": float(t[0]), "mu_handover": job.mu_h, "bound": bound, "abar_end": math.sqrt(A),
+             "bbar_end": r["sign_b"] * math.sqrt(B), "free_forced_ratio": lim["ratio"], "tau_1_2": crossing(flow, r, tau),
+             "limit_settled": int(lim["settled"] and lim["label_inf"] != "other"), "decades_to_settle": lim["decades"],
+             "label_inf": RN.code(lim["label_inf"]), "noise_floor": floor, "spiral_unresolved": int(unresolved)}
     omega = job.omega.copy()
     if series:
         omega[r["idx"]] = reconstruct(flow, r, tau)
     else:
         omega[-1] = reconstruct(flow, r, tau, last_only=True)[-1]
-    limit = {"tau_handover": float(t[0]), "mu_handover": job.mu_h, "bound": bound, "abar_end": math.sqrt(A),
-             "bbar_end": r["sign_b"] * math.sqrt(B), "free_forced_ratio": lim["ratio"], "tau_1_2": crossing(flow, r, tau),
-             "limit_settled": int(lim["settled"] and lim["label_inf"] != "other"), "decades_to_settle": lim["decades"],
-             "label_inf": RN.code(lim["label_inf"]), "noise_floor": floor, "spiral_unresolved": int(unresolved)}
-    return RN.Record(lim["label"], early["label"], lim["label_inf"], confidence, 0, reason, C.Verdict(
-        lim["label"], confidence, lim["label_inf"], reason, ev).vector(), omega[-1].copy(), tau_end, job.nsteps, 0, 0.0,
-        limit=limit, method=RN.HANDED_OVER, series=omega if series else None)
+    ev = C.Verdict(label, confidence, candidate, reason, v.evidence).vector()
+    return RN.Record(label, early, candidate, float(confidence), 0, reason, ev, omega[-1].copy(),
+                     tau_end, job.nsteps, 0, 0.0, limit=limit, method=RN.HANDED_OVER, series=omega if series else None)
 
 
 def full_record(job: _Job, st, info: tuple, returned: bool = False) -> RN.Record:

@@ -1,6 +1,7 @@
 """The hodographs of an atlas (the paper's figure 3), as a PNG: one small panel per type found,
-the run with the highest confidence of that type -- its series read from the store, or
-integrated again where the store kept none (the runs are deterministic) -- as omega scaled
+a run of that type from the cell deepest inside the type's domain (``representatives``) -- its
+series read from the store, or integrated again where the store kept none (the runs are
+deterministic) -- as omega scaled
 by sqrt(tau + 1/|omega0|^2): the unit sphere at the start, omega sqrt(tau) at the end, where
 the asymptotic types are fixed points (1), circles (3, 4), spirals onto an axis (2) or arcs (5).
 
@@ -26,33 +27,61 @@ from .cells import spec_of
 from .diagram import save_small
 from .style import ORDER
 
+MARGIN_CELLS = 2.0          # a representative's cell: at least this many grid steps from any cell of another type
+
+
+def depth(pure: np.ndarray) -> np.ndarray:
+    """How deep each cell lies inside a region: ``pure`` (n_delta, n_chi) bool -> the distance,
+    in grid steps (Euclidean on the cell indices), from each cell of the region to the nearest
+    cell outside it -- the grid's surroundings count as outside, so its edges (delta = +-1,
+    chi = 0, 90 deg: other regimes) are boundaries too; 0 outside the region."""
+    ni, nj = pure.shape
+    oi, oj = np.nonzero(~pure)
+    ring_i = np.concatenate([np.arange(-1, ni + 1), np.arange(-1, ni + 1), np.full(nj, -1), np.full(nj, ni)])
+    ring_j = np.concatenate([np.full(ni + 2, -1), np.full(ni + 2, nj), np.arange(nj), np.arange(nj)])
+    oi, oj = np.concatenate([oi, ring_i]).astype(float), np.concatenate([oj, ring_j]).astype(float)
+    ii, jj = np.meshgrid(np.arange(ni, dtype=float), np.arange(nj, dtype=float), indexing="ij")
+    d2 = np.min((ii[..., None] - oi) ** 2 + (jj[..., None] - oj) ** 2, axis=-1)
+    return np.where(pure, np.sqrt(d2), 0.0)
+
 
 def representatives(ds) -> list[tuple]:
-    """(model, label, delta, chi, member index, confidence) for each type found, per model:
-    the cell where the type has its largest share (ties: the one nearest the centre of that
-    type's cells), and there the member labelled so with the highest confidence -- preferring
-    the members whose series the store keeps (``[output].series``), so that drawing needs no
-    integration unless a type was met only among the others."""
+    """(model, type, delta, chi, member index, confidence, depth) for each type the diagram
+    shows (``cells.cell_types``: the types as tau -> oo where the store has them), per model: a
+    run that ends in that type *and* shows it at tau_end (its label there), from the cell that
+    lies deepest inside the type's domain -- every start of the cell of that type, and the cell
+    ``depth`` grid steps from the nearest cell holding anything else or the grid's edge (at least
+    ``MARGIN_CELLS`` wherever the domain is that wide) -- so a panel shows the type as it is
+    inside its domain, not a slow run by a boundary.  Ties go to the more confident run; among
+    a cell's runs, those whose series the store keeps (``[output].series``: drawn without
+    integrating again) first, then the most confident.  A type that no whole cell holds is
+    shown from the cell where it has its largest share; one no run shows at tau_end, by its
+    most confident run."""
+    from .cells import cell_types
+
     out = []
     d_all, c_all = ds["delta"].values, ds["chi"].values
     kept = ds.sizes["start"] if "series" in ds else 0
     for model in [str(m) for m in ds["model"].values]:
-        lab_all = ds["label"].sel(model=model).values
-        conf_all = ds["confidence"].sel(model=model).values
+        types, _ = cell_types(ds, model)
+        shows = ds["label"].sel(model=model).values
+        conf = np.nan_to_num(ds["confidence"].sel(model=model).values.astype(float), nan=-1.0)
         for name in ORDER:
             if name in ("other", "failed", "missing", "approaching"):
                 continue
-            width = kept if (lab_all[..., :kept] == name).any() else lab_all.shape[-1]
-            m, conf = lab_all[..., :width] == name, conf_all[..., :width]
-            if not m.any():
+            ends = types == name
+            if not ends.any():
                 continue
-            share = m.mean(axis=-1)
-            ii, jj = np.nonzero(share > 0)
-            cd, cc = np.average(d_all[ii], weights=share[ii, jj]), np.average(c_all[jj], weights=share[ii, jj])
-            dist = (d_all[:, None] - cd) ** 2 + ((c_all[None, :] - cc) / (0.5 * math.pi)) ** 2
-            i, j = min(zip(ii, jj), key=lambda ij: (-share[ij], dist[ij]))
-            k = int(np.argmax(np.where(m[i, j], conf[i, j], -1.0)))
-            out.append((model, name, float(d_all[i]), float(c_all[j]), k, float(conf[i, j, k])))
+            share = ends.mean(axis=-1)
+            deep = depth(share == 1.0)
+            good = ends & (shows == name)
+            pick = good if good.any() else ends
+            score = np.where(pick, conf, -2.0) + np.where(np.arange(pick.shape[-1]) < kept, 3.0, 0.0)
+            best = np.max(np.where(pick, score, -np.inf), axis=-1)           # per cell: its best run's score
+            cell = np.where(pick.any(axis=-1))
+            i, j = max(zip(*cell), key=lambda ij: (deep[ij], share[ij], best[ij]))
+            k = int(np.argmax(np.where(pick[i, j], score[i, j], -np.inf)))
+            out.append((model, name, float(d_all[i]), float(c_all[j]), k, float(conf[i, j, k]), float(deep[i, j])))
     return out
 
 
@@ -92,7 +121,7 @@ def hodographs(ds, path: str):
     omega0 = ds["omega0"].values
     d_all, c_all = list(ds["delta"].values), list(ds["chi"].values)
     tau_start = float(spec_of(ds)["run"].get("tau_start", 1e-2))
-    for idx, (model, name, d, c, k, conf) in enumerate(reps):
+    for idx, (model, name, d, c, k, conf, deep) in enumerate(reps):
         tau, omega = series_of(ds, model, d_all.index(d), c_all.index(c), k)
         w0 = float(np.linalg.norm(omega0[k]))
         # omega sqrt(tau) has a limit for every braking type; a residual rotation does not brake
@@ -119,9 +148,10 @@ def hodographs(ds, path: str):
         ax.tick_params(labelsize=6, pad=-3)
         ax.locator_params(nbins=4)
         unit = "  (\u03c9/|\u03c9\u2080|)" if name == "R" else ""
-        after = f"; averaged flow from \u03c4 = {t_h:.0e} (ring)" if handed else ""
+        after = f"\naveraged flow from \u03c4 = {t_h:.0e} (ring)" if handed else ""
+        inside = f", {deep:.1f} cells inside" if deep > 0 else ""
         ax.set_title(f"{model} \"{name}\"  \u03b4={d:+.2f} \u03c7={math.degrees(c):.1f}\u00b0{unit}\n"
-                     f"confidence {conf:.2f}{after}", fontsize=8)
+                     f"confidence {conf:.2f}{inside}{after}", fontsize=8)
     note = ("\nafter a hand-over (black ring) the samples are the averaged flow's: the amplitudes are the run's "
             "(to its stated bound), the phase is the averaged one, not resolved"
             if "tau_handover" in ds and np.isfinite(ds["tau_handover"].values).any() else "")

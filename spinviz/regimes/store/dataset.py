@@ -3,7 +3,8 @@
 Layout (dims ``model``, ``delta``, ``chi``, ``member``; ``axis`` = 1, 2, 3; ``quantity`` =
 ``classify.EVIDENCE``; ``formula`` = ``FORMULAS``)::
 
-    regime, regime_early, candidate   int8   label codes (flag_values / flag_meanings; 0 = not computed yet)
+    regime, regime_early, candidate   int8   label codes at tau_end, what the state shows there (flag_values /
+                                             flag_meanings; 0 = not computed yet); ``label_inf`` is the limit
     status, method                    int8   how the run ended (``runs.STATUS_TEXT``), the integrator
     confidence, tau_reached, run_seconds  float64
     nsteps, nfev                      int64
@@ -50,7 +51,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...atomic import loads_json
-from ...errors import UsageError
+from ...errors import UsageError, printable
 from ...interrupt import deferred
 from ...physics import asymptotics as FM
 from ..engine import classify as C
@@ -60,7 +61,9 @@ from . import integrity as IN
 
 DIMS = ("model", "delta", "chi", "member")
 PER_RUN = {            # name -> (dtype, description)
-    "regime": ("int8", "asymptotic type (see flag_meanings); 0 = not computed yet"),
+    "regime": ("int8", "the type the run's state shows at tau_reached (see flag_meanings): the classifier's label on "
+                       "its last window_decades of samples -- a handed-over run's rebuilt from the averaged flow; "
+                       "label_inf is where it goes; 0 = not computed yet"),
     "regime_early": ("int8", "the same run's label window_decades before its end (agreement = the label held)"),
     "candidate": ("int8", "the best class even where regime is 'other' (or a mixture 1|2, 4|5)"),
     "status": ("int8", "how the run ended (flag_meanings)"),
@@ -79,8 +82,8 @@ LIMIT = {
     "tau_handover": "tau where the run left full integration for the averaged flow (NaN: in full to tau_end)",
     "mu_handover": "the averaged flow's small parameter mu = |omega|^2/|delta omega3| (x max(1, |omega|/|omega3|), "
                    "reduced) at the hand-over",
-    "bound": "stated bound on the error of abar_end, bbar_end: 0.2 mu_handover^2 |(a, b)| + noise_floor "
-             "(+ type 1's ln tau drift on the reduced axial state)",
+    "bound": "stated bound on the error of abar_end, bbar_end: 0.2 mu_handover^2 |(a, b)| + min(a, b) (mu_handover^2 + "
+             "int mu^2 d ln tau) / min(1, 1 - delta) + noise_floor (+ type 1's ln tau drift on the reduced axial state)",
     "abar_end": "averaged omega_perp sqrt(tau) at tau_end (through the near-identity transform; NaN where it does not hold)",
     "bbar_end": "averaged omega3 sqrt(tau) at tau_end, signed",
     "free_forced_ratio": "free spiral / forced response of omega_perp at tau_end (reduced axial state: type 2's part "
@@ -90,8 +93,9 @@ LIMIT = {
     "limit_settled": "1: within 5 % (ln A, ln B) of the attractor and, on the reduced axial state, the ratio past 0.1 "
                      "(limit 1) or 10 (limit 2); full runs: the label held over the last two windows",
     "decades_to_settle": "decades beyond tau_end still needed to settle (from the attractor's eigenvalues and alpha + 1)",
-    "label_inf": "the type as tau -> oo (flag_meanings): the attractor; for runs in full their label, a type-4 run "
-                 "where beta < -3/4 counted as 5 (captured into the libration)",
+    "label_inf": "the type as tau -> oo (flag_meanings): a handed-over run's attractor, settled or not (regime says "
+                 "what its state shows at tau_end); for runs in full their label, a type-4 run where beta < -3/4 "
+                 "counted as 5 (captured into the libration)",
     "noise_floor": "global error of the full stage at hand-over, scaled amplitudes (the cell's first handed-over "
                    "runs of the task rerun at rtol/100); NaN: not measured",
     "spiral_unresolved": "1: the free spiral at hand-over is below 10 x the noise floor (or the transform's residual): "
@@ -408,13 +412,27 @@ def verify(path: str) -> IN.Report:
     return IN.verify(path, run_variables(path))
 
 
+# The first classifier version whose ``regime`` of a handed-over run is what its state shows at
+# tau_end; a hand-over store of an earlier version holds the attractor there (``label_inf``'s value)
+STATE_LABELS_SINCE = 4
+
+
 def open_atlas(path: str):
-    """The store as an xarray Dataset, with ``label`` (strings; ``limit_label`` for the label as
-    tau -> oo, where the store has it) and the evidence unpacked into one variable per quantity
-    (``slope_perp``, ``X2``, ...); runs not computed yet are masked."""
+    """The store as an xarray Dataset, with ``label`` (strings: what each run's state shows at
+    tau_end) and ``limit_label`` (the type as tau -> oo, where the store has it), and the
+    evidence unpacked into one variable per quantity (``slope_perp``, ``X2``, ...); runs not
+    computed yet are masked.  A hand-over store of a classifier before ``STATE_LABELS_SINCE``,
+    whose ``regime`` of a handed-over run is its attractor, is refused (``UsageError``, one line):
+    its ``label`` would silently mean another thing."""
     import xarray as xr
 
     ds = xr.open_zarr(path)
+    version = ds.attrs.get("classifier_version")
+    if isinstance(version, int) and version < STATE_LABELS_SINCE and "tau_handover" in ds \
+            and bool((ds["method"] == RN.METHOD_CODE[RN.HANDED_OVER]).any()):
+        raise UsageError(f"{printable(str(path), 200)}: an atlas of classifier version {version}, whose label at "
+                         f"tau_end of a handed-over run is its attractor's; this spinviz (version {C.VERSION}) labels "
+                         f"the state there: compute the atlas again into a new store")
     names = np.array(["" for _ in range(256)], dtype=object)
     for lab, c in C.CODE.items():
         names[c % 256] = lab

@@ -20,6 +20,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ...errors import SceneError, UsageError
+from ..engine import classify as C
 from ..engine import refine as RF
 from ..faults import ForeignLevel, StoreDamaged
 from . import dataset as DS
@@ -191,7 +192,7 @@ def recorded_identity(path: str) -> str | None:
 def recorded_spec(path: str):
     """The ``AtlasSpec`` the store at ``path`` records (``inputs.atlas_spec.spec_from_record``),
     checked against its own ``spec_sha256``: ``SceneError`` naming ``.zattrs`` when the record
-    is unreadable or does not match its hash."""
+    is unreadable, was made by another classifier version, or does not match its hash."""
     from ...inputs.atlas_spec import spec_from_record
 
     where = os.path.join(path, ".zattrs")
@@ -202,6 +203,10 @@ def recorded_spec(path: str):
     except (OSError, ValueError):
         raise SceneError(where, "(file)", "unreadable: not the attributes of an atlas store") from None
     spec = replace(spec_from_record(attrs, where), path=path)
+    version = attrs.get("classifier_version")
+    if version != C.VERSION and DS.identity(spec) != attrs.get("spec_sha256"):
+        raise SceneError(where, "classifier_version", f"{version!r}: made by another classifier version (this "
+                                                      f"spinviz's is {C.VERSION}), whose labels mean another thing")
     if DS.identity(spec) != attrs.get("spec_sha256"):
         raise SceneError(where, "spec_sha256", "does not match the recorded spec (the attributes were changed)")
     return spec

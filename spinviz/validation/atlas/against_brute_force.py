@@ -185,47 +185,224 @@ def format_table(rows: list[dict]) -> str:
     return "\n".join(out + ([""] + refs if refs else []))
 
 
+# --- the stated bound against tight references ---------------------------------------------------
+MARGIN_TOL = 1e-15             # the references' tolerance (scalar Taylor on the scaled variable)
+
+
+SCAN_DELTA = (0.3, 0.5, 0.7, 0.9, 0.95, 0.98)
+SCAN_BETA = (-0.52, -0.55, -0.6, -0.65, -0.7)
+
+
+def bound_points() -> list[tuple]:
+    """(name, model, delta, chi_deg, |omega0|): the validation and disputed points; the
+    audit's (0.7, 29 deg) and two cells beside it (the balanced state just inside (4.17), the
+    transverse one where mu falls slowest); and a scan of the reduced transverse state between
+    the 3|4 boundary beta(4.18) = -1/2 and the 4|5 band (``SCAN_BETA`` at each of ``SCAN_DELTA``),
+    where omega3 dies as tau^(beta + 1/2), slowest by the boundary, so the smaller amplitude b
+    stays large against the bound's |(a, b)| term for decades."""
+    from ...physics import asymptotics as FM
+    from .convergence import points as conv
+
+    scan = [(f"scan beta = {b:g}", "reduced", d, round(math.degrees(chi_at_beta(d, b)), 2), 0.1)
+            for d in SCAN_DELTA for b in SCAN_BETA]
+    near = [("4 by 3|4: b slow", "reduced", 0.7, 29.0, 0.1), ("4 by 4|5: mu slow", "reduced", 0.7, 31.0, 0.1),
+            ("3 by 3|4", "reduced", 0.7, 25.0, 0.1)]
+    near = [(f"{n} (beta = {FM.type4_eq4_18(d, math.radians(c))['beta']:.2f})", m, d, c, w) for n, m, d, c, w in near]
+    return conv() + near + scan
+
+
+def margins(members: int = 8, tau_end: float = 1e12, points=None, seed: int = 1, progress=None) -> list[dict]:
+    """The hand-over engine's stated bound where it was measured: per point, ``members`` starts
+    run by the engine (rtol 1e-8, as the atlases) to ``tau_end``, and each handed-over one again
+    by a scalar Taylor integrator at ``MARGIN_TOL`` (``full_run``), both read through the same
+    near-identity transform.  Per point: how many handed over, the largest and median error
+    over the bound, how many beyond it, and the error of the smaller amplitude as a share of
+    itself over mu_h^2 (signed: its largest magnitude, and how many are positive)."""
+    say = progress or (lambda m: None)
+    rows = []
+    for name, model, d, cdeg, w in (points or bound_points()):
+        say(f"bound: {name}")
+        chi = math.radians(cdeg)
+        starts = directions(members, seed) * w
+        t0 = time.perf_counter()
+        en = HO.cell_records(model, d, chi, starts, Settings(tau_end=tau_end, rtol=1e-8))
+        flow = AV.Flow(model, d, chi) if d != 0.0 and 0.0 < chi < 0.5 * math.pi else None
+        over, first, small = [], [], []
+        state = flow.stable_state() if flow is not None else None
+        axial = state is None or (model == "reduced" and state.name == "axial")
+        for k, e in enumerate(en):
+            lim = e.limit or {}
+            if flow is None or not math.isfinite(lim.get("tau_handover", math.nan)):
+                continue
+            wr = full_run(model, d, chi, starts[k], [tau_end], MARGIN_TOL)[-1]
+            a, b = (float(x) for x in AV.scaled_amplitudes(flow, wr[0] + 1j * wr[1], wr[2], tau_end))
+            ea, eb = lim["abar_end"] - a, abs(lim["bbar_end"]) - b
+            over.append(max(abs(ea), abs(eb)) / lim["bound"])
+            if not axial:               # the first term alone (+ the floor): the bound without the smaller one's share
+                floor = lim.get("noise_floor", math.nan)
+                alone = HO.BOUND_C * lim["mu_handover"] ** 2 * math.hypot(lim["abar_end"], lim["bbar_end"])
+                first.append(max(abs(ea), abs(eb)) / (alone + (floor if math.isfinite(floor) else 0.0)))
+            if not lim.get("spiral_unresolved", 0):         # a free spiral below the noise: no share of its own
+                small.append((eb / b if b < a else ea / a) / lim["mu_handover"] ** 2)
+        rows.append({"point": name, "model": model, "delta": d, "chi_deg": cdeg, "omega0": w, "members": members,
+                     "tau_end": tau_end, "handed_over": len(over),
+                     "max_over_bound": float(max(over)) if over else math.nan,
+                     "median_over_bound": float(np.median(over)) if over else math.nan,
+                     "beyond_bound": int(sum(x > 1.0 for x in over)),
+                     "max_over_first_term": float(max(first)) if first else math.nan,
+                     "small_share_mu2": float(max(small, key=abs)) if small else math.nan,
+                     "small_positive": int(sum(x > 0.0 for x in small)), "seconds": time.perf_counter() - t0})
+    return rows
+
+
+def format_margins(rows: list[dict]) -> str:
+    """The bound rows as a Markdown table."""
+    out = ["| point | model | δ | χ | handed over | error / bound: largest, median | beyond | error / first term "
+           "alone: largest | smaller amplitude's error / (itself × μ_h²): largest, positive |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        n = r["handed_over"]
+        err = f"{r['max_over_bound']:.2f}, {r['median_over_bound']:.2f}" if n else "-"
+        sm = f"{r['small_share_mu2']:+.2f}, {r['small_positive']}/{n}" if n and math.isfinite(r["small_share_mu2"]) else "-"
+        ft = f"{r['max_over_first_term']:.2f}" if n and math.isfinite(r["max_over_first_term"]) else "-"
+        out.append(f"| {r['point']} | {r['model']} | {r['delta']:g} | {r['chi_deg']:.2f}° | {n}/{r['members']} | {err} | "
+                   f"{r['beyond_bound'] if n else '-'} | {ft} | {sm} |")
+    return "\n".join(out)
+
+
 # --- the 4|5 band: basin fractions against beta -------------------------------------------------
-BAND_CHI_DEG = tuple(float(c) for c in np.arange(36.0, 47.01, 1.0))     # delta = 0.5: beta from -0.55 to -0.88
+BAND_DELTA = 0.5
+BAND_CHI_DEG = (39.0, 40.0, 41.0, 42.0, 43.0, 44.0)  # delta = 0.5: beta(4.18) = -0.617 ... -0.795
+OTHER_DELTA = 0.4                                   # the same betas at another delta
+AUDIT_CHI_DEG = 47.0                                # (0.4, 47 deg), beta = -0.730: the independent audit's point
+SPREAD_DELTA = (0.2, 0.8)                           # the audit's beta at deltas farther apart
+CONFIDENCE = 0.95
 
 
-def basins(delta: float = 0.5, chis_deg=BAND_CHI_DEG, members: int = 32,
-           tau_end: float = 1e16, rtol: float = 1e-8, seed: int = 1, omega: float = 0.1, progress=None) -> list[dict]:
-    """Across the 4|5 band at one delta: per chi, beta of (4.18) and the shares of the starts
-    whose limit is type 4 and type 5 (the hand-over engine: beyond beta = -3/4 the spiral is
-    captured, a type-4 run counting as 5 with its ``lock_to_5_at_tau``; before it both are
-    attractors and the fractions are the basins'), and what is still unsettled."""
+def chi_at_beta(delta: float, beta: float) -> float:
+    """chi (rad) where beta of (4.18), -(2 + delta) xi / (2 (1 - delta)(xi + 2)), equals ``beta``."""
+    xi = -4.0 * (1.0 - delta) * beta / (2.0 + delta + 2.0 * (1.0 - delta) * beta)
+    return math.atan(math.sqrt(xi))
+
+
+def band_points() -> list[tuple]:
+    """(delta, chi_deg) across the 4|5 band: ``BAND_CHI_DEG`` at ``BAND_DELTA``, then the same
+    betas of (4.18) at ``OTHER_DELTA`` (whether the shares follow beta alone), then the
+    audit's point (``OTHER_DELTA``, ``AUDIT_CHI_DEG``) and its beta at ``BAND_DELTA`` and at
+    ``SPREAD_DELTA``."""
+    from ...physics import asymptotics as FM
+
+    pts = [(BAND_DELTA, c) for c in BAND_CHI_DEG]
+    betas = [FM.type4_eq4_18(BAND_DELTA, math.radians(c))["beta"] for c in BAND_CHI_DEG]
+    pts += [(OTHER_DELTA, round(math.degrees(chi_at_beta(OTHER_DELTA, b)), 2)) for b in betas]
+    audit = FM.type4_eq4_18(OTHER_DELTA, math.radians(AUDIT_CHI_DEG))["beta"]
+    return pts + [(OTHER_DELTA, AUDIT_CHI_DEG)] + [(d, round(math.degrees(chi_at_beta(d, audit)), 2))
+                                                   for d in (BAND_DELTA,) + SPREAD_DELTA]
+
+
+def share_interval(k: int, n: int, confidence: float = CONFIDENCE) -> tuple[float, float]:
+    """The Clopper-Pearson interval of a share k/n, by its closed form in the beta
+    distribution's quantiles (lower B^-1(a/2; k, n - k + 1), upper B^-1(1 - a/2; k + 1, n - k),
+    a = 1 - ``confidence``; 0 and 1 at k = 0, n): its coverage is at least ``confidence`` for
+    every true share, where Wilson's dips below it (to ~0.83 at 32 starts near shares of 0
+    and 1) -- and the table's claims are of both kinds, a type absent from a cell and two
+    types sharing it."""
+    from scipy.stats import beta
+
+    a, k, n = 1.0 - confidence, int(k), int(n)
+    lo = float(beta.ppf(0.5 * a, k, n - k + 1)) if k > 0 else 0.0
+    hi = float(beta.ppf(1.0 - 0.5 * a, k + 1, n - k)) if k < n else 1.0
+    return lo, hi
+
+
+def starts_needed(half_width: float, confidence: float = CONFIDENCE) -> int:
+    """The fewest starts whose Clopper-Pearson interval at a share of 1/2 (the widest) is at
+    most +-``half_width``."""
+    n = 4
+    while True:
+        lo, hi = share_interval(n // 2, n, confidence)
+        if 0.5 * (hi - lo) <= half_width:
+            return n
+        n += 2
+
+
+def basins(members: int = 128, tau_end: float = 1e16, points=None, rtol: float = 1e-8, seed: int = 1,
+           omega: float = 0.1, threads: int | None = None, progress=None) -> list[dict]:
+    """Across the 4|5 band (``band_points``): per point, beta of (4.18) and the shares of the
+    starts whose limit is type 4 and type 5, with their Clopper-Pearson intervals (the
+    hand-over engine: beyond beta = -3/4 the spiral is captured, a type-4 run counting as 5
+    with its ``lock_to_5_at_tau``; before it both are attractors and the shares are the basins'
+    fractions among starts uniform on the sphere at |omega0| = ``omega``), and what is still
+    unsettled.  The points run in ``threads`` threads (the cores)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ...executors.processes import usable_cores
     from ...physics import asymptotics as FM
 
     say = progress or (lambda m: None)
-    rows = []
     starts = directions(members, seed) * omega
-    for cdeg in chis_deg:
-        chi = math.radians(float(cdeg))
-        say(f"basins: delta {delta:g}, chi {cdeg:g} deg")
-        recs = HO.cell_records("reduced", delta, chi, starts, Settings(tau_end=tau_end, rtol=rtol))
+    pts = list(points or band_points())
+
+    def one(p):
+        d, cdeg = p
+        say(f"basins: delta {d:g}, chi {cdeg:g} deg")
+        return HO.cell_records("reduced", d, math.radians(cdeg), starts, Settings(tau_end=tau_end, rtol=rtol))
+
+    with ThreadPoolExecutor(threads or usable_cores(), thread_name_prefix="spinviz-basins") as pool:
+        per = list(pool.map(one, pts))
+    rows = []
+    for (d, cdeg), recs in zip(pts, per):
         lim = Counter(_limit(r) for r in recs)
-        end = Counter(_shown(r) for r in recs)
         lock = [r.evidence[RN.C.EVIDENCE.index("lock_to_5_at_tau")] for r in recs if _limit(r) == "5" and r.label == "4"]
-        rows.append({"delta": delta, "chi_deg": float(cdeg), "beta": FM.type4_eq4_18(delta, chi)["beta"],
-                     "members": members, "tau_end": tau_end, "limit": dict(lim), "at_tau_end": dict(end),
-                     "share_4": lim.get("4", 0) / members, "share_5": lim.get("5", 0) / members,
-                     "captured_later": len(lock),
-                     "median_lock_tau": float(np.nanmedian(lock)) if lock else math.nan})
+        k4, k5 = lim.get("4", 0), lim.get("5", 0)
+        rows.append({"delta": d, "chi_deg": float(cdeg), "beta": FM.type4_eq4_18(d, math.radians(cdeg))["beta"],
+                     "members": members, "tau_end": tau_end, "omega0": omega, "limit": dict(lim),
+                     "at_tau_end": dict(Counter(_shown(r) for r in recs)),
+                     "share_4": k4 / members, "ci_4": share_interval(k4, members),
+                     "share_5": k5 / members, "ci_5": share_interval(k5, members), "other": members - k4 - k5,
+                     "captured_later": len(lock), "median_lock_tau": float(np.nanmedian(lock)) if lock else math.nan})
     return rows
 
 
 def format_basins(rows: list[dict]) -> str:
-    """The basin rows as a Markdown table."""
-    out = ["| chi | beta (4.18) | limit: 4 / 5 / other | at tau_end | type 4 at tau_end captured later (median tau) |",
-           "|---|---|---|---|---|"]
-    for r in rows:
-        other = r["members"] - round(r["share_4"] * r["members"]) - round(r["share_5"] * r["members"])
+    """The basin rows as a Markdown table (95 % Clopper-Pearson intervals in brackets)."""
+    out = ["| δ | χ | β (4.18) | as τ → ∞: type 4 | type 5 | other | at τ_end | type 4 at τ_end captured later "
+           "(median τ) |", "|---|---|---|---|---|---|---|---|"]
+    pc = lambda x, ci: f"{100 * x:.0f} % [{100 * ci[0]:.0f}, {100 * ci[1]:.0f}]"  # noqa: E731
+    for r in sorted(rows, key=lambda r: (-r["beta"], r["delta"])):
         at = ", ".join(f"{k} {v}" for k, v in sorted(r["at_tau_end"].items(), key=lambda kv: -kv[1]))
         lock = f"{r['captured_later']} ({r['median_lock_tau']:.1e})" if r["captured_later"] else "0"
-        out.append(f"| {r['chi_deg']:.1f}° | {r['beta']:.3f} | {100 * r['share_4']:.0f} % / {100 * r['share_5']:.0f} % / "
-                   f"{other} | {at} | {lock} |")
+        out.append(f"| {r['delta']:g} | {r['chi_deg']:.2f}° | {r['beta']:.3f} | {pc(r['share_4'], r['ci_4'])} | "
+                   f"{pc(r['share_5'], r['ci_5'])} | {r['other']} | {at} | {lock} |")
+    n = rows[0]["members"] if rows else 0
+    out += ["", f"{n} starts per point (|ω0| = {rows[0]['omega0'] if rows else 0:g}, τ_end = "
+                f"{rows[0]['tau_end'] if rows else 0:.0e}); brackets: 95 % Clopper–Pearson intervals."]
+    pairs = equal_beta(rows)
+    if pairs:
+        out += ["", "At equal β, type 4's share against δ = "
+                f"{BAND_DELTA:g}'s (Fisher's exact test: p, the chance of counts as far apart from one share):", ""]
+        out += [f"* β = {q['beta']:.3f}: δ = {q['delta']:g} {100 * q['share']:.0f} % against {100 * q['share_band']:.0f} %, "
+                f"p = {q['p']:.2g}" for q in pairs]
     return "\n".join(out)
+
+
+def equal_beta(rows: list[dict]) -> list[dict]:
+    """Each row off ``BAND_DELTA`` against the ``BAND_DELTA`` row of the same beta (within 1e-3):
+    type 4's two shares and Fisher's exact test of their counts -- whether the share is a
+    function of beta alone."""
+    from scipy.stats import fisher_exact
+
+    band = [r for r in rows if r["delta"] == BAND_DELTA]
+    out = []
+    for r in sorted((r for r in rows if r["delta"] != BAND_DELTA), key=lambda r: (-r["beta"], r["delta"])):
+        same = [b for b in band if abs(b["beta"] - r["beta"]) < 1e-3]
+        if not same:
+            continue
+        b = same[0]
+        k, kb = r["limit"].get("4", 0), b["limit"].get("4", 0)
+        p = float(fisher_exact([[k, r["members"] - k], [kb, b["members"] - kb]]).pvalue)
+        out.append({"beta": r["beta"], "delta": r["delta"], "share": k / r["members"], "share_band": kb / b["members"], "p": p})
+    return out
 
 
 # --- the averaged flows against full integration -------------------------------------------------
@@ -241,7 +418,8 @@ def flows(cells=FLOW_CELLS, mus=FLOW_MU, tau_f: float = 1e10, tol: float = 1e-15
     0.05)) run by a scalar Taylor integrator at ``tol`` to ``tau_f`` on 40 samples a decade,
     handed over at the first sample below each mu of ``mus``; the averaged amplitudes at tau_f
     against the full run's (read through the same transform): the error, the engine's stated
-    bound 0.2 mu_h^2 |(a, b)|, the error / mu_h^2, and the order fitted over ``mus``."""
+    bound (``handover_engine.stated_bound`` without the noise floor), the error / mu_h^2, and the
+    order fitted over ``mus``."""
     say = progress or (lambda m: None)
     rows = []
     for model, d, chi, what in cells:
@@ -262,7 +440,7 @@ def flows(cells=FLOW_CELLS, mus=FLOW_MU, tau_f: float = 1e10, tol: float = 1e-15
             a, b = math.exp(0.5 * r["lnA"][-1]), math.exp(0.5 * r["lnB"][-1])
             err = max(abs(a - a_ref), abs(b - b_ref))
             pts.append({"mu_h": float(mu[i]), "tau_h": float(tau[i]), "error": err,
-                        "bound": HO.BOUND_C * mu[i] ** 2 * math.hypot(a, b), "error_over_mu2": err / mu[i] ** 2})
+                        "bound": HO.stated_bound(float(mu[i]), a, b, r["mu2_int"], delta=d), "error_over_mu2": err / mu[i] ** 2})
         order = float(np.polyfit(np.log([p["mu_h"] for p in pts]), np.log([p["error"] for p in pts]), 1)[0])
         rows.append({"model": model, "delta": d, "chi_deg": math.degrees(chi), "type": what, "tau_f": tau_f,
                      "order": order, "points": pts, "seconds": time.perf_counter() - t0,

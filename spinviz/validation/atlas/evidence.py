@@ -35,6 +35,10 @@ TOLERANCE_S_PER_RUN = 0.009      # a run of the 12 x 12 grid at one rtol (82 s f
 BRUTE_S_PER_START = 0.7          # brute force per start and unit of sqrt(tau/1e10) over the 19 points (1 222 s for 16
 #                                  starts at 1e12 and 1e14, the machine shared)
 FLOWS_S = 60.0                   # eight starts to 1e10 at tol 1e-15 (measured 25-50 s)
+BASIN_S_PER_RUN = 0.075          # a run of the 4|5 band to 1e16, most in full (64 in 4.8 s of CPU, load ~6)
+LIBRATION_S = 2.0                # (4.42) read two ways: 8 starts sampled densely over 1e10 ... 2e10 (0.9 s)
+ENGINE_S_PER_RUN = 0.03          # a run of the hand-over engine, one cell's batch and its noise floor included
+MARGIN_REF_S = 0.12              # a tol-1e-15 reference of a handed-over start to 1e10 (0.05-0.12 s at (0.7, 29 deg))
 
 
 @dataclass(frozen=True)
@@ -81,7 +85,9 @@ def _validate(req, say):
     from . import validate as V
 
     rows = V.run(req.members, req.workers, progress=False)
-    return rows, V.format_table(rows), 0
+    say("(4.42) read as peak and as r.m.s.: dense samples")
+    lib = V.libration_readings()
+    return rows + [{"libration_readings": lib}], V.format_table(rows) + "\n\n" + V.format_libration(lib), 0
 
 
 def _crosscheck(req, say):
@@ -127,6 +133,13 @@ def _basins(req, say):
     return rows, HV.format_basins(rows), 0
 
 
+def _bound(req, say):
+    from . import against_brute_force as HV
+
+    rows = HV.margins(members=req.members, tau_end=req.tau_end, progress=say)
+    return rows, HV.format_margins(rows), 0 if all(r["beyond_bound"] == 0 for r in rows) else 1
+
+
 def _flows(req, say):
     from . import against_brute_force as HV
 
@@ -140,6 +153,12 @@ def _cores(req) -> int:
     return req.workers or usable_cores()
 
 
+def _band_points() -> int:
+    from .against_brute_force import band_points
+
+    return len(band_points())
+
+
 def _full(tau: float) -> float:
     from ...regimes.engine.cost import full_run_s
 
@@ -148,7 +167,8 @@ def _full(tau: float) -> float:
 
 KINDS = {k.name: k for k in (
     Kind("validate", "single-cell atlases inside every domain against the paper's formulas", 32,
-         cost=lambda r: 11 * r.members * ATLAS_S_PER_RUN / _cores(r), compute=_validate, options=("workers",)),
+         cost=lambda r: 12 * r.members * ATLAS_S_PER_RUN / _cores(r) + LIBRATION_S, compute=_validate,
+         options=("workers",)),
     Kind("crosscheck", "the disputed points with the paper's (4.2)-(4.4) typed in and SciPy", 3,
          cost=lambda r: 6 * r.members * CROSSCHECK_S_PER_RUN, compute=_crosscheck),
     Kind("physical", "the dimensionless runs against physical-unit simulate runs of (2.2)+(2.3) and (2.5); exit "
@@ -168,10 +188,15 @@ KINDS = {k.name: k for k in (
          cost=lambda r: r.members * BRUTE_S_PER_START * sum(_grows(h) for h in r.horizons), compute=_handover,
          options=("horizons", "out"), tau_why="where brute force integrates in full", horizons=(1e12, 1e14),
          keeps="handover_validation"),
-    Kind("basins", "the 4|5 band at delta = 0.5: the shares of the starts ending in 4 and in 5 against beta of "
-                   "(4.18), with their intervals", 32,
-         cost=lambda r: 12 * r.members * _full(r.tau_end), compute=_basins, options=("tau_end",), tau_max=1e20,
-         tau_why="where the hand-over engine was measured to hold", tau_end=1e16),
+    Kind("basins", "the 4|5 band at delta = 0.5 and 0.4: the shares of the starts ending in 4 and in 5 against "
+                   "beta of (4.18), with their Clopper-Pearson intervals at 95 percent", 256,
+         cost=lambda r: _band_points() * r.members * BASIN_S_PER_RUN * (_full(r.tau_end) / _full(1e16)) / _cores(r),
+         compute=_basins, options=("tau_end",), tau_max=1e20, tau_why="where the hand-over engine was measured to hold",
+         tau_end=1e16),
+    Kind("bound", "the hand-over engine's end amplitudes against tol-1e-15 references of the same starts: the error "
+                  "over the stated bound at every validation point; exit status 1 if one is beyond it", 8,
+         cost=lambda r: 18 * r.members * (ENGINE_S_PER_RUN + MARGIN_REF_S * _grows(r.tau_end)), compute=_bound,
+         options=("tau_end",), tau_end=1e12, tau_why="where the references integrate in full"),
     Kind("flows", "the averaged flows against full integration at tol 1e-15: the error of the averaged amplitudes "
                   "against the stated bound and its order in mu", 1,
          cost=lambda r: FLOWS_S, compute=_flows),

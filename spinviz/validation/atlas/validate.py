@@ -105,6 +105,56 @@ def format_table(rows) -> str:
     return "\n".join(lines)
 
 
+# --- (4.42) read as peak and as r.m.s. ----------------------------------------------------------
+LIBRATION = ("5 in '?' and (4.43)", 0.8, 1.2)     # the type-5 point where (4.42) is real
+
+
+def libration_readings(members: int = 8, delta: float = LIBRATION[1], chi: float = LIBRATION[2], omega: float = 0.1,
+                       tau: float = 1e10, span: float = 2.0, samples: int = 40001, seed: int = 1) -> dict:
+    """(4.42)'s A^2 and M^2 read both ways the paper allows.  (4.33) writes the swing as
+    omega_angle = f cos(phi), omega3 = v sin(phi) + w cos(phi) with f = A tau^-1/2, v = M tau^-3/4:
+    A, M are amplitudes, the peaks of omega_angle sqrt(tau), omega3 tau^(3/4) over a swing; for the
+    harmonic swing (4.33) assumes, the same as sqrt(2) x their r.m.s.  The measured swing is
+    anharmonic (~40 deg), so the two readings differ.  Each of ``members`` starts (|omega0| =
+    ``omega``, ``seed``) is integrated by a scalar Taylor integrator at tol 1e-12 to ``tau`` and
+    sampled ``samples`` times evenly over [tau, span tau] (~20 swings at (0.8, 1.2)); per
+    start the relative deviations from (4.42) of the peak readings (max A^2 = max omega_angle^2
+    tau, max M^2 = max omega3^2 tau^(3/2)), of the r.m.s. readings (2 <...>), and of B (mean
+    omega2 sqrt(tau): a mean either way).  Returns {"point", "delta", "chi", "members", "tau",
+    name: (median, min, max)}."""
+    from ...inputs.atlas_spec import directions
+    from .against_brute_force import full_run
+
+    f = FM.type5_eq4_42(delta, chi)
+    n1, n3 = math.sin(chi), math.cos(chi)
+    t = np.linspace(tau, span * tau, samples)
+    per: dict = {}
+    for w0 in directions(members, seed) * omega:
+        w = full_run("reduced", delta, chi, w0, t, tol=1e-12)
+        a2 = (w[:, 0] + (n3 / n1) * (1.0 - delta) * w[:, 2]) ** 2 * t          # omega_angle (4.23)^2 tau
+        m2 = w[:, 2] ** 2 * t**1.5
+        got = {"A^2 peak": (a2.max(), f["A2"]), "A^2 r.m.s.": (2.0 * a2.mean(), f["A2"]),
+               "M^2 peak": (m2.max(), f["M2"]), "M^2 r.m.s.": (2.0 * m2.mean(), f["M2"]),
+               "B": (float(np.mean(w[:, 1] * np.sqrt(t))), f["B"])}
+        for k, (meas, pred) in got.items():
+            per.setdefault(k, []).append((meas - pred) / abs(pred))
+    out = {"point": LIBRATION[0], "delta": delta, "chi": chi, "members": members, "tau": tau, "span": span}
+    out.update({k: (float(np.median(v)), float(np.min(v)), float(np.max(v))) for k, v in per.items()})
+    return out
+
+
+def format_libration(r: dict) -> str:
+    """The two readings of (4.42) as a Markdown table."""
+    lines = [f"(4.42) at {r['point']} (δ = {r['delta']:g}, χ = {math.degrees(r['chi']):.2f}°), {r['members']} starts, "
+             f"dense samples over τ = {r['tau']:.0e} … {r['span'] * r['tau']:.0e}: deviation from (4.42), median [min, max]", "",
+             "| quantity | peak (the classifier's) | r.m.s. (2 × mean square) |", "|---|---|---|"]
+    fmt = lambda v: f"{100 * v[0]:+.1f} % [{100 * v[1]:+.1f}, {100 * v[2]:+.1f}]"  # noqa: E731
+    for q in ("A^2", "M^2"):
+        lines.append(f"| {q} | {fmt(r[q + ' peak'])} | {fmt(r[q + ' r.m.s.'])} |")
+    lines.append(f"| B (a mean) | {fmt(r['B'])} | {fmt(r['B'])} |")
+    return "\n".join(lines)
+
+
 # --- the diagram against the domains ---------------------------------------------------------
 def paper_domain(delta: float, chi: float) -> str:
     """The type figure 2 assigns to a cell: (4.15) "2", (4.17) "3", (4.19) "4", (4.20) "?",

@@ -131,7 +131,7 @@ class Gas:
 
 # --- the flux-weighted normal speeds --------------------------------------------------------
 def flux_integrals(s, kmax: int = 4):
-    """I_k(s) = int_0^oo y^k exp(-(y - s)^2) dy for k = 0..kmax, shape (kmax + 1, *s.shape).
+    """I_k(s) = int_0^oo y^k exp(-(y - s)^2) dy for k = 0..kmax, shape ``(kmax + 1, *s.shape)``.
 
     I_0 = (sqrt(pi)/2) erfc(-s), I_1 = exp(-s^2)/2 + s I_0, I_(k+1) = s I_k + (k/2) I_(k-1):
     erfc(-s) of a face receding from the gas (s < 0) is erfc(|s|), small and accurate, so its

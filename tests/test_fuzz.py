@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 
 import spinviz
 from spinviz.commands import main
+from spinviz.physics.bodies import custom
 
 from tomlgen import dumps
 
@@ -175,6 +176,9 @@ def _tiny_body():
     return spinviz.symmetric_top(0.3, 0.7)
 
 
+ASYMMETRIC = custom((1.0, 1.36, 1.64), (0.57, 0.0, 0.82), units="dimensionless", name="box")   # the DAST box's shape
+
+
 api_values = st.one_of(
     values, st.none(), st.just(np.array([0.0, 0.05, 0.3])), st.just(np.array([[1.0, 2.0]])), st.just(np.float32(2.0)),
     st.just(np.int64(5)), st.just("scenes/askew_example.toml"), st.just(object()), st.builds(_tiny_body))
@@ -186,7 +190,8 @@ PLAUSIBLE = {              # values a caller might mean: the fuzz reaches runs a
         lambda v: [0.0, *sorted(set(v))])),
     "q0": st.one_of(st.none(), st.lists(st.floats(-1.0, 1.0), min_size=4, max_size=4)),
     "euler_zxz0": st.one_of(st.none(), st.lists(st.floats(-7.0, 7.0), min_size=3, max_size=3)),
-    "method": st.sampled_from(["auto", "taylor", "rk45", "dop853", "radau", "split4", "secular", "TAYLOR"]),
+    "method": st.sampled_from(["auto", "taylor", "rk45", "dop853", "radau", "split4", "secular", "polhode",
+                               "taylor -> polhode", "TAYLOR"]),
     "rtol": st.floats(1e-12, 1e-3), "atol": st.one_of(st.none(), st.floats(1e-14, 1e-6)),
     "step": st.one_of(st.none(), st.floats(0.01, 5.0)),
     "kinematics": st.sampled_from(["quaternion", "euler_zxz", "none"]),
@@ -221,7 +226,7 @@ def test_hostile_simulate_arguments_get_a_trajectory_or_a_typed_error(data):
     from spinviz.errors import SimulationError, SpecError
     from spinviz.inputs.simulation import SimulationRequest
 
-    kw = dict(SIMULATE_ARGS, body=_tiny_body())
+    kw = dict(SIMULATE_ARGS, body=data.draw(st.sampled_from([_tiny_body(), ASYMMETRIC])))
     hostile = data.draw(st.integers(0, 2)) == 0          # a third hostile, the rest what a caller might mean
     for _ in range(data.draw(st.integers(1, 3))):
         name = data.draw(st.sampled_from(sorted(SIMULATE_ARGS)))

@@ -146,11 +146,12 @@ def test_the_answer_is_stable_against_the_number_of_trials(cube):
 @pytest.mark.slow
 def test_a_stop_signal_ends_a_requirements_run_clean(tmp_path):
     """SIGTERM during the requirements' Monte Carlo (worker processes running): one line, exit 143,
-    nothing written, no process of the command left."""
+    nothing written, no process of the command left.  40 trials: with 16 one dark start (spun
+    nearly along d) leaves the vacuum's share below 95 %, and the command answers at once."""
     from procs import gone
 
     env = dict(os.environ, PYTHONUNBUFFERED="1")
-    proc = subprocess.Popen([sys.executable, "-m", "spinviz", "decide", str(CUBE), "--requirements", "--trials", "16",
+    proc = subprocess.Popen([sys.executable, "-m", "spinviz", "decide", str(CUBE), "--requirements", "--trials", "40",
                              "--workers", "2", "--out", str(tmp_path / "r")], cwd=tmp_path, env=env, text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
     seen, end = [], time.monotonic() + 120

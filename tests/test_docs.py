@@ -119,7 +119,7 @@ def test_api_page_of_simulate(site, tmp_path):
     sig = re.sub(r"\s+", " ", html.unescape(re.sub(r"<[^>]+>", "", sig))).strip()
     assert sig.startswith("simulate(body: Body, model: str, omega0, *, t_end: float | None = None, "
                           "samples: int | None = None, t_eval=None, q0=None, euler_zxz0=None, method: str = 'auto',"), sig
-    assert "kinematics: str = 'quaternion') → Trajectory" in sig, sig
+    assert "kinematics: str = 'quaternion', environment=None) → Trajectory" in sig, sig
     # the docstring, its numpydoc sections as field lists: name (type) – meaning
     assert "Integrate the Euler equation of model with orientation; return a Trajectory." in text
     assert re.search(r"kinematics \(\{.quaternion., .euler_zxz., .none.\}\) – “quaternion” \(default\); "

@@ -155,14 +155,38 @@ class SimulationRequest:
                                           f"{self.model!r}; Taylor's method and SciPy's integrate it")
             if m.fixed_step and self.step is None:
                 raise SpecError("step", f"method {m.name} is fixed-step: give step > 0")
+        trap = self.environment is not None and self.environment.active
         try:
             check_cost(self.body, self.model, np.asarray(self.omega0), self.horizon, self.method, self.step,
-                       kinematics=self.kinematics)
+                       kinematics=self.kinematics, braking_rate=self._gas_braking() if trap else 0.0)
         except SpecError as e:
             raise SpecError(self.time_key if e.key == "t_end" else e.key, e.reason) from None
-        if self.environment is not None and self.environment.active:
+        if trap:
             self._check_environment()
         return self
+
+    def _gas_braking(self) -> float:
+        """The least rate at which a trap's gas brakes |Omega| (1/s): its linear drag, at a spin
+        far below the gas's speeds (a faster body rams the gas and brakes faster); 0 without a
+        gas, or where the body cannot be in one (``_check_environment`` says why)."""
+        from .environment import check_body
+
+        env = self.environment
+        try:
+            check_body(env, self.body)
+        except SpecError as e:
+            raise SpecError(f"environment.{e.key}", e.reason) from None
+        gas = env.gas_model()
+        if gas is None:
+            return 0.0
+        from ..physics.gas import GasModel
+        from ..physics.surface import surface_of
+
+        surface = surface_of(self.body)
+        model = GasModel(gas, surface, tuple(self.body.inertia))
+        w = np.asarray(self.omega0, dtype=float)
+        slow = w / float(np.linalg.norm(w)) * 1e-6 * gas.mean_speed / surface.size
+        return max(model.damping_rate(slow), 0.0)
 
     def _check_environment(self):
         """A run in a trap: the body it needs (units, a surface, free-molecular flow), a method

@@ -48,7 +48,7 @@ AVERAGED = ("secular", "polhode")   # methods that follow the slow variables, no
 
 
 def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", step: float | None = None,
-               spin=None, kinematics: str = "quaternion", picked: str | None = None) -> None:
+               spin=None, kinematics: str = "quaternion", picked: str | None = None, braking_rate: float = 0.0) -> None:
     """Refuse, before any work, a run that cannot finish: more than 1e10 fixed steps, or more
     than ``HARD_MAX_TURNS`` turns (estimated with braking) for a method that resolves every
     turn.  ``secular`` follows the slow variables instead and has no such limit; ``auto`` is
@@ -57,7 +57,9 @@ def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", ste
     before tau0 |Omega| has braked to ``secular.EPS_MAX``, as the averaged flow predicts them
     (``handover.plan``; ``choose_method`` picks it only where they can finish), and its slow
     flow, like ``secular``'s, by its steps and the range of float64 it stays in
-    (``horizon.check_secular``).  ``SpecError`` names "step" or "t_end"."""
+    (``horizon.check_secular``).  ``braking_rate``: a braking of |omega| beside the radiation's,
+    at least this exponential rate (1/time; a trap's gas), which bounds the turns too.
+    ``SpecError`` names "step" or "t_end"."""
     method = str(method).lower()
     auto = method == "auto"
     if not body.is_symmetric and (auto or method == "polhode"):
@@ -82,6 +84,9 @@ def check_cost(body, model: str, omega0, t_end: float, method: str = "auto", ste
             raise SpecError("step", f"t_end / step = {t_end / step:.3g} steps; at most {MAX_FIXED_STEPS:g} can finish")
         return
     turns = estimated_turns(body, model, omega0, t_end, spin)
+    if braking_rate > 0.0:          # |omega| <= |omega0| exp(-rate t): the turns are at most its integral
+        turns = min(turns, float(np.linalg.norm(omega0)) * -math.expm1(-braking_rate * t_end)
+                    / (2.0 * math.pi * braking_rate))
     if turns > HARD_MAX_TURNS:
         who = method
         if auto:

@@ -16,6 +16,7 @@ import os
 import queue as _queue
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 import traceback
@@ -75,6 +76,17 @@ def _worker_signals(parent: int) -> None:
         """Unwind through the worker's clean-up."""
         raise SystemExit(128 + signum)
 
+    def unraisable(u):
+        """A SIGTERM that lands inside a callback Python cannot unwind through (a weak
+        reference's, as the import machinery's module locks are) would be printed as "Exception
+        ignored" and swallowed: the worker leaves at once instead, silent (its output is
+        discarded: the parent writes nothing after a stop)."""
+        if isinstance(u.exc_value, SystemExit):
+            os._exit(u.exc_value.code if isinstance(u.exc_value.code, int) else 1)
+        default_unraisable(u)
+
+    default_unraisable = sys.unraisablehook
+    sys.unraisablehook = unraisable
     signal.signal(signal.SIGTERM, leave)
     if hasattr(signal, "pthread_sigmask"):              # born with them blocked (WorkerPool): handled from here on
         signal.pthread_sigmask(signal.SIG_UNBLOCK, (signal.SIGINT, signal.SIGTERM, signal.SIGHUP))

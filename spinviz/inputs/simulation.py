@@ -156,50 +156,47 @@ class SimulationRequest:
             if m.fixed_step and self.step is None:
                 raise SpecError("step", f"method {m.name} is fixed-step: give step > 0")
         trap = self.environment is not None and self.environment.active
+        gas = self._trap_gas() if trap else None
         try:
             check_cost(self.body, self.model, np.asarray(self.omega0), self.horizon, self.method, self.step,
-                       kinematics=self.kinematics, braking_rate=self._gas_braking() if trap else 0.0)
+                       kinematics=self.kinematics, braking_rate=0.0 if gas is None else self._gas_braking(gas))
         except SpecError as e:
             raise SpecError(self.time_key if e.key == "t_end" else e.key, e.reason) from None
         if trap:
-            self._check_environment()
+            self._check_environment(gas)
         return self
 
-    def _gas_braking(self) -> float:
-        """The least rate at which a trap's gas brakes |Omega| (1/s): its linear drag, at a spin
-        far below the gas's speeds (a faster body rams the gas and brakes faster); 0 without a
-        gas, or where the body cannot be in one (``_check_environment`` says why)."""
+    def _trap_gas(self):
+        """The trap's gas acting on this body (``physics.gas.GasModel``; None without a gas),
+        once the body is one it can act on (CGS, a surface, free-molecular flow)."""
         from .environment import check_body
 
-        env = self.environment
         try:
-            check_body(env, self.body)
+            check_body(self.environment, self.body)
         except SpecError as e:
             raise SpecError(f"environment.{e.key}", e.reason) from None
-        gas = env.gas_model()
+        gas = self.environment.gas_model()
         if gas is None:
-            return 0.0
+            return None
         from ..physics.gas import GasModel
         from ..physics.surface import surface_of
 
-        surface = surface_of(self.body)
-        model = GasModel(gas, surface, tuple(self.body.inertia))
+        return GasModel(gas, surface_of(self.body), tuple(self.body.inertia))
+
+    def _gas_braking(self, model) -> float:
+        """The least rate at which the gas ``model`` brakes |Omega| (1/s): its linear drag, at a
+        spin far below the gas's speeds (a faster body rams the gas and brakes faster)."""
         w = np.asarray(self.omega0, dtype=float)
-        slow = w / float(np.linalg.norm(w)) * 1e-6 * gas.mean_speed / surface.size
+        slow = w / float(np.linalg.norm(w)) * 1e-6 * model.gas.mean_speed / model.surface.size
         return max(model.damping_rate(slow), 0.0)
 
-    def _check_environment(self):
-        """A run in a trap: the body it needs (units, a surface, free-molecular flow), a method
-        that carries it (``integrators.environment``) and a cost that can finish."""
+    def _check_environment(self, model):
+        """A run in a trap (its body checked by ``_trap_gas``, whose gas is ``model``, or None): a
+        method that carries it (``integrators.environment``) and a cost that can finish."""
         from ..integrators import environment as IE
         from ..integrators.auto import choose_method
-        from .environment import check_body
 
         env = self.environment
-        try:
-            check_body(env, self.body)
-        except SpecError as e:
-            raise SpecError(f"environment.{e.key}", e.reason) from None
         key = "environment.pressure_mbar" if env.has_gas else "environment.field_v_per_m"
         if self.kinematics != "quaternion":
             raise SpecError("kinematics", "a run in a trap needs the orientation (kinematics \"quaternion\"): the field "
@@ -212,13 +209,8 @@ class SimulationRequest:
         if why is not None:
             raise SpecError("method" if self.method != "auto" else key,
                             why if self.method != "auto" else f"auto picks {method!r} for this run, and {why}")
-        gas = env.gas_model()
-        if gas is None:
+        if model is None:
             return
-        from ..physics.gas import GasModel
-        from ..physics.surface import surface_of
-
-        model = GasModel(gas, surface_of(self.body), tuple(self.body.inertia))
         if method in ("taylor", "taylor-long"):
             n = IE.estimated_collisions(model, self.omega0, self.horizon)
             if n > IE.MAX_COLLISIONS:

@@ -150,6 +150,12 @@ def _polhode_note(body, model: str, omega0, t_end: float, spin=None) -> str:
     return "it applies"
 
 
+def _phase_note(turns: float) -> str:
+    """What an averaged method's reason adds where the spin phase after ``turns`` is beyond float64."""
+    ulp = float(np.spacing(2.0 * math.pi * turns))
+    return f"; the spin phase is beyond float64 (1 ulp = {ulp:.2g} rad)" if ulp > 1e-3 else ""
+
+
 def estimated_turns(body, model: str, omega0, t_end: float, spin=None) -> float:
     """Turns of the body over [0, t_end] with braking: |omega| following the law of (3.7),
     d|omega|/ds = -kappa eps |omega|^3, with kappa measured at the start
@@ -234,8 +240,7 @@ def choose_method(body, model: str, omega0, t_end: float, kinematics: str = "qua
 
         try:
             prepare(problem)
-            ulp = float(np.spacing(2.0 * math.pi * turns))
-            phase = f"; the spin phase is beyond float64 (1 ulp = {ulp:.2g} rad)" if ulp > 1e-3 else ""
+            phase = _phase_note(turns)
             return "secular", (f"~{turns:.3g} turns of a symmetric top (estimated with braking): the slow flow, in "
                                f"full where the precession is slow, averaged where it is fast (tau0 |Omega0| = "
                                f"{eps:.2g}){phase}")
@@ -247,8 +252,7 @@ def choose_method(body, model: str, omega0, t_end: float, kinematics: str = "qua
 
         try:
             check_applicable(problem)
-            ulp = float(np.spacing(2.0 * math.pi * turns))
-            phase = f"; the spin phase is beyond float64 (1 ulp = {ulp:.2g} rad)" if ulp > 1e-3 else ""
+            phase = _phase_note(turns)
             return "polhode", (f"~{turns:.3g} turns of an asymmetric body (estimated with braking): the torque averaged "
                                f"over the Euler-Poinsot polhode (tau0 |Omega0| = {eps:.2g}), separatrix crossings in "
                                f"full{phase}")

@@ -289,7 +289,7 @@ def test_spec_grid_and_identity():
     assert np.degrees(s.chis).tolist() == pytest.approx([10.0, 45.0])
     assert s.runs == 3 * 2 * 2 and s.omega0.shape == (2, 3)
     assert np.allclose(np.linalg.norm(s.omega0, axis=1), 0.1)
-    from spinviz.regimes.store.dataset import identity
+    from spinviz.regimes.store.levels import identity
 
     same = parse_spec({**GOOD, "title": "renamed"}, "other.toml")
     assert identity(same) == identity(s)                       # the title does not change the numbers
@@ -369,8 +369,8 @@ def test_import_is_light():
 
 def test_plan_covers_exactly_the_missing_runs():
     """Batches tile the missing runs exactly (never a done one), inside one storage chunk each."""
-    from spinviz.regimes.api import plan
-    from spinviz.regimes.store.dataset import chunk_shape
+    from spinviz.regimes.engine.runs import plan
+    from spinviz.regimes.store.levels import chunk_shape
 
     s = parse_spec({**GOOD, "members": {"count": 5, "seed": 1, "omega": 0.1}}, "g.toml")
     chunks = chunk_shape(s)

@@ -167,7 +167,7 @@ def test_verify_a_clean_store(reference, capsys):
     chunks, the runs the spec implies, the verdict; exit 0."""
     rc, lines = verify(reference, capsys)
     assert rc == 0
-    sha = DS.identity(levels.recorded_spec(str(reference)))
+    sha = levels.identity(levels.recorded_spec(str(reference)))
     assert lines == ["metadata: ok", f"spec: ok (sha256 {sha[:12]}, [refine] levels = 0)"] + [
         f"{v}: ok (4 chunks)" for v in DS.run_variables(str(reference))] + [
         "runs: all 36 computed", f"{reference}: ok: 36 runs verified"]

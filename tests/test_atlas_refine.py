@@ -61,8 +61,8 @@ def test_level_one_computes_exactly_the_children_of_flagged_cells(refined):
     _, done1 = LV.level_types(level1, 0)
     np.testing.assert_array_equal(done1, RF.children(flagged))
     g = zarr.open_group(level1, mode="r", zarr_format=2)
-    np.testing.assert_allclose(np.asarray(g["delta"]), RF.centres(-1.0, 1.0, 4, 1), rtol=0, atol=1e-15)
-    np.testing.assert_allclose(np.asarray(g["chi_deg"]), RF.centres(0.0, 90.0, 4, 1), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(np.asarray(g["delta"]), LV.centres(-1.0, 1.0, 4, 1), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(np.asarray(g["chi_deg"]), LV.centres(0.0, 90.0, 4, 1), rtol=0, atol=1e-12)
     assert res.levels == 1 and res.total == 64 + 4 * int(done1.sum()) == res.computed
     # the level's runs are real runs: every computed one labelled, every other one "missing" (code 0)
     codes = regime(level1)[0]

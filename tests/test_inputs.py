@@ -161,13 +161,13 @@ def test_an_atlas_that_cannot_finish_is_refused_before_any_work(tmp_path, monkey
     take months (the runs the averaged flow cannot carry are integrated in full: ~0.5 s each
     at 1e20).  The memory of this process and the time on its workers are estimated from the
     spec and the machine (here a 16 GB machine, one worker), and refused in one line naming the key."""
-    from spinviz.regimes import api
+    from spinviz.regimes import compute
     from spinviz.regimes.engine import cost as SP
 
     def work(*a, **k):
         raise AssertionError("the atlas started working")
 
-    monkeypatch.setattr(api, "plan", work)
+    monkeypatch.setattr(compute, "compute", work)
     monkeypatch.setattr(SP, "physical_memory", lambda: 16e9)
     spec = tmp_path / "big.toml"
     spec.write_text(ATLAS.format(cells=cells, members=members))

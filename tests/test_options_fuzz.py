@@ -46,8 +46,8 @@ def heavy_entries():
     """The modules' attributes that start real work, for every command."""
     from spinviz import driver, pipeline
     from spinviz.analysis import decide
-    from spinviz.regimes import api
     from spinviz.regimes import bench as atlas_bench
+    from spinviz.regimes import compute
     from spinviz.regimes.asymmetric import atlas as boxes_atlas
     from spinviz.regimes.store import dataset
     from spinviz.validation import bench, checks, process_bench, render_bench, report, secular_sweep, stress
@@ -56,7 +56,7 @@ def heavy_entries():
     return [(driver, "simulate_request"), (driver, "simulate"), (pipeline, "require_render_stack"),
             (render_bench, "require_render_stack"), (checks, "run_all"), (secular_sweep, "run_case"),
             (bench, "make_problem"), (process_bench, "problem"), (stress, "run_all"), (report, "generate"),
-            (api, "_compute"), (atlas_bench, "atlas"), (dataset, "Writer"), (evidence, "_compute"),
+            (compute, "compute"), (atlas_bench, "atlas"), (dataset, "Writer"), (evidence, "_compute"),
             (decide, "setup_from_scene"), (decide, "run"), (boxes_atlas, "atlas")]
 
 

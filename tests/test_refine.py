@@ -3,6 +3,7 @@
 import numpy as np
 
 from spinviz.regimes.engine import refine as RF
+from spinviz.regimes.store import levels as LV
 
 BOUNDARY = lambda d: 40.0 + 20.0 * d            # noqa: E731  chi (deg) of the synthetic boundary, delta in (-1, 1)
 
@@ -19,7 +20,7 @@ def run_levels(levels, cells=(8, 8)):
     maj, comp = [], []
     computed = np.ones((nd, nc), dtype=bool)
     for k in range(levels + 1):
-        d, c = RF.centres(-1.0, 1.0, nd, k), RF.centres(0.0, 90.0, nc, k)
+        d, c = LV.centres(-1.0, 1.0, nd, k), LV.centres(0.0, 90.0, nc, k)
         types = synthetic(d, c)
         m, share = RF.majority(types)
         maj.append(m)
@@ -46,8 +47,8 @@ def test_refinement_resolves_a_known_boundary_to_the_stated_width():
         assert fine[i, j], (d, BOUNDARY(d))
     # away from the boundary nothing was refined: distance > 2 coarse cells in chi
     for k in range(1, levels + 1):
-        d = RF.centres(-1.0, 1.0, 8, k)[:, None]
-        c = RF.centres(0.0, 90.0, 8, k)[None, :]
+        d = LV.centres(-1.0, 1.0, 8, k)[:, None]
+        c = LV.centres(0.0, 90.0, 8, k)[None, :]
         far = np.abs(c - BOUNDARY(d)) > 2 * 11.25
         assert not np.any(comp[k] & far)
 

@@ -190,7 +190,7 @@ def _run(spec, args) -> int:
 def stopped(args, signal_name) -> str:
     """The one line of an atlas command stopped by a signal (wherever it landed): the finished
     chunks are on disk and the same command completes the store -- that is the point."""
-    from ..inputs.atlas_spec import default_out
+    from ..inputs.atlas import default_out
 
     if args.job != "run":
         return f"interrupted by {signal_name}; nothing was written"

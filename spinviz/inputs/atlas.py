@@ -21,12 +21,14 @@ reason, default).  Then:
 from __future__ import annotations
 
 import math
+import os
 from typing import Annotated, Any, Literal
 
 from pydantic import Field, PlainValidator, model_validator
 from pydantic_core import PydanticCustomError
 
-from ..errors import SpecError, brief
+from ..atomic import check_parent_writable, special_kind
+from ..errors import SpecError, UsageError, brief
 from ..physics import models as M
 from .base import Flag, Int, Path, Positive, Real, Text, between, check_vector, refused, registered, request, shown, wrong_type
 from .toml import Table
@@ -292,3 +294,24 @@ def check_cluster(workers: int | None, scheduler: str | None) -> None:
     if workers is not None and workers > cores:
         raise SpecError("workers", f"must be at most {cores}, the cores this process may use (more workers than "
                                    f"cores only share them), got {workers}")
+
+
+def default_out(spec) -> str:
+    """``<spec stem>.zarr`` in the current directory (``spec``: an ``AtlasSpec`` or its path)."""
+    path = spec if isinstance(spec, str | os.PathLike) else spec.path
+    stem = os.path.splitext(os.path.basename(os.fspath(path)))[0] or "atlas"
+    return f"{stem}.zarr"
+
+
+def store_path(spec, out: str | None) -> str:
+    """The store of ``spec``: ``out``, or ``default_out``; a directory to be created or an
+    existing atlas store (checked later), not a file or a special file, not the spec itself,
+    in a writable directory (``UsageError`` naming it)."""
+    path = out if out is not None else default_out(spec)
+    if os.path.exists(path) and not os.path.isdir(path):
+        kind = special_kind(os.stat(path).st_mode) or "a file"
+        raise UsageError(f"{path}: exists and is {kind}; an atlas store is a directory (e.g. atlas.zarr)")
+    if spec.path and os.path.exists(path) and os.path.exists(spec.path) and os.path.samefile(path, spec.path):
+        raise UsageError(f"{path}: is the spec itself")
+    check_parent_writable(path)
+    return path

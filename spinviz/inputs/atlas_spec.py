@@ -44,7 +44,7 @@ braking law to the end of the run (docs/atlas.md: labels and amplitudes against 
 Every table is declared in ``spinviz.inputs.atlas`` (how to add a key is said there); this
 module builds the ``AtlasSpec`` from the validated tables -- every rule joining keys (the
 axes, the inertia limit, the horizon, the run cap) is checked here, once, and the spec is
-trusted after -- and where its store goes (``store_path``).  Whether the atlas can finish on
+trusted after.  Where its store goes is the arguments' (``atlas.store_path``).  Whether the atlas can finish on
 this machine (memory, time) is the engine's to say, from its measured costs
 (``regimes.engine.cost.check_feasible``), before any work.
 """
@@ -58,8 +58,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..atomic import check_parent_writable, loads_json, special_kind
-from ..errors import SceneError, SpecTypeError, UsageError
+from ..atomic import loads_json
+from ..errors import SceneError, SpecTypeError
 from ..physics.bodies import MIN_INERTIA_RATIO
 from . import atlas as IA
 from .base import fields_of, shown
@@ -347,27 +347,6 @@ def _check_horizon(path, s: Settings, omega0) -> None:
         raise SceneError(path, "[run].tau_end", f"tau_end = {s.tau_end:g} is {braking:.3g} braking times T = 1/|omega0|^2 "
                                                 f"of the slowest start (|omega0| = {slowest:g}); the asymptotic laws need at "
                                                 f"least {IA.MIN_BRAKING_TIMES:g}")
-
-
-def default_out(spec) -> str:
-    """``<spec stem>.zarr`` in the current directory (``spec``: an ``AtlasSpec`` or its path)."""
-    path = spec if isinstance(spec, str | os.PathLike) else spec.path
-    stem = os.path.splitext(os.path.basename(os.fspath(path)))[0] or "atlas"
-    return f"{stem}.zarr"
-
-
-def store_path(spec: AtlasSpec, out: str | None) -> str:
-    """The store of ``spec``: ``out``, or ``default_out``; a directory to be created or an
-    existing atlas store (checked later), not a file or a special file, not the spec itself,
-    in a writable directory (``UsageError`` naming it)."""
-    path = out if out is not None else default_out(spec)
-    if os.path.exists(path) and not os.path.isdir(path):
-        kind = special_kind(os.stat(path).st_mode) or "a file"
-        raise UsageError(f"{path}: exists and is {kind}; an atlas store is a directory (e.g. atlas.zarr)")
-    if spec.path and os.path.exists(path) and os.path.exists(spec.path) and os.path.samefile(path, spec.path):
-        raise UsageError(f"{path}: is the spec itself")
-    check_parent_writable(path)
-    return path
 
 
 def directions(count: int, seed: int) -> np.ndarray:

@@ -129,10 +129,11 @@ def store_cost(spec, repeats: int = 3) -> dict:
     synthetic results, with the checksums and with ``integrity.record`` replaced by a no-op;
     medians over ``repeats``.  Returns ms per chunk write (with, without, of which the
     checksums), the store's size and the time to verify it."""
-    from .api import RUNS_PER_TASK, plan
     from .engine import classify as C
+    from .engine.runs import RUNS_PER_TASK, plan
     from .store import dataset as DS
     from .store import integrity as IN
+    from .store import levels as LV
 
     if isinstance(repeats, bool) or not isinstance(repeats, int) or not 1 <= repeats <= 100:
         from ..errors import SpecError
@@ -146,8 +147,8 @@ def store_cost(spec, repeats: int = 3) -> dict:
         for _ in range(repeats):
             for sums in (False, True):
                 out = os.path.join(tmp, f"s{int(sums)}.zarr")
-                chunks = DS.chunk_shape(spec)
-                DS.create(spec, out, chunks)
+                chunks = LV.chunk_shape(spec)
+                DS.create(spec, out, chunks, LV.identity(spec))
                 done = np.zeros((len(spec.models), len(spec.deltas), len(spec.chis), spec.members), dtype=bool)
                 batches, keys, expected = plan(spec, chunks, done, RUNS_PER_TASK)
                 results = [_synthetic(b, len(C.EVIDENCE)) for b in batches]

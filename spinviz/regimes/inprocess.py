@@ -1,8 +1,8 @@
 """Small work in this process: the atlas's batches in a few threads of the client, with no
 cluster started (a LocalCluster costs ~3.5 s to start and stop, and importing Dask's
 distributed stack ~1-2 s more: more than a small atlas's work).  The same store writes,
-progress and stop signals as ``cluster.execute``; ``api`` chooses it for small work
-(``api.SMALL_WORK_S``) when no scheduler and no worker count are asked for.
+progress and stop signals as ``cluster.execute``; ``compute`` chooses it for small work
+(``compute.SMALL_WORK_S``) when no scheduler and no worker count are asked for.
 """
 
 from __future__ import annotations

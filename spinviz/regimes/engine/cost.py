@@ -17,7 +17,7 @@ from ...inputs.atlas_spec import AtlasSpec, Settings
 from ...inputs.options import MAX_DAYS_ENV, max_days
 from ...physics.averaged import averaging_holds
 
-# What this process holds for an atlas, measured with tracemalloc around api.plan and the
+# What this process holds for an atlas, measured with tracemalloc around runs.plan and the
 # store's predictions (64 x 64 cells x 32 members: 955 B a cell at the peak, 650 B a task),
 # with a margin; and what a run costs, one core, rtol 1e-8, classification included
 # (docs/atlas.md, "Benchmark" and "Horizons").
@@ -51,6 +51,11 @@ def run_cost_s(settings: Settings, model: str, delta: float, chi: float) -> floa
     return handed if averaging_holds(model, float(delta), float(chi))[0] else full
 
 
+def work_s(batches) -> float:
+    """The estimated CPU seconds of ``batches`` (``runs.Batch``: ``run_cost_s`` of each of their runs)."""
+    return sum(len(b.omega0) * run_cost_s(b.settings, b.model, d, c) for b in batches for d in b.deltas for c in b.chis)
+
+
 @dataclass(frozen=True)
 class Cost:
     """What an atlas needs: ``bytes`` in this process, ``cpu_s`` of integration, ``wall_s`` on ``workers``."""
@@ -81,13 +86,13 @@ def cost(spec: AtlasSpec, runs_per_task: int = 32, workers: int | None = None) -
     tc = max(1, runs_per_task // tm)
     tasks = len(spec.models) * len(spec.deltas) * math.ceil(len(spec.chis) / tc) * math.ceil(spec.members / tm)
     nbytes = BYTES_PER_CELL * cells + BYTES_PER_TASK * tasks + BYTES_PER_RUN * spec.runs
-    if spec.settings.engine == "taylor":
-        cpu = spec.runs * run_cost_s(spec.settings, spec.models[0], 0.5, 0.5)
+    if spec.settings.engine == "taylor":                 # the same cost at every cell: one stands for all
+        sample, weight = [(spec.models[0], 0.5, 0.5)], spec.runs
     else:
         ds, cs = spec.deltas, spec.chis
         ds, cs = ds[::max(1, len(ds) // SAMPLED_AXIS)], cs[::max(1, len(cs) // SAMPLED_AXIS)]
-        share = cells / (len(ds) * len(cs))
-        cpu = spec.members * share * sum(run_cost_s(spec.settings, m, d, c) for m in spec.models for d in ds for c in cs)
+        sample, weight = [(m, d, c) for m in spec.models for d in ds for c in cs], spec.members * cells / (len(ds) * len(cs))
+    cpu = weight * sum(run_cost_s(spec.settings, m, d, c) for m, d, c in sample)
     return Cost(spec.runs, tasks, nbytes, cpu, None if not workers else cpu / workers, workers)
 
 

@@ -87,12 +87,6 @@ def children(flagged: np.ndarray) -> np.ndarray:
     return upsample(flagged.astype(bool))
 
 
-def centres(lo: float, hi: float, cells: int, level: int) -> np.ndarray:
-    """Cell centres of level ``level`` over [lo, hi] (``cells`` at level 0)."""
-    n = cells * 2**level
-    return lo + (np.arange(n) + 0.5) * (hi - lo) / n
-
-
 def width(lo: float, hi: float, cells: int, levels: int) -> float:
     """The finest cell size after ``levels`` refinements: the width a boundary is resolved to."""
     return (hi - lo) / (cells * 2**levels)

@@ -14,6 +14,7 @@ chi = 0 or pi/2 or delta = 0, (5.2), (5.6)), reaching it: |d x omega| < ``RESIDU
 (~1e8 steps); the samples after the stop are the rotation reached, held, and the reason says
 so.  A run that fails keeps its samples so far and its reason; the batch goes on.
 
+``plan`` cuts the runs a store lacks into ``Batch``es, each inside one storage chunk;
 ``run_batch`` is what a Dask task executes: a block of the atlas (one model, a few cells,
 some members), returned as small arrays.
 """
@@ -27,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...inputs.atlas_spec import Settings
+from ...inputs.atlas_spec import AtlasSpec, Settings
 from ...integrators import status as ST
 from . import classify as C
 from . import limit as LM
@@ -42,6 +43,7 @@ STATUS_TEXT = {ST.OK: "ok", ST.TOO_MANY_STEPS: "step budget exhausted", ST.STEP_
 METHOD = "taylor"          # brute force: Taylor's method to tau_end (the store's ``method`` names it per run)
 HANDED_OVER = "taylor+averaged"   # the hand-over engine's runs: Taylor's method, then the averaged flow
 METHOD_CODE = {METHOD: 0, HANDED_OVER: 1}
+RUNS_PER_TASK = 32          # a task of ~32 runs lasts ~0.2-10 s: scheduling (~ms) stays below 1 %
 SINGULAR_MARGIN = 0.5      # truncated: refuse a start where 1 + (g x omega).J^-1 g < this
 RESIDUAL_ETA = 1e-9        # rad: |d x omega|/(|d||omega|) at which a run in an exact-residual cell stops
 
@@ -173,6 +175,58 @@ class Batch:
         """How many of this batch's members (its first ones) have their series kept."""
         m0, m1 = self.region[3]
         return max(0, min(m1, self.series) - m0)
+
+
+def plan(spec: AtlasSpec, chunks: tuple, done: np.ndarray, runs_per_task: int = RUNS_PER_TASK):
+    """Batches covering exactly the runs not yet done, each inside one storage chunk, in store
+    order (a block that is partly done is cut into the missing stretches of members).
+
+    Returns (batches, the storage chunk of each -- its Zarr chunk index (model, delta, chi
+    block, member block) --, expected batches per chunk)."""
+    _, _, cc, cm = chunks
+    tm = min(cm, max(1, runs_per_task))
+    tc = max(1, min(cc, runs_per_task // tm))
+    batches, keys, expected = [], [], {}
+    nd, nc, nm = len(spec.deltas), len(spec.chis), spec.members
+    for mi, model in enumerate(spec.models):
+        for di in range(nd):
+            for c0 in range(0, nc, cc):
+                for a in range(c0, min(c0 + cc, nc), tc):
+                    b = min(a + tc, c0 + cc, nc)
+                    for m0 in range(0, nm, cm):
+                        key = (mi, di, c0 // cc, m0 // cm)
+                        for ma in range(m0, min(m0 + cm, nm), tm):
+                            mb = min(ma + tm, m0 + cm, nm)
+                            block = done[mi, di, a:b, ma:mb]
+                            if block.all():
+                                continue
+                            if not block.any():
+                                parts = [(a, b, ma, mb)]
+                            else:                    # partly done: only the missing runs, cell by cell
+                                parts = [(a + j, a + j + 1, ma + s0, ma + s1) for j in range(b - a)
+                                         for s0, s1 in _runs_of(~block[j])]
+                            for pa, pb, pma, pmb in parts:
+                                batches.append(Batch(model, (float(spec.deltas[di]),),
+                                                        tuple(float(x) for x in spec.chis[pa:pb]),
+                                                        np.asarray(spec.omega0[pma:pmb]), spec.settings,
+                                                        (mi, (di, di + 1), (pa, pb), (pma, pmb)), spec.series))
+                                keys.append(key)
+                                expected[key] = expected.get(key, 0) + 1
+    return batches, keys, expected
+
+
+def _runs_of(mask: np.ndarray) -> list[tuple[int, int]]:
+    """[start, stop) of each stretch of True in a 1-D mask."""
+    out, start = [], None
+    for i, m in enumerate(mask):
+        if m and start is None:
+            start = i
+        elif not m and start is not None:
+            out.append((start, i))
+            start = None
+    if start is not None:
+        out.append((start, len(mask)))
+    return out
 
 
 # [run] engine -> the module that runs it, beside the brute force here ("taylor"): each

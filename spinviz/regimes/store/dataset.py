@@ -50,13 +50,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...atomic import loads_json
 from ...errors import UsageError, printable
 from ...interrupt import deferred
 from ...physics import asymptotics as FM
 from ..engine import classify as C
 from ..engine import limit as LM
 from ..engine import runs as RN
+from ..faults import StoreDamaged
 from . import integrity as IN
 
 DIMS = ("model", "delta", "chi", "member")
@@ -118,8 +118,6 @@ SERIES = "series"          # omega(tau) of a cell's first members (``[output].se
 def run_variables(path: str) -> tuple:
     """The per-run variables of the store at ``path``: ``RUN_VARIABLES``, and ``series`` where kept."""
     return RUN_VARIABLES + ((SERIES,) if os.path.isdir(os.path.join(path, SERIES)) else ())
-MAX_CHUNK_RUNS = 4096
-MAX_CHUNK_MEMBERS = 256
 
 
 def predictions(delta: float, chi: float) -> list[float]:
@@ -133,19 +131,13 @@ def predictions(delta: float, chi: float) -> list[float]:
             tr["T4_A2"], tr["T4_beta"], tr["T2_B2"], tr["T2_alpha"]]
 
 
-def chunk_shape(spec) -> tuple:
-    """Storage chunk: one model, one delta, a row of chi, the members (at most ~4096 runs)."""
-    cm = min(spec.members, MAX_CHUNK_MEMBERS)
-    cc = max(1, min(len(spec.chis), MAX_CHUNK_RUNS // cm))
-    return (1, 1, cc, cm)
-
-
 def _flags(names) -> dict:
     return {"flag_values": list(names.keys()), "flag_meanings": " ".join(str(v).replace(" ", "_") for v in names.values())}
 
 
-def template(spec, chunks: tuple):
-    """The empty Dataset (dask-backed, so writing it writes only metadata)."""
+def template(spec, chunks: tuple, sha256: str):
+    """The empty Dataset of ``spec`` (dask-backed, so writing it writes only metadata), stored
+    in ``chunks`` and carrying ``sha256`` (``levels.identity``) as its identity."""
     # Long on purpose: every variable, coordinate and attribute of the store declared in one place
     import dask.array as da
     import xarray as xr
@@ -200,7 +192,7 @@ def template(spec, chunks: tuple):
     attrs = {
         "title": spec.title or os.path.basename(spec.path),
         "spec": spec.canonical_json(),
-        "spec_sha256": identity(spec),
+        "spec_sha256": sha256,
         **({"grid_axes": json.dumps({k: list(v) for k, v in spec.axes.items()})} if spec.axes else {}),
         "seed": -1 if spec.seed is None else int(spec.seed),
         "spinviz_version": __version__,
@@ -214,17 +206,9 @@ def template(spec, chunks: tuple):
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def identity(spec) -> str:
-    """sha256 of the spec's canonical JSON with the classifier's version: equal identities,
-    equal numbers (the title and description do not enter)."""
-    import hashlib
-
-    return hashlib.sha256(f"classifier {C.VERSION}\n{spec.canonical_json()}".encode()).hexdigest()
-
-
-def create(spec, path: str, chunks: tuple | None = None) -> None:
-    """Write the empty store at ``path`` atomically (temporary sibling, then rename)."""
-    chunks = chunks or chunk_shape(spec)
+def create(spec, path: str, chunks: tuple, sha256: str) -> None:
+    """Write the empty store of ``spec`` at ``path`` atomically (temporary sibling, then
+    rename): chunked as ``chunks`` (``levels.chunk_shape``), carrying ``sha256``."""
     parent = os.path.dirname(os.path.abspath(path)) or "."
     os.makedirs(parent, exist_ok=True)
     # .NAME.XXXXXXXX.partial: what a kill before the rename leaves, recognised by that name
@@ -232,7 +216,7 @@ def create(spec, path: str, chunks: tuple | None = None) -> None:
     tmp = tempfile.mkdtemp(prefix=f".{os.path.basename(os.path.abspath(path))}.", suffix=".partial", dir=parent)
     try:
         store = os.path.join(tmp, "atlas.zarr")
-        template(spec, chunks).to_zarr(store, mode="w-", compute=False, zarr_format=2, consolidated=True)
+        template(spec, chunks, sha256).to_zarr(store, mode="w-", compute=False, zarr_format=2, consolidated=True)
         IN.record_skeleton(store)                      # checksums of the skeleton, inside the store before it lands
         with deferred():
             if os.path.exists(path):
@@ -240,29 +224,6 @@ def create(spec, path: str, chunks: tuple | None = None) -> None:
             os.rename(store, path)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-
-
-def check_identity(spec, path: str) -> None:
-    """Refuse (``UsageError``, one line) a store that is not an atlas of this very spec."""
-    import zarr
-
-    try:
-        attrs = dict(zarr.open_group(path, mode="r", zarr_format=2).attrs)
-    except Exception as e:                             # not a Zarr group at all
-        raise UsageError(f"{path}: exists and is not an atlas store ({type(e).__name__}); choose another store path") from None
-    if "spec_sha256" not in attrs:
-        raise UsageError(f"{path}: exists and is not an atlas store (no spec_sha256); choose another store path")
-    if attrs["spec_sha256"] != identity(spec):
-        what = "the same spec from another classifier version" if _same_spec(attrs, spec) else "another spec"
-        raise UsageError(f"{path}: holds an atlas of {what} (sha256 {attrs['spec_sha256'][:12]}, this spec "
-                         f"{identity(spec)[:12]}); refusing to mix them: choose another store path or delete it")
-
-
-def _same_spec(attrs: dict, spec) -> bool:
-    try:
-        return loads_json(attrs.get("spec", "")) == json.loads(spec.canonical_json())
-    except (TypeError, ValueError):
-        return False
 
 
 def level_path(out: str, k: int) -> str:
@@ -415,6 +376,41 @@ def verify(path: str) -> IN.Report:
 # The first classifier version whose ``regime`` of a handed-over run is what its state shows at
 # tau_end; a hand-over store of an earlier version holds the attractor there (``label_inf``'s value)
 STATE_LABELS_SINCE = 4
+
+
+def resume(path: str, say) -> tuple:
+    """An existing store, whose skeleton and identity ``levels.open_level`` judged: every chunk
+    verified against its checksums; damaged or unverified chunks are emptied (their runs
+    recomputed) and leftover temporary files removed, each said in one line.
+
+    Returns (chunks, done mask, runs to recompute, notices)."""
+    rep = verify(path)
+    if rep.skeleton is None or rep.skeleton:          # changed since it was judged: another hand in the store
+        raise StoreDamaged(f"{path}: its metadata changed while it was being opened; move it away and compute the "
+                           f"atlas again")
+    notices = []
+    shape, chunks = IN.layout(path)
+    bad = rep.bad_keys
+    repaired = 0
+    if bad:
+        with deferred():
+            IN.discard(path, run_variables(path), bad, rep.leftovers)
+        n = sum(int(np.prod([r.stop - r.start for r in IN.chunk_region(k, shape, chunks)])) for k in bad)
+        repaired = n
+        what = "damaged" if rep.damaged else "unverified"
+        if rep.damaged and rep.unrecorded:
+            what = "damaged or unverified"
+        notices.append(f"{path}: {len(bad)} {what} chunk{'s' if len(bad) != 1 else ''} ({IN.summary(rep.problems())}); "
+                       f"{'their' if len(bad) != 1 else 'its'} {n} runs are recomputed")
+    elif rep.leftovers:
+        with deferred():
+            IN.discard(path, run_variables(path), [], rep.leftovers)
+    if rep.leftovers and not bad:
+        notices.append(f"{path}: removed {len(rep.leftovers)} temporary file{'s' if len(rep.leftovers) != 1 else ''} "
+                       f"of an interrupted write ({IN.summary([IN.Damage(x, 'leftover') for x in rep.leftovers], 3)})")
+    for line in notices:
+        say(line)
+    return tuple(chunks), done_mask(path), repaired, notices
 
 
 def open_atlas(path: str):

@@ -13,13 +13,16 @@ a store this way.
 
 from __future__ import annotations
 
+import json
 import os
 import re
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ...atomic import loads_json
 from ...errors import SceneError, UsageError
+from ...interrupt import deferred
 from ..engine import classify as C
 from ..engine import refine as RF
 from ..faults import ForeignLevel, StoreDamaged
@@ -27,6 +30,14 @@ from . import dataset as DS
 from . import integrity as IN
 
 LEVEL_DIR = re.compile(r"level([1-9][0-9]*)")
+MAX_CHUNK_RUNS = 4096
+MAX_CHUNK_MEMBERS = 256
+
+
+def centres(lo: float, hi: float, cells: int, level: int) -> np.ndarray:
+    """Cell centres of level ``level`` over [lo, hi] (``cells`` at level 0)."""
+    n = cells * 2**level
+    return lo + (np.arange(n) + 0.5) * (hi - lo) / n
 
 
 def level_spec(spec, k: int):
@@ -35,13 +46,53 @@ def level_spec(spec, k: int):
         return spec
     (d0, d1, nd), (c0, c1, nc) = spec.axes["delta"], spec.axes["chi"]
     return replace(spec, title=f"{spec.title or os.path.basename(spec.path)}: refinement level {k}",
-                   deltas=RF.centres(d0, d1, nd, k), chis=RF.centres(c0, c1, nc, k), refine_levels=0,
+                   deltas=centres(d0, d1, nd, k), chis=centres(c0, c1, nc, k), refine_levels=0,
                    axes={"delta": (d0, d1, nd * 2**k), "chi": (c0, c1, nc * 2**k)})
+
+
+def identity(spec) -> str:
+    """sha256 of the spec's canonical JSON with the classifier's version: equal identities,
+    equal numbers (the title and description do not enter)."""
+    import hashlib
+
+    return hashlib.sha256(f"classifier {C.VERSION}\n{spec.canonical_json()}".encode()).hexdigest()
 
 
 def level_identity(spec, k: int) -> str:
     """The ``spec_sha256`` level ``k`` of an atlas of ``spec`` must carry."""
-    return DS.identity(level_spec(spec, k))
+    return identity(level_spec(spec, k))
+
+
+def check_identity(spec, path: str) -> None:
+    """Refuse (``UsageError``, one line) a store that is not an atlas of this very spec."""
+    import zarr
+
+    try:
+        attrs = dict(zarr.open_group(path, mode="r", zarr_format=2).attrs)
+    except Exception as e:                             # not a Zarr group at all
+        raise UsageError(f"{path}: exists and is not an atlas store ({type(e).__name__}); choose another store path") from None
+    if "spec_sha256" not in attrs:
+        raise UsageError(f"{path}: exists and is not an atlas store (no spec_sha256); choose another store path")
+    want = identity(spec)
+    if attrs["spec_sha256"] != want:
+        what = "the same spec from another classifier version" if _same_spec(attrs, spec) else "another spec"
+        raise UsageError(f"{path}: holds an atlas of {what} (sha256 {attrs['spec_sha256'][:12]}, this spec "
+                         f"{want[:12]}); refusing to mix them: choose another store path or delete it")
+
+
+def _same_spec(attrs: dict, spec) -> bool:
+    try:
+        return loads_json(attrs.get("spec", "")) == json.loads(spec.canonical_json())
+    except (TypeError, ValueError):
+        return False
+
+
+def chunk_shape(spec) -> tuple:
+    """A level's storage chunk: one model, one delta, a row of chi, the members (at most
+    ``MAX_CHUNK_RUNS`` runs, ``MAX_CHUNK_MEMBERS`` members)."""
+    cm = min(spec.members, MAX_CHUNK_MEMBERS)
+    cc = max(1, min(len(spec.chis), MAX_CHUNK_RUNS // cm))
+    return (1, 1, cc, cm)
 
 
 def level_types(path: str, model_index: int):
@@ -75,34 +126,85 @@ def wanted(spec, paths: list, k: int) -> np.ndarray:
 
 @dataclass
 class Level:
-    """One level of the quadtree (``refine``): its spec (level 0: the spec itself; level k: the
-    grid cut 2^k times finer), its store (level 0: ``out``; level k: ``out/levelK``, an atlas
-    store of its own), the cells to compute (model, delta, chi) -- None: all -- and what its
-    directory holds (``State``; None for level 0, which ``check_store`` judged)."""
+    """One level of the quadtree (``refine``), opened for a run (``open_level``).
+
+    spec : level 0: the spec itself; level k: the grid cut 2^k times finer.  out : its store
+    (level 0: ``out``; level k: ``out/levelK``, an atlas store of its own).  wanted : the cells
+    (model, delta, chi) to compute -- None: all.  state : what its directory held (``State``;
+    None for level 0, which ``check_store`` judged).  identity : the ``spec_sha256`` it carries.
+    chunks : its storage chunk (``chunk_shape``, or the existing store's).  done : the runs on
+    disk (model, delta, chi, member).  exists : whether its store exists.  repaired : runs of
+    damaged or unverified chunks to recompute.  notices : what was said on opening it.
+    """
 
     spec: object
     out: str
     wanted: np.ndarray | None
     state: State | None = None
+    identity: str = ""
+    chunks: tuple = ()
+    done: np.ndarray | None = None
+    exists: bool = False
+    repaired: int = 0
+    notices: list = field(default_factory=list)
 
     @property
     def runs(self) -> int:
         """Runs this level holds: all of its spec's, or its wanted cells' members."""
         return self.spec.runs if self.wanted is None else int(self.wanted.sum()) * self.spec.members
 
+    @property
+    def skip(self) -> np.ndarray:
+        """The runs not to compute: those on disk, and those outside the wanted cells."""
+        return self.done if self.wanted is None else (self.done | ~self.wanted[..., None])
 
-def level(spec, out: str, below: list, k: int) -> Level | None:
-    """Level ``k`` of the atlas of ``spec`` in the store ``out``, given the levels ``below`` it
-    (computed): level 0 the store itself; level k its wanted cells (``wanted``) and the state of
-    its directory against the identity it must carry -- None when the levels below flag no cell."""
-    if k == 0:
-        return Level(spec, out, None)
-    cells = wanted(spec, [x.out for x in below], k)
-    if not cells.any():
-        return None
+    @property
+    def reused(self) -> int:
+        """Runs of this level already on disk."""
+        return int(self.done.sum() if self.wanted is None else (self.done & self.wanted[..., None]).sum())
+
+
+def open_level(spec, out: str, below: list, k: int, *, retry_failed: bool = False, say=print) -> Level | None:
+    """Level ``k`` of the atlas of ``spec`` in the store ``out``, ready to run, given the levels
+    ``below`` it (computed); None when they flag no cell for it.
+
+    Level 0 is the store itself: an existing one is judged whole first (``check_store``: of
+    this very spec, every ``levelK`` in it a level of this spec).  Level k holds the children of
+    the cells the levels below flag (``wanted``); a damaged level store is removed -- a level is
+    recomputable from the spec and the levels below -- and said in one line, a foreign one
+    refused.  An existing store is then resumed (``dataset.resume``: every chunk against its
+    checksums); ``retry_failed`` also recomputes the runs recorded as failed."""
     sub = level_spec(spec, k)
     path = DS.level_path(out, k)
-    return Level(sub, path, cells, state(path, DS.identity(sub)))
+    sha = identity(sub)
+    chunks = chunk_shape(sub)
+    notices: list = []
+    cells, st = None, None
+    if k == 0:
+        if os.path.exists(path):
+            check_store(spec, path)
+    else:
+        st = state(path, sha)
+        cells = wanted(spec, [x.out for x in below], k)
+        if not cells.any():
+            return None
+        if st.kind == "foreign":                     # appeared since the check: another hand in the store
+            raise ForeignLevel(f"{path}: holds a refinement level of another atlas; remove it (rm -r {path}) and "
+                               f"run the same command again")
+        if st.kind == "damaged":
+            with deferred():
+                IN.remove(path)
+            notices.append(f"{path}: {st.why}; the level is computed again")
+            say(notices[-1])
+    exists = os.path.exists(path)
+    done = np.zeros((len(sub.models), len(sub.deltas), len(sub.chis), sub.members), dtype=bool)
+    repaired = 0
+    if exists:
+        chunks, done, repaired, said = DS.resume(path, say)
+        notices += said
+        if retry_failed:
+            done &= DS.regime_codes(path) != -1
+    return Level(sub, path, cells, st, sha, chunks, done, exists, repaired, notices)
 
 
 def check_store(spec, out: str) -> None:
@@ -117,13 +219,13 @@ def check_store(spec, out: str) -> None:
     if skeleton is None:
         if not os.path.exists(os.path.join(out, ".zgroup")):
             raise UsageError(f"{out}: exists and is not an atlas store (no .zgroup); choose another store path")
-        DS.check_identity(spec, out)                 # another Zarr store, or another spec: said as such
+        check_identity(spec, out)                    # another Zarr store, or another spec: said as such
         raise StoreDamaged(f"{out}: carries no checksums (made by an earlier spinviz, or its {IN.DIR} was deleted), "
                            f"so its runs cannot be trusted; move it away and compute the atlas again")
     if skeleton:
         raise StoreDamaged(f"{out}: its metadata are damaged ({IN.summary(skeleton, 4)}); they cannot be "
                            f"recomputed from the runs: move it away and compute the atlas again")
-    DS.check_identity(spec, out)
+    check_identity(spec, out)
     for k in found(out):
         path = DS.level_path(out, k)
         if k > spec.refine_levels:
@@ -204,10 +306,10 @@ def recorded_spec(path: str):
         raise SceneError(where, "(file)", "unreadable: not the attributes of an atlas store") from None
     spec = replace(spec_from_record(attrs, where), path=path)
     version = attrs.get("classifier_version")
-    if version != C.VERSION and DS.identity(spec) != attrs.get("spec_sha256"):
+    if version != C.VERSION and identity(spec) != attrs.get("spec_sha256"):
         raise SceneError(where, "classifier_version", f"{version!r}: made by another classifier version (this "
                                                       f"spinviz's is {C.VERSION}), whose labels mean another thing")
-    if DS.identity(spec) != attrs.get("spec_sha256"):
+    if identity(spec) != attrs.get("spec_sha256"):
         raise SceneError(where, "spec_sha256", "does not match the recorded spec (the attributes were changed)")
     return spec
 

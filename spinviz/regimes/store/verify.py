@@ -94,7 +94,7 @@ def _judge_top(path: str, problems: list):
             lines.insert(1, f"spec: DAMAGED ({e.key}: {e.reason})")
             problems.append(("metadata", "the recorded spec does not hold; compute the atlas again into a new store"))
         else:
-            lines.insert(1, f"spec: ok (sha256 {DS.identity(spec)[:12]}, [refine] levels = {spec.refine_levels})")
+            lines.insert(1, f"spec: ok (sha256 {LV.identity(spec)[:12]}, [refine] levels = {spec.refine_levels})")
     entry = _entry(path, 0, lines, rep, ok=rep.clean and spec is not None)
     _chunk_problems(entry, rep, problems)
     if spec is not None and rep.clean:

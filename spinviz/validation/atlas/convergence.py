@@ -173,8 +173,8 @@ def tolerance(members: int = 8, rtols=TOLERANCES, cells: int = 12, seed: int = 1
     from ...inputs.options import EvidenceRequest
 
     EvidenceRequest(members=members, tau_end=tau_end)
-    from ...regimes.engine.refine import centres
     from ...regimes.engine.runs import warm
+    from ...regimes.store.levels import centres
 
     say = progress or (lambda m: None)
     grid = [(d, math.radians(c)) for d in centres(-1.0, 1.0, cells, 0) for c in centres(0.0, 90.0, cells, 0)]

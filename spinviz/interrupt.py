@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import signal
+import sys
 import threading
 
 SIGNALS = tuple(s for s in (getattr(signal, n, None) for n in ("SIGINT", "SIGTERM", "SIGHUP")) if s is not None)
@@ -34,6 +35,7 @@ SIGNALS = tuple(s for s in (getattr(signal, n, None) for n in ("SIGINT", "SIGTER
 _received: int | None = None
 _raised = False           # the first signal was raised as ``Interrupted`` (so it was acted on)
 _held = False             # the command's work is over: signals are only recorded (``hold``)
+_outer_hook = None        # the ``sys.unraisablehook`` that ``install()`` found in place
 
 
 class Interrupted(KeyboardInterrupt):
@@ -86,10 +88,26 @@ def _handler(signum, frame):
         raise Interrupted(signum)
 
 
+def _unraisable(u) -> None:
+    """``sys.unraisablehook`` while the handlers are installed.  Wherever else Python cannot
+    unwind -- C code that calls back into Python and reports what it raised as "Exception
+    ignored in ..." -- an ``Interrupted`` raised there stays pending, silently: the next
+    ``check()`` raises it, or the command line reports it as it exits.  Anything else goes
+    to the hook that was in place."""
+    global _raised
+    if isinstance(u.exc_value, Interrupted):
+        _raised = False
+        return
+    (_outer_hook or sys.__unraisablehook__)(u)
+
+
 def install() -> None:
-    """Turn SIGINT, SIGTERM and SIGHUP into ``Interrupted`` (main thread only)."""
-    global _received, _raised, _held
+    """Turn SIGINT, SIGTERM and SIGHUP into ``Interrupted`` (main thread only), and keep one
+    that Python swallows pending (``_unraisable``)."""
+    global _received, _raised, _held, _outer_hook
     _received, _raised, _held = None, False, False
+    if sys.unraisablehook is not _unraisable:
+        _outer_hook, sys.unraisablehook = sys.unraisablehook, _unraisable
     for s in SIGNALS:
         signal.signal(s, _handler)
 
@@ -110,6 +128,7 @@ def handlers():
         return
     global _received, _raised, _held, _deferring
     old = {s: signal.getsignal(s) for s in SIGNALS}
+    hook = sys.unraisablehook
     depth = _deferring
     install()
     try:
@@ -117,6 +136,7 @@ def handlers():
     finally:
         for s, h in old.items():
             signal.signal(s, h)
+        sys.unraisablehook = hook
         _received, _raised, _held, _deferring = None, False, False, depth   # a later run here starts clean
 
 

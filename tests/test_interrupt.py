@@ -97,6 +97,39 @@ def test_a_signal_inside_a_weakref_callback_or_finalizer_is_recorded_not_raised(
         assert swallowed == [], make
 
 
+def test_a_signal_raised_where_python_cannot_unwind_stays_pending_and_silent(monkeypatch, capsys):
+    """A callback that C code calls and whose exception Python only reports ("Exception
+    ignored in ..."), here a weak reference's callback of a module the handler does not
+    recognise: the signal raised there is not printed, stays pending, and ``check()`` raises
+    it; other unraisable exceptions still reach the hook that was in place."""
+    import sys
+    import weakref
+
+    class Thing:
+        pass
+
+    def callback(_):
+        send(signal.SIGINT)
+        for _ in range(1000):
+            np.sqrt(2.0)
+
+    seen = []
+    outer = sys.unraisablehook
+    with interrupt.handlers():
+        monkeypatch.setattr(interrupt, "_outer_hook", lambda u: seen.append(type(u.exc_value).__name__))
+        t = Thing()
+        ref = weakref.ref(t, callback)
+        del t
+        assert ref() is None
+        assert interrupt.pending() == signal.SIGINT
+        with pytest.raises(interrupt.Interrupted):
+            interrupt.check()
+        sys.unraisablehook(type("U", (), {"exc_value": ValueError("x")})())
+    assert sys.unraisablehook is outer
+    assert seen == ["ValueError"]
+    assert "Exception ignored" not in capsys.readouterr().err
+
+
 def test_a_stopped_kernel_has_returned_before_the_signal_is_reraised():
     """A signal landing while the main thread waits for a kernel: the exception reaches the
     caller only after the kernel saw its stop flag and returned.  (With Thread.join, CPython

@@ -113,7 +113,7 @@ def compute(spec, out: str, *, scheduler=None, workers=None, processes: bool = T
             if not lv.exists:
                 DS.create(lv.spec, path, lv.chunks, lv.identity)
             writer = DS.Writer(path, expected, flush_s=flush_s)
-            label = os.path.basename(out) if k == 0 else f"{os.path.basename(out)}/{os.path.basename(path)}"
+            label = os.path.basename(path) if k == 0 else f"{os.path.basename(os.path.dirname(path))}/{os.path.basename(path)}"
             bar = Progress(sum(b.runs for b in batches), f"atlas {printable(label, 80)}", enabled=progress)
             s = None
             try:                                 # each result written into the level's store as it arrives

@@ -134,9 +134,8 @@ def compute(spec, out: str, *, scheduler=None, workers=None, processes: bool = T
             if s.incomplete is not None:
                 if s.incomplete.cluster_lost:
                     cluster.close_fast()
-                done = DS.done_mask(path)
-                done = int((done if lv.wanted is None else done & lv.wanted[..., None]).sum())
-                raise AtlasIncomplete(path, s.incomplete.cause, lv.runs - done, lv.runs, done, s.incomplete.cluster_lost)
+                done, runs = LV.done_within(path, lv.wanted)
+                raise AtlasIncomplete(path, s.incomplete.cause, runs - done, runs, done, s.incomplete.cluster_lost)
         notices += _not_implied(out, len(levels), say)
     seconds = time.perf_counter() - t0
     return AtlasResult(out, totals["runs"], totals["todo"], totals["reused"], totals["failed"], seconds, where, [], stats,

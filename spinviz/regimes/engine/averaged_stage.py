@@ -9,17 +9,16 @@ import math
 
 import numpy as np
 
-from ...integrators.cache import working
+from ...integrators import cache
 
 LV_TOL = 1e-12              # Taylor tolerance of the averaged stage (on ln A, ln B)
+_LV: dict = {}              # (LV)'s built integrators of this process, by batch width
 
 
 def lv_template(batch: int):
     """heyoka's batch integrator of (LV) in (ln A, ln B) against sigma = s - s_h, (P, Q, R, S)
     in par[0..3] per lane (built once per process, kept in spinviz's integrator cache)."""
     import heyoka as hy
-
-    from ...integrators import cache
 
     key = ("lv", batch)
     ta = _LV.get(key)
@@ -34,9 +33,6 @@ def lv_template(batch: int):
             cache.store(digest, ta)
         _LV[key] = ta
     return ta
-
-
-_LV: dict = {}
 
 
 def averaged_stage(flows: list, tau: np.ndarray, handed: list, omega_h, mu_limit: float) -> list[dict]:
@@ -57,7 +53,7 @@ def averaged_stage(flows: list, tau: np.ndarray, handed: list, omega_h, mu_limit
                     "y0": (math.log(max(abs(zb) ** 2 * t_h, 1e-300)), math.log(max(w3b * w3b * t_h, 1e-300))),
                     "sigma": np.log(tau[idx] / t_h)})
     n = width()
-    ta = working(lv_template(n)) if flows else None
+    ta = cache.working(lv_template(n)) if flows else None
     for a in range(0, len(flows), n):
         part = list(range(a, min(a + n, len(flows))))
         _lv_lanes(ta, [flows[i] for i in part], [out[i] for i in part], n)

@@ -86,9 +86,6 @@ NOISE_PROBES = 4            # handed-over runs per cell rerun at rtol/100 for th
 NOISE_FACTOR = 10.0         # a component below this x the floor is not resolved
 RESIDUAL_C = 5.0            # the transform's own residual on the forced response: 5 mu^2 |z_f| (measured)
 CHUNK_MAX = 40              # samples a lane advances at most between looks
-LV_RTOL = 1e-10             # the averaged stage's tolerance (on ln A, ln B)
-
-
 
 
 # --- where the engine hands over -------------------------------------------------------------

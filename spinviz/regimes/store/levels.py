@@ -161,7 +161,7 @@ class Level:
     @property
     def reused(self) -> int:
         """Runs of this level already on disk."""
-        return int(self.done.sum() if self.wanted is None else (self.done & self.wanted[..., None]).sum())
+        return counted(self.done, self.wanted)[0]
 
 
 def open_level(spec, out: str, below: list, k: int, *, retry_failed: bool = False, say=print) -> Level | None:
@@ -197,13 +197,13 @@ def open_level(spec, out: str, below: list, k: int, *, retry_failed: bool = Fals
             notices.append(f"{path}: {st.why}; the level is computed again")
             say(notices[-1])
     exists = os.path.exists(path)
-    done = np.zeros((len(sub.models), len(sub.deltas), len(sub.chis), sub.members), dtype=bool)
-    repaired = 0
     if exists:
         chunks, done, repaired, said = DS.resume(path, say)
         notices += said
         if retry_failed:
             done &= DS.regime_codes(path) != -1
+    else:
+        done, repaired = np.zeros((len(sub.models), len(sub.deltas), len(sub.chis), sub.members), dtype=bool), 0
     return Level(sub, path, cells, st, sha, chunks, done, exists, repaired, notices)
 
 
@@ -316,7 +316,12 @@ def recorded_spec(path: str):
 
 def done_within(path: str, cells: np.ndarray | None) -> tuple[int, int]:
     """(runs done, runs wanted) of a level store: all its runs, or the members of ``cells``."""
-    done = DS.done_mask(path)
+    return counted(DS.done_mask(path), cells)
+
+
+def counted(done: np.ndarray, cells: np.ndarray | None) -> tuple[int, int]:
+    """(runs done, runs wanted) of a done mask (model, delta, chi, member): all its runs, or
+    the members of ``cells`` (model, delta, chi)."""
     if cells is None:
         return int(done.sum()), int(done.size)
     return int((done & cells[..., None]).sum()), int(cells.sum()) * done.shape[-1]
